@@ -1,0 +1,63 @@
+// Pinhole camera (ARCHITECTURE.md, "Coordinate and camera conventions"): right-handed world,
+// +Y up, the camera looks down its -Z axis, image rows go top to bottom, perspective with a
+// vertical field of view.
+#pragma once
+
+#include <array>
+
+#include "pointillist/core/math.hpp"
+
+namespace pointillist {
+
+struct Camera {
+  Vec3f eye{0, 0, 1};
+  Vec3f target{0, 0, 0};
+  Vec3f up{0, 1, 0};
+  float fov_deg = 30.0f;  // vertical field of view
+  int width = 1024;       // image size in pixels
+  int height = 768;
+};
+
+// An orbit around a model's view sphere (centre c, radius R = largest distance from c to a
+// sample): eye = c + D·R·(cos(el)·sin(az), sin(el), cos(el)·cos(az)), looking at c, up +Y.
+struct OrbitOptions {
+  float azimuth_deg = 0.0f;
+  float elevation_deg = 0.0f;
+  float distance = 0.0f;  // D in units of R; 0 = 1.05 / sin(fov/2), the whole model in view
+  float fov_deg = 30.0f;
+  int width = 1024;
+  int height = 768;
+};
+
+// Throws OptionError when the elevation is ±90° (the up vector is then undefined) or the
+// size/fov/distance is out of range.
+Camera orbit_camera(const Sphere& view_sphere, const OrbitOptions& options);
+
+// A plane n·p + d = 0 with unit normal n; signed distance n·p + d, positive inside.
+struct Plane {
+  Vec3f normal;
+  float d = 0;
+  float distance(Vec3f p) const { return dot(normal, p) + d; }
+};
+
+// Everything the renderer derives from a Camera: an orthonormal eye basis, the focal length in
+// pixels, and the four side planes of the view frustum (no near/far planes: depth is tested
+// separately).
+struct CameraFrame {
+  Vec3f eye;
+  Vec3f right;    // +x on screen
+  Vec3f up;       // +y on screen (rows go down, so pixel y decreases along it)
+  Vec3f forward;  // viewing direction (= -Z of the camera); depth = dot(p - eye, forward)
+  float focal_px = 1;  // f = (H/2) / tan(fov/2)
+  int width = 1, height = 1;
+  std::array<Plane, 4> planes;  // left, right, bottom, top; normals point into the frustum
+
+  // Depth (eye-space distance along the view direction; positive in front).
+  float depth(Vec3f p) const { return dot(p - eye, forward); }
+};
+
+// Throws OptionError when eye == target, up is parallel to the view direction, fov is not in
+// (0, 180) or the size is not positive.
+CameraFrame make_camera_frame(const Camera& camera);
+
+}  // namespace pointillist

@@ -1,0 +1,76 @@
+// QSplat bounding-sphere hierarchy (Rusinkiewicz & Levoy, "QSplat: A Multiresolution Point
+// Rendering System for Large Meshes", SIGGRAPH 2000).
+//
+// Nodes are stored breadth-first in one flat array: node 0 is the root, the children of a node
+// are `child_count` consecutive nodes starting at `first_child`, and every node's children come
+// after it, so the coarse levels are a prefix of the array. Leaves are single input splats.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "pointillist/core/math.hpp"
+#include "pointillist/core/point_set.hpp"
+#include "pointillist/core/progress.hpp"
+#include "pointillist/core/thread_pool.hpp"
+
+namespace pointillist {
+
+// 40 bytes, no padding; written to .ptl files as is (little endian), so the layout is fixed.
+struct SphereNode {
+  Vec3f center;             // bounding sphere of the subtree (world units)
+  float radius = 0;
+  Vec3f normal;             // unit mean normal of the subtree (area weighted)
+  // Normal cone: sine of the half-angle θ of a cone around `normal` that contains every normal
+  // of the subtree. Backface culling of the subtree is possible only when θ < 90°; a value
+  // >= 1 means "no bound" (θ >= 90°). Leaves have 0.
+  float cone_sin = 0;
+  std::uint32_t first_child = 0;  // index of the first child; 0 for leaves
+  std::uint8_t child_count = 0;   // 0 for leaves, else 2..4
+  Rgb8 color;                     // mean color of the subtree (meaningful when the tree has colors)
+};
+static_assert(sizeof(SphereNode) == 40, "SphereNode is a file layout");
+
+// Non-owning view of a hierarchy, e.g. over a memory-mapped .ptl file.
+struct SphereTreeView {
+  std::span<const SphereNode> nodes;
+  bool has_colors = false;
+  std::uint64_t leaf_count = 0;
+  std::uint32_t depth = 0;  // levels below the root (a single leaf has depth 0)
+  Aabb bounds;              // box around all sample positions (not radii)
+  Sphere view_sphere;       // centre of `bounds`, largest distance to a sample (orbit camera)
+};
+
+// Owning hierarchy as built in memory.
+struct SphereTree {
+  std::vector<SphereNode> nodes;
+  bool has_colors = false;
+  std::uint64_t leaf_count = 0;
+  std::uint32_t depth = 0;
+  Aabb bounds;
+  Sphere view_sphere;
+
+  SphereTreeView view() const {
+    return {nodes, has_colors, leaf_count, depth, bounds, view_sphere};
+  }
+};
+
+struct SphereTreeOptions {
+  // Subtrees smaller than this many points are built by one task; larger ones split in parallel.
+  // Only changes speed, never the result.
+  std::size_t parallel_grain_points = 1 << 15;
+};
+
+// Builds the hierarchy over `points` (positions, normals and radii required; colors optional).
+// Splits at the median along the longest axis of the bounding box, recursively, and collapses
+// the binary tree so every interior node has 2–4 children. Interior spheres enclose their
+// children's spheres; normals are area-weighted means (weight r²) with a cone covering the
+// children's cones; colors are means. O(n log n), parallel, deterministic for any thread count.
+// Throws Error when points is empty, when normals or radii are missing, or on more than
+// 2^31 points.
+SphereTree build_sphere_tree(const PointSet& points, ThreadPool& pool,
+                             Progress& progress = Progress::none(),
+                             const SphereTreeOptions& options = {});
+
+}  // namespace pointillist

@@ -1,0 +1,80 @@
+#include "pointillist/core/camera.hpp"
+
+#include <cmath>
+#include <string>
+
+#include "pointillist/core/error.hpp"
+
+namespace pointillist {
+
+Camera orbit_camera(const Sphere& view_sphere, const OrbitOptions& o) {
+  if (!(std::abs(o.elevation_deg) < 89.999f)) {
+    throw OptionError("view elevation " + std::to_string(o.elevation_deg) +
+                      "° is at or beyond a pole; use a value strictly between -90 and 90, or "
+                      "give --eye/--target/--up");
+  }
+  if (!(o.fov_deg > 0.0f && o.fov_deg < 180.0f)) {
+    throw OptionError("field of view " + std::to_string(o.fov_deg) +
+                      "° is out of range; use a value between 0 and 180 (exclusive)");
+  }
+  if (o.distance < 0.0f || !std::isfinite(o.distance)) {
+    throw OptionError("view distance " + std::to_string(o.distance) +
+                      " is invalid; give a positive multiple of the model radius (or 0 for auto)");
+  }
+  const float half_fov = deg_to_rad(o.fov_deg) * 0.5f;
+  const float d = o.distance > 0.0f ? o.distance : 1.05f / std::sin(half_fov);
+  const float az = deg_to_rad(o.azimuth_deg);
+  const float el = deg_to_rad(o.elevation_deg);
+  const float radius = view_sphere.radius > 0.0f ? view_sphere.radius : 1.0f;
+  const Vec3f dir{std::cos(el) * std::sin(az), std::sin(el), std::cos(el) * std::cos(az)};
+  Camera cam;
+  cam.eye = view_sphere.center + dir * (d * radius);
+  cam.target = view_sphere.center;
+  cam.up = {0, 1, 0};
+  cam.fov_deg = o.fov_deg;
+  cam.width = o.width;
+  cam.height = o.height;
+  return cam;
+}
+
+CameraFrame make_camera_frame(const Camera& c) {
+  if (c.width <= 0 || c.height <= 0) {
+    throw OptionError("image size " + std::to_string(c.width) + "x" + std::to_string(c.height) +
+                      " is invalid; both sides must be positive");
+  }
+  if (!(c.fov_deg > 0.0f && c.fov_deg < 180.0f)) {
+    throw OptionError("field of view " + std::to_string(c.fov_deg) +
+                      "° is out of range; use a value between 0 and 180 (exclusive)");
+  }
+  const Vec3f view = c.target - c.eye;
+  if (!(length(view) > 0.0f) || !is_finite(view)) {
+    throw OptionError("camera eye and target coincide (or are not finite); give distinct points");
+  }
+  CameraFrame f;
+  f.eye = c.eye;
+  f.forward = normalized(view);
+  const Vec3f right = cross(f.forward, c.up);
+  if (!(length(right) > 1e-6f * length(c.up))) {
+    throw OptionError("camera up vector is parallel to the viewing direction; choose another --up");
+  }
+  f.right = normalized(right);
+  f.up = cross(f.right, f.forward);
+  f.width = c.width;
+  f.height = c.height;
+  const float tan_half_v = std::tan(deg_to_rad(c.fov_deg) * 0.5f);
+  f.focal_px = (static_cast<float>(c.height) * 0.5f) / tan_half_v;
+  const float tan_half_h = static_cast<float>(c.width) * 0.5f / f.focal_px;
+  // Side planes through the eye; a point is inside when its lateral offset is within
+  // depth * tan(half angle). Normals are the inward unit normals of those planes.
+  const auto plane_through_eye = [&](Vec3f n) {
+    n = normalized(n);
+    return Plane{n, -dot(n, f.eye)};
+  };
+  f.planes[0] = plane_through_eye(f.right + f.forward * tan_half_h);   // left
+  f.planes[1] = plane_through_eye(-f.right + f.forward * tan_half_h);  // right
+  f.planes[2] = plane_through_eye(f.up + f.forward * tan_half_v);      // bottom
+  f.planes[3] = plane_through_eye(-f.up + f.forward * tan_half_v);     // top
+  return f;
+}
+
+}  // namespace pointillist

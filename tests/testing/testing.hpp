@@ -1,0 +1,33 @@
+// Helpers shared by the test suites: where test data lives, temporary folders.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+namespace pointillist::testing {
+
+// tests/data in the source tree (small files committed with the tests).
+std::filesystem::path test_data_dir();
+// ../shared/testdata beside the project (QSplat reference files and friends).
+std::filesystem::path shared_testdata_dir();
+// The model cache filled by scripts/fetch-models.sh: $POINTILLIST_MODELS, else
+// $XDG_CACHE_HOME/pointillist/models, else ~/.cache/pointillist/models.
+std::filesystem::path model_cache_dir();
+// Path of a fetched model (e.g. "dragon_vrip.ply.gz"), or empty when it has not been fetched.
+std::filesystem::path cached_model(const std::string& file_name);
+
+// A fresh, empty temporary folder removed when the object dies.
+class TempDir {
+ public:
+  TempDir();
+  ~TempDir();
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+  std::string file(const std::string& name) const { return (path_ / name).string(); }
+
+ private:
+  std::filesystem::path path_;
+};
+
+}  // namespace pointillist::testing
