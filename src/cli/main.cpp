@@ -1,1 +1,205 @@
-int main() { return 0; }
+// The `pointillist` command: convert scans to splat models, render them, inspect files, demo.
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <new>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cli/commands.hpp"
+#include "pointillist/core/error.hpp"
+
+namespace pc = pointillist::cli;
+using pointillist::OptionError;
+using pointillist::Vec3f;
+
+namespace {
+
+std::vector<float> parse_floats(const std::string& text, std::size_t count, const char sep,
+                                const std::string& option) {
+  std::vector<float> values;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, sep)) {
+    try {
+      std::size_t used = 0;
+      const float v = std::stof(item, &used);
+      if (used != item.size()) throw std::invalid_argument(item);
+      values.push_back(v);
+    } catch (const std::exception&) {
+      values.clear();
+      break;
+    }
+  }
+  if (values.size() != count) {
+    throw OptionError(option + " '" + text + "': expected " + std::to_string(count) +
+                      " numbers separated by '" + sep + "'");
+  }
+  return values;
+}
+
+Vec3f parse_vec3(const std::string& text, const std::string& option) {
+  const auto v = parse_floats(text, 3, ',', option);
+  return {v[0], v[1], v[2]};
+}
+
+void add_threads(CLI::App* app, unsigned& threads) {
+  app->add_option("--threads", threads, "Worker threads (0 = one per core)")->default_val(0);
+}
+
+void add_prepare_options(CLI::App* app, pointillist::PrepareOptions& p) {
+  const std::map<std::string, pointillist::NormalSource> normal_sources{
+      {"auto", pointillist::NormalSource::Auto},
+      {"keep", pointillist::NormalSource::Keep},
+      {"mesh", pointillist::NormalSource::Mesh},
+      {"pca", pointillist::NormalSource::Pca}};
+  app->add_option("--normals", p.normals,
+                  "Normal source: auto (file, else mesh faces, else PCA), keep, mesh, pca")
+      ->transform(CLI::CheckedTransformer(normal_sources, CLI::ignore_case))
+      ->default_str("auto");
+  app->add_option("--k", p.k, "Neighbours for PCA normals")->default_val(16)->check(
+      CLI::Range(3u, 256u));
+  app->add_option("--radius-scale", p.radius_scale, "Multiply every splat radius by S")
+      ->default_val(1.0f)
+      ->check(CLI::PositiveNumber);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Pointillist: multiresolution splat models from 3D scans, rendered fast on the CPU"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "pointillist 0.1.0");
+
+  // convert
+  pc::ConvertOptions convert;
+  auto* convert_cmd = app.add_subcommand(
+      "convert", "Convert scans (PLY, .ply.gz) into a splat model (.ptl) or points with normals "
+                 "and radii (.ply)");
+  convert_cmd->add_option("inputs", convert.inputs, "Input files (several are merged)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  convert_cmd->add_option("-o,--output", convert.output, "Output file: .ptl or .ply")->required();
+  add_prepare_options(convert_cmd, convert.prepare);
+  convert_cmd->add_flag("--ascii", convert.ascii, "Write .ply output as ascii");
+  add_threads(convert_cmd, convert.threads);
+  convert_cmd->add_flag("-q,--quiet", convert.quiet, "No progress bars and no summary");
+
+  // render
+  pc::RenderOptions render;
+  std::string size = "1280x720", view, eye, target, up, background = "0,0,0";
+  auto* render_cmd =
+      app.add_subcommand("render", "Render a model (.ptl, or .ply/.ply.gz built in memory) to PNG");
+  render_cmd->add_option("input", render.input, "Model file")->required()->check(CLI::ExistingFile);
+  render_cmd->add_option("-o,--output", render.output, "Output PNG")->required();
+  render_cmd->add_option("--size", size, "Image size WxH")->default_str("1280x720");
+  render_cmd->add_option("--view", view, "Orbit view AZ,EL in degrees (default 0,0)");
+  render_cmd->add_option("--distance", render.view.distance,
+                         "Eye distance in model radii (default: whole model in view)");
+  render_cmd->add_option("--fov", render.view.fov_deg, "Vertical field of view, degrees")
+      ->default_val(30.0f);
+  render_cmd->add_option("--eye", eye, "Explicit eye X,Y,Z (with --target)");
+  render_cmd->add_option("--target", target, "Explicit target X,Y,Z (with --eye)");
+  render_cmd->add_option("--up", up, "Explicit up vector X,Y,Z (default 0,1,0)");
+  render_cmd->add_option("--threshold", render.settings.threshold_px,
+                         "Stop refining at this projected splat diameter, pixels")
+      ->default_val(1.0f)
+      ->check(CLI::Range(0.01f, 1000.0f));
+  const std::map<std::string, pointillist::SplatShape> shapes{
+      {"square", pointillist::SplatShape::Square},
+      {"circle", pointillist::SplatShape::Circle},
+      {"ellipse", pointillist::SplatShape::Ellipse}};
+  render_cmd->add_option("--splat", render.settings.shape, "Splat kernel: square, circle, ellipse")
+      ->transform(CLI::CheckedTransformer(shapes, CLI::ignore_case))
+      ->default_str("circle");
+  render_cmd->add_option("--background", background, "Background color R,G,B (0-255)")
+      ->default_str("0,0,0");
+  render_cmd->add_option("--depth", render.depth_output, "Also write a 16-bit depth PNG");
+  render_cmd->add_option("--stats", render.stats_output, "Write statistics as JSON (- = stdout)");
+  add_prepare_options(render_cmd, render.prepare);
+  add_threads(render_cmd, render.threads);
+  render_cmd->add_flag("-q,--quiet", render.quiet, "No progress bars and no summary");
+
+  // info
+  pc::InfoOptions info;
+  auto* info_cmd = app.add_subcommand("info", "Describe a model or scan file");
+  info_cmd->add_option("input", info.input, "Model or scan file")->required()->check(
+      CLI::ExistingFile);
+  add_threads(info_cmd, info.threads);
+
+  // demo
+  pc::DemoOptions demo;
+  auto* demo_cmd = app.add_subcommand(
+      "demo", "Generate the built-in analytic scene, convert it, render views with every kernel "
+              "(and the Stanford dragon when fetched)");
+  demo_cmd->add_option("--out", demo.out_dir, "Output folder")->default_val("demo-out");
+  demo_cmd->add_option("--points", demo.points, "Samples in the generated scene")
+      ->default_val(400000)
+      ->check(CLI::Range(std::size_t{100}, std::size_t{200'000'000}));
+  add_threads(demo_cmd, demo.threads);
+  demo_cmd->add_flag("-q,--quiet", demo.quiet, "No progress bars");
+
+  // generate
+  pc::GenerateOptions generate;
+  auto* generate_cmd = app.add_subcommand(
+      "generate", "Write a point cloud sampled from an analytic scene (for tests and benchmarks)");
+  generate_cmd->add_option("-o,--output", generate.output, "Output .ply")->required();
+  generate_cmd->add_option("--scene", generate.scene, "demo, sphere, torus or cube")
+      ->default_val("demo");
+  generate_cmd->add_option("--points", generate.points, "Number of samples")
+      ->default_val(1000000)
+      ->check(CLI::Range(std::size_t{1}, std::size_t{2'000'000'000}));
+  generate_cmd->add_option("--seed", generate.seed, "Random seed")->default_val(1);
+  generate_cmd->add_flag("--with-normals", generate.with_normals, "Also write exact normals");
+  generate_cmd->add_flag("-q,--quiet", generate.quiet, "No summary line");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+
+  try {
+    if (*convert_cmd) return pc::run_convert(convert);
+    if (*render_cmd) {
+      const auto wh = parse_floats(size, 2, 'x', "--size");
+      render.view.width = static_cast<int>(wh[0]);
+      render.view.height = static_cast<int>(wh[1]);
+      if (wh[0] < 1 || wh[1] < 1 || wh[0] > 32768 || wh[1] > 32768 ||
+          wh[0] != render.view.width || wh[1] != render.view.height) {
+        throw OptionError("--size '" + size + "': width and height must be whole numbers from 1 to 32768");
+      }
+      if (!view.empty()) {
+        const auto ae = parse_floats(view, 2, ',', "--view");
+        render.view.azimuth_deg = ae[0];
+        render.view.elevation_deg = ae[1];
+      }
+      if (!eye.empty()) render.view.eye = parse_vec3(eye, "--eye");
+      if (!target.empty()) render.view.target = parse_vec3(target, "--target");
+      if (!up.empty()) render.view.up = parse_vec3(up, "--up");
+      const Vec3f bg = parse_vec3(background, "--background");
+      for (float c : {bg.x, bg.y, bg.z}) {
+        if (c < 0 || c > 255) throw OptionError("--background '" + background + "': components must be 0-255");
+      }
+      render.settings.background = {static_cast<std::uint8_t>(bg.x), static_cast<std::uint8_t>(bg.y),
+                                    static_cast<std::uint8_t>(bg.z)};
+      return pc::run_render(render);
+    }
+    if (*info_cmd) return pc::run_info(info);
+    if (*demo_cmd) return pc::run_demo(demo);
+    if (*generate_cmd) return pc::run_generate(generate);
+  } catch (const pointillist::Error& e) {
+    std::fprintf(stderr, "pointillist: error: %s\n", e.what());
+    return 1;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr,
+                 "pointillist: error: out of memory; the model is too large for this machine's "
+                 "memory (try fewer input files or a machine with more memory)\n");
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "pointillist: internal error: %s (please report this)\n", e.what());
+    return 2;
+  }
+  return 0;
+}

@@ -1,0 +1,70 @@
+// The `pointillist` subcommands: options structs filled by main.cpp, and the functions that run
+// them. Each returns the process exit code; errors are thrown as pointillist::Error.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "pointillist/core/camera.hpp"
+#include "pointillist/prep/prepare.hpp"
+#include "pointillist/render/render.hpp"
+
+namespace pointillist::cli {
+
+struct ConvertOptions {
+  std::vector<std::string> inputs;
+  std::string output;
+  PrepareOptions prepare;
+  bool ascii = false;  // .ply output only
+  unsigned threads = 0;
+  bool quiet = false;
+};
+int run_convert(const ConvertOptions& options);
+
+struct ViewOptions {
+  int width = 1280, height = 720;
+  float azimuth_deg = 0, elevation_deg = 0;
+  float distance = 0;  // 0 = automatic
+  float fov_deg = 30;
+  std::optional<Vec3f> eye, target, up;
+};
+
+struct RenderOptions {
+  std::string input;
+  std::string output;
+  ViewOptions view;
+  RenderSettings settings;
+  std::string depth_output;  // empty = no depth image
+  std::string stats_output;  // empty = none, "-" = stdout
+  PrepareOptions prepare;    // for .ply inputs
+  unsigned threads = 0;
+  bool quiet = false;
+};
+int run_render(const RenderOptions& options);
+
+struct InfoOptions {
+  std::string input;
+  unsigned threads = 0;
+};
+int run_info(const InfoOptions& options);
+
+struct DemoOptions {
+  std::string out_dir = "demo-out";
+  std::size_t points = 400'000;
+  unsigned threads = 0;
+  bool quiet = false;
+};
+int run_demo(const DemoOptions& options);
+
+struct GenerateOptions {
+  std::string output;
+  std::string scene = "demo";  // demo, sphere, torus, cube
+  std::size_t points = 1'000'000;
+  std::uint64_t seed = 1;
+  bool with_normals = false;  // write the exact normals too
+  bool quiet = false;
+};
+int run_generate(const GenerateOptions& options);
+
+}  // namespace pointillist::cli

@@ -1,0 +1,78 @@
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+
+#include "cli/commands.hpp"
+#include "cli/model_loading.hpp"
+#include "cli/terminal_progress.hpp"
+#include "pointillist/core/error.hpp"
+#include "pointillist/format/ptl.hpp"
+#include "pointillist/io/ply.hpp"
+#include "pointillist/lod/sphere_tree.hpp"
+
+namespace pointillist::cli {
+
+namespace {
+
+bool ends_with(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+const char* normal_source_name(NormalSource s) {
+  switch (s) {
+    case NormalSource::Auto: return "auto";
+    case NormalSource::Keep: return "keep";
+    case NormalSource::Mesh: return "mesh";
+    case NormalSource::Pca: return "pca";
+  }
+  return "?";
+}
+
+}  // namespace
+
+int run_convert(const ConvertOptions& o) {
+  const bool to_ptl = ends_with(o.output, ".ptl");
+  const bool to_ply = ends_with(o.output, ".ply");
+  if (!to_ptl && !to_ply) {
+    throw OptionError("convert: output '" + o.output +
+                      "' has an unknown extension; use .ptl (Pointillist model) or .ply (points "
+                      "with normals and radii)");
+  }
+  if (o.ascii && !to_ply) throw OptionError("convert: --ascii applies only to .ply output");
+  const auto start = std::chrono::steady_clock::now();
+  ThreadPool pool(o.threads);
+  TerminalProgress progress(!o.quiet && TerminalProgress::stderr_is_terminal());
+
+  PointSet points = read_inputs(o.inputs, pool, progress);
+  prepare_splats(points, pool, progress, o.prepare);
+  const std::size_t point_count = points.size();
+
+  if (to_ptl) {
+    const SphereTree tree = build_sphere_tree(points, pool, progress);
+    std::ostringstream meta;
+    meta << "generator: pointillist " << "0.1.0" << "\n";
+    for (const auto& in : o.inputs) meta << "source: " << in << "\n";
+    meta << "normals: " << normal_source_name(o.prepare.normals) << "\n"
+         << "k: " << o.prepare.k << "\n"
+         << "radius_scale: " << o.prepare.radius_scale << "\n";
+    for (const auto& c : points.comments) meta << "comment: " << c << "\n";
+    ProgressPhase phase(progress, "write", 0);
+    write_ptl(o.output, tree, meta.str());
+  } else {
+    ProgressPhase phase(progress, "write", 0);
+    write_ply(o.output, points,
+              {.encoding = o.ascii ? PlyEncoding::Ascii : PlyEncoding::BinaryLittleEndian});
+  }
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!o.quiet) {
+    const double size = double(std::filesystem::file_size(o.output));
+    std::printf("converted %zu points in %.2f s (%.2f M points/s) -> %s, %s, %.1f bytes/point\n",
+                point_count, seconds, point_count / seconds / 1e6, o.output.c_str(),
+                human_bytes(size).c_str(), point_count ? size / double(point_count) : 0.0);
+  }
+  return 0;
+}
+
+}  // namespace pointillist::cli

@@ -1,0 +1,67 @@
+#include <array>
+#include <cstdio>
+
+#include "cli/commands.hpp"
+#include "cli/model_loading.hpp"
+
+namespace pointillist::cli {
+
+int run_info(const InfoOptions& o) {
+  ThreadPool pool(o.threads);
+  const LoadedModel model = LoadedModel::open(o.input, {}, pool, Progress::none());
+  const SphereTreeView& t = model.tree();
+  std::array<std::uint64_t, 5> children{};
+  for (const SphereNode& n : t.nodes) children[n.child_count <= 4 ? n.child_count : 0]++;
+  const double leaves = double(t.leaf_count);
+
+  std::printf("file:        %s\n", o.input.c_str());
+  if (model.memory_mapped()) {
+    std::printf("format:      Pointillist model (.ptl) version %u, memory-mapped\n",
+                model.ptl()->version());
+  } else {
+    std::printf("format:      PLY %s, %zu input points%s (hierarchy built in memory)\n",
+                model.input_is_mesh ? "mesh" : "point cloud", model.input_points,
+                model.input_is_mesh ? " (vertices used by faces kept)" : "");
+  }
+  std::printf("points:      %llu (leaves)\n", static_cast<unsigned long long>(t.leaf_count));
+  std::printf("nodes:       %zu (%.3f per point; children 2/3/4: %llu/%llu/%llu)\n",
+              t.nodes.size(), leaves > 0 ? double(t.nodes.size()) / leaves : 0.0,
+              static_cast<unsigned long long>(children[2]),
+              static_cast<unsigned long long>(children[3]),
+              static_cast<unsigned long long>(children[4]));
+  std::printf("depth:       %u levels below the root\n", t.depth);
+  if (model.memory_mapped()) {
+    std::printf("attributes:  position, normal, normal cone, radius%s\n",
+                t.has_colors ? ", color" : "");
+  } else {
+    std::printf("attributes:  in file: position%s%s%s%s; computed: %s%s\n",
+                model.input_has_normals ? ", normal" : "", model.input_has_colors ? ", color" : "",
+                model.input_has_radii ? ", radius" : "", model.input_is_mesh ? ", faces" : "",
+                model.input_has_normals ? "" : "normal, ", model.input_has_radii ? "-" : "radius");
+  }
+  std::printf("bounds:      min (%g, %g, %g)  max (%g, %g, %g)\n", t.bounds.lo.x, t.bounds.lo.y,
+              t.bounds.lo.z, t.bounds.hi.x, t.bounds.hi.y, t.bounds.hi.z);
+  if (!t.nodes.empty()) {
+    const SphereNode& root = t.nodes[0];
+    std::printf("sphere:      centre (%g, %g, %g), radius %g (root of the hierarchy)\n",
+                root.center.x, root.center.y, root.center.z, root.radius);
+  }
+  std::printf("view sphere: centre (%g, %g, %g), radius %g (used by --view)\n",
+              t.view_sphere.center.x, t.view_sphere.center.y, t.view_sphere.center.z,
+              t.view_sphere.radius);
+  std::printf("file size:   %s (%.2f bytes/point)\n", human_bytes(double(model.file_size)).c_str(),
+              leaves > 0 ? double(model.file_size) / leaves : 0.0);
+  if (!model.metadata.empty()) {
+    std::printf("metadata:\n");
+    std::size_t start = 0;
+    while (start < model.metadata.size()) {
+      std::size_t end = model.metadata.find('\n', start);
+      if (end == std::string::npos) end = model.metadata.size();
+      std::printf("  %s\n", model.metadata.substr(start, end - start).c_str());
+      start = end + 1;
+    }
+  }
+  return 0;
+}
+
+}  // namespace pointillist::cli

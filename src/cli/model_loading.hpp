@@ -1,0 +1,52 @@
+// Getting from a file on disk to a hierarchy the renderer can draw: open a .ptl by memory mapping,
+// or read a point/mesh file, prepare splats and build the hierarchy in memory.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pointillist/core/point_set.hpp"
+#include "pointillist/core/progress.hpp"
+#include "pointillist/core/thread_pool.hpp"
+#include "pointillist/format/ptl.hpp"
+#include "pointillist/lod/sphere_tree.hpp"
+#include "pointillist/prep/prepare.hpp"
+
+namespace pointillist::cli {
+
+// Reads and merges one or more input files (PLY for now). Throws Error naming the file.
+PointSet read_inputs(const std::vector<std::string>& paths, ThreadPool& pool, Progress& progress);
+
+// A hierarchy either mapped from a .ptl file or built in memory.
+class LoadedModel {
+ public:
+  const SphereTreeView& tree() const { return view_; }
+  bool memory_mapped() const { return file_ != nullptr; }
+  const PtlFile* ptl() const { return file_.get(); }
+  std::uint64_t file_size = 0;
+  std::string metadata;
+  // Kept for `info` when the input was not a .ptl.
+  std::size_t input_points = 0;
+  bool input_has_normals = false, input_has_colors = false, input_has_radii = false;
+  bool input_is_mesh = false;
+
+  static LoadedModel open(const std::string& path, const PrepareOptions& prepare, ThreadPool& pool,
+                          Progress& progress);
+
+ private:
+  std::unique_ptr<PtlFile> file_;
+  SphereTree built_;
+  SphereTreeView view_;
+};
+
+// "1.23 MB"-style size.
+std::string human_bytes(double bytes);
+
+}  // namespace pointillist::cli
+
+namespace pointillist::cli {
+// Path of a model fetched by scripts/fetch-models.sh ($POINTILLIST_MODELS, else
+// $XDG_CACHE_HOME/pointillist/models, else ~/.cache/pointillist/models), or "" if absent.
+std::string cached_model_path(const std::string& file_name);
+}  // namespace pointillist::cli

@@ -1,0 +1,152 @@
+// End-to-end tests of the `pointillist` command: exit codes, messages, outputs.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "pointillist/io/ply.hpp"
+#include "pointillist/io/png.hpp"
+#include "testing/testing.hpp"
+
+using namespace pointillist;
+using ::testing::HasSubstr;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+Result run(const std::string& args) {
+  const std::string cmd = std::string(POINTILLIST_CLI_PATH) + " " + args + " 2>&1";
+  Result r;
+  FILE* pipe = ::popen(cmd.c_str(), "r");
+  if (!pipe) return r;
+  char buf[4096];
+  while (std::size_t n = std::fread(buf, 1, sizeof buf, pipe)) r.output.append(buf, n);
+  const int status = ::pclose(pipe);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+void write_text(const std::string& path, const std::string& text) {
+  std::ofstream(path, std::ios::binary) << text;
+}
+
+}  // namespace
+
+TEST(Cli, GenerateConvertInfoRenderRoundTrip) {
+  testing::TempDir dir;
+  const auto ply = dir.file("scene.ply"), ptl = dir.file("scene.ptl"), png = dir.file("scene.png");
+  ASSERT_EQ(run("generate --scene sphere --points 20000 -o " + ply).exit_code, 0);
+  const Result conv = run("convert " + ply + " -o " + ptl);
+  ASSERT_EQ(conv.exit_code, 0) << conv.output;
+  EXPECT_THAT(conv.output, HasSubstr("converted 20000 points"));
+  const Result info = run("info " + ptl);
+  ASSERT_EQ(info.exit_code, 0) << info.output;
+  EXPECT_THAT(info.output, HasSubstr("points:      20000"));
+  const Result ren = run("render " + ptl + " -o " + png + " --size 160x120 --view 30,20");
+  ASSERT_EQ(ren.exit_code, 0) << ren.output;
+  const ImageRgb8 img = read_png_rgb8(png);
+  EXPECT_EQ(img.width, 160);
+  EXPECT_EQ(img.height, 120);
+  // The sphere is in the middle of the picture; the corners are background (black by default).
+  const Rgb8 centre = img.pixels[60 * 160 + 80];
+  EXPECT_GT(int(centre.r) + centre.g + centre.b, 100);
+  EXPECT_EQ(img.pixels[0], (Rgb8{0, 0, 0}));
+}
+
+TEST(Cli, RenderStatsJsonHasTheRequiredFields) {
+  testing::TempDir dir;
+  const auto ply = dir.file("scene.ply");
+  ASSERT_EQ(run("generate --scene torus --points 5000 --with-normals -o " + ply).exit_code, 0);
+  const Result r = run("render " + ply + " -o " + dir.file("t.png") + " --size 64x48 --stats -");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  for (const char* key : {"\"splats\"", "\"nodes_visited\"", "\"culled_frustum\"",
+                          "\"culled_backface\"", "\"width\": 64", "\"height\": 48", "\"threads\"",
+                          "\"select\"", "\"raster\"", "\"total\""}) {
+    EXPECT_THAT(r.output, HasSubstr(key));
+  }
+}
+
+TEST(Cli, ConvertToPlyWritesNormalsAndRadii) {
+  testing::TempDir dir;
+  const auto in = dir.file("in.ply"), out = dir.file("out.ply");
+  ASSERT_EQ(run("generate --scene sphere --points 3000 -o " + in).exit_code, 0);
+  ASSERT_EQ(run("convert -q " + in + " -o " + out).exit_code, 0);
+  const PointSet p = read_ply(out);
+  EXPECT_EQ(p.size(), 3000u);
+  ASSERT_TRUE(p.has_normals());
+  ASSERT_TRUE(p.has_radii());
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    EXPECT_GT(dot(p.normals[i], p.positions[i]), 0.0f) << "normal " << i << " faces inward";
+    EXPECT_GT(p.radii[i], 0.0f);
+  }
+}
+
+TEST(Cli, TruncatedInputFailsWithFileAndPositionAndLeavesNoOutput) {
+  testing::TempDir dir;
+  const auto bad = dir.file("bad.ply"), out = dir.file("out.ptl");
+  write_text(bad,
+             "ply\nformat binary_little_endian 1.0\nelement vertex 10\nproperty float x\n"
+             "property float y\nproperty float z\nend_header\n\x01\x02\x03");
+  const Result r = run("convert " + bad + " -o " + out);
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_THAT(r.output, HasSubstr("bad.ply"));
+  EXPECT_THAT(r.output, HasSubstr("byte"));
+  EXPECT_FALSE(fs::exists(out));
+  for (const auto& entry : fs::directory_iterator(dir.path())) {
+    EXPECT_THAT(entry.path().filename().string(), ::testing::Not(HasSubstr("out")))
+        << "left a partial file behind";
+  }
+}
+
+TEST(Cli, AsciiErrorNamesTheLine) {
+  testing::TempDir dir;
+  const auto bad = dir.file("bad.ply");
+  write_text(bad,
+             "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+             "property float z\nend_header\n0 0 0\n1 oops 2\n");
+  const Result r = run("convert " + bad + " -o " + dir.file("o.ptl"));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_THAT(r.output, HasSubstr("bad.ply"));
+  EXPECT_THAT(r.output, HasSubstr("line 9"));
+}
+
+TEST(Cli, UnknownOutputExtensionIsExplained) {
+  testing::TempDir dir;
+  const auto in = dir.file("in.ply");
+  ASSERT_EQ(run("generate --points 100 -o " + in).exit_code, 0);
+  const Result r = run("convert " + in + " -o " + dir.file("model.xyz"));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_THAT(r.output, HasSubstr(".ptl"));
+}
+
+TEST(Cli, MissingInputAndBadOptionsFailCleanly) {
+  EXPECT_NE(run("render /nonexistent/model.ptl -o /tmp/x.png").exit_code, 0);
+  testing::TempDir dir;
+  const auto in = dir.file("in.ply");
+  ASSERT_EQ(run("generate --points 100 -o " + in).exit_code, 0);
+  const Result r = run("render " + in + " -o " + dir.file("x.png") + " --view 10,90");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_THAT(r.output, HasSubstr("elevation"));
+  const Result s = run("render " + in + " -o " + dir.file("x.png") + " --size 12by4");
+  EXPECT_NE(s.exit_code, 0);
+  EXPECT_THAT(s.output, HasSubstr("--size"));
+}
+
+TEST(Cli, RenderingAPtlIsNotConvertedAgain) {
+  testing::TempDir dir;
+  const auto in = dir.file("in.ply"), ptl = dir.file("m.ptl");
+  ASSERT_EQ(run("generate --points 1000 -o " + in).exit_code, 0);
+  ASSERT_EQ(run("convert -q " + in + " -o " + ptl).exit_code, 0);
+  const Result r = run("convert " + ptl + " -o " + dir.file("again.ptl"));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_THAT(r.output, HasSubstr("already a Pointillist model"));
+}
