@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "pointillist/core/error.hpp"
+#include "pointillist/core/thread_pool.hpp"
 #include "pointillist/io/ply.hpp"
 
 namespace pointillist::cli {
@@ -38,7 +39,6 @@ void append_points(PointSet& a, PointSet&& b) {
 }  // namespace
 
 PointSet read_inputs(const std::vector<std::string>& paths, ThreadPool& pool, Progress& progress) {
-  (void)pool;
   PointSet all;
   for (const std::string& path : paths) {
     if (!std::filesystem::exists(path)) {
@@ -49,7 +49,7 @@ PointSet read_inputs(const std::vector<std::string>& paths, ThreadPool& pool, Pr
       throw Error(path + ": is already a Pointillist model (.ptl); give the source scan (.ply, "
                          ".ply.gz) to convert, or render the .ptl directly");
     }
-    append_points(all, read_ply(path, progress));
+    append_points(all, read_ply(path, progress, {.pool = &pool}));
   }
   return all;
 }

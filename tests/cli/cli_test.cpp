@@ -42,7 +42,7 @@ void write_text(const std::string& path, const std::string& text) {
 }  // namespace
 
 TEST(Cli, GenerateConvertInfoRenderRoundTrip) {
-  testing::TempDir dir;
+  pointillist::testing::TempDir dir;
   const auto ply = dir.file("scene.ply"), ptl = dir.file("scene.ptl"), png = dir.file("scene.png");
   ASSERT_EQ(run("generate --scene sphere --points 20000 -o " + ply).exit_code, 0);
   const Result conv = run("convert " + ply + " -o " + ptl);
@@ -63,7 +63,7 @@ TEST(Cli, GenerateConvertInfoRenderRoundTrip) {
 }
 
 TEST(Cli, RenderStatsJsonHasTheRequiredFields) {
-  testing::TempDir dir;
+  pointillist::testing::TempDir dir;
   const auto ply = dir.file("scene.ply");
   ASSERT_EQ(run("generate --scene torus --points 5000 --with-normals -o " + ply).exit_code, 0);
   const Result r = run("render " + ply + " -o " + dir.file("t.png") + " --size 64x48 --stats -");
@@ -76,7 +76,7 @@ TEST(Cli, RenderStatsJsonHasTheRequiredFields) {
 }
 
 TEST(Cli, ConvertToPlyWritesNormalsAndRadii) {
-  testing::TempDir dir;
+  pointillist::testing::TempDir dir;
   const auto in = dir.file("in.ply"), out = dir.file("out.ply");
   ASSERT_EQ(run("generate --scene sphere --points 3000 -o " + in).exit_code, 0);
   ASSERT_EQ(run("convert -q " + in + " -o " + out).exit_code, 0);
@@ -91,7 +91,7 @@ TEST(Cli, ConvertToPlyWritesNormalsAndRadii) {
 }
 
 TEST(Cli, TruncatedInputFailsWithFileAndPositionAndLeavesNoOutput) {
-  testing::TempDir dir;
+  pointillist::testing::TempDir dir;
   const auto bad = dir.file("bad.ply"), out = dir.file("out.ptl");
   write_text(bad,
              "ply\nformat binary_little_endian 1.0\nelement vertex 10\nproperty float x\n"
@@ -108,7 +108,7 @@ TEST(Cli, TruncatedInputFailsWithFileAndPositionAndLeavesNoOutput) {
 }
 
 TEST(Cli, AsciiErrorNamesTheLine) {
-  testing::TempDir dir;
+  pointillist::testing::TempDir dir;
   const auto bad = dir.file("bad.ply");
   write_text(bad,
              "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
@@ -120,7 +120,7 @@ TEST(Cli, AsciiErrorNamesTheLine) {
 }
 
 TEST(Cli, UnknownOutputExtensionIsExplained) {
-  testing::TempDir dir;
+  pointillist::testing::TempDir dir;
   const auto in = dir.file("in.ply");
   ASSERT_EQ(run("generate --points 100 -o " + in).exit_code, 0);
   const Result r = run("convert " + in + " -o " + dir.file("model.xyz"));
@@ -130,7 +130,7 @@ TEST(Cli, UnknownOutputExtensionIsExplained) {
 
 TEST(Cli, MissingInputAndBadOptionsFailCleanly) {
   EXPECT_NE(run("render /nonexistent/model.ptl -o /tmp/x.png").exit_code, 0);
-  testing::TempDir dir;
+  pointillist::testing::TempDir dir;
   const auto in = dir.file("in.ply");
   ASSERT_EQ(run("generate --points 100 -o " + in).exit_code, 0);
   const Result r = run("render " + in + " -o " + dir.file("x.png") + " --view 10,90");
@@ -142,7 +142,7 @@ TEST(Cli, MissingInputAndBadOptionsFailCleanly) {
 }
 
 TEST(Cli, RenderingAPtlIsNotConvertedAgain) {
-  testing::TempDir dir;
+  pointillist::testing::TempDir dir;
   const auto in = dir.file("in.ply"), ptl = dir.file("m.ptl");
   ASSERT_EQ(run("generate --points 1000 -o " + in).exit_code, 0);
   ASSERT_EQ(run("convert -q " + in + " -o " + ptl).exit_code, 0);

@@ -8,19 +8,31 @@
 
 namespace pointillist {
 
+class ThreadPool;
+
 struct PlyReadOptions {
   // Read `red green blue` / `diffuse_*` into PointSet::colors when present. Off: ignore colors.
   bool read_colors = true;
+  // Optional pool (2+ threads): large ascii bodies are parsed in parallel pieces, and a .gz file
+  // is inflated on one thread while another parses. Binary bodies decode at memory speed on one
+  // thread. Null: everything runs on the calling thread. The result is the same either way.
+  ThreadPool* pool = nullptr;
 };
 
 // Reads a PLY file (ascii, binary_little_endian or binary_big_endian; `.gz` is decompressed
-// transparently, detected by its magic bytes). Understood vertex properties: x y z, nx ny nz,
-// red green blue [alpha] (uchar or float) or diffuse_red/green/blue, radius or scale. Faces
-// (`vertex_indices` or `vertex_index`) are fan-triangulated into PointSet::triangles. Unknown
-// elements and properties are skipped.
+// transparently, detected by its magic bytes). Understood vertex properties: x y z (any scalar
+// type, stored as float), nx ny nz (normalized; dropped when all are zero; a zero or non-finite
+// normal among valid ones becomes (0, 0, 1)), red green blue (alpha ignored) or
+// diffuse_red/green/blue, radius or scale. Colors: float/double are 0..1, ushort is 0..65535,
+// other integer types are clamped to 0..255. Faces (`vertex_indices` or `vertex_index`) are
+// fan-triangulated into PointSet::triangles; polygons with fewer than 3 vertices are skipped.
+// `comment` lines go to PointSet::comments. Unknown elements and properties are skipped. Ascii
+// bodies hold one element per line (blank lines are ignored).
+// Progress: one phase "read", total = the file's size in bytes.
 // Throws FormatError naming the file and the line (ascii) or byte offset (binary) for malformed
 // headers, truncated data, wrong counts, non-numeric tokens, out-of-range face indices,
-// NaN/inf coordinates and files without vertices; IoError when the file cannot be read.
+// NaN/inf coordinates or radii and files without vertices (for .gz files the byte offset is
+// into the decompressed data); IoError when the file cannot be read.
 PointSet read_ply(const std::string& path, Progress& progress = Progress::none(),
                   const PlyReadOptions& options = {});
 
@@ -32,8 +44,12 @@ struct PlyWriteOptions {
 };
 
 // Writes positions and whichever of normals (nx ny nz), colors (red green blue, uchar), radii
-// (radius) and triangles are present. Written to a temporary file and renamed, so a failure never
-// leaves a partial file. Throws IoError.
+// (radius) and triangles (list uchar int vertex_indices) are present, all as float but colors,
+// plus PointSet::comments as comment lines. Ascii floats use the shortest text that reads back
+// as the same float. Written to `path + ".tmp-XXXXXX"` in the same folder and renamed, so a
+// failure never leaves a partial file (the temporary is removed).
+// Throws IoError naming the file; Error when an attribute array's length differs from the
+// position count or a triangle indexes past the last position (nothing is written then).
 void write_ply(const std::string& path, const PointSet& points,
                const PlyWriteOptions& options = {});
 

@@ -63,12 +63,18 @@ struct SphereTreeOptions {
 };
 
 // Builds the hierarchy over `points` (positions, normals and radii required; colors optional).
-// Splits at the median along the longest axis of the bounding box, recursively, and collapses
-// the binary tree so every interior node has 2–4 children. Interior spheres enclose their
-// children's spheres; normals are area-weighted means (weight r²) with a cone covering the
-// children's cones; colors are means. O(n log n), parallel, deterministic for any thread count.
-// Throws Error when points is empty, when normals or radii are missing, or on more than
-// 2^31 points.
+// Splits at the median along the longest axis of the bounding box, recursively (ties broken by
+// input index), and collapses the binary tree so every interior node has 2–4 children: a node's
+// children are the quarters of its range (a half of one point is itself a child). The root
+// alone may take just its two halves, when that aligns the collapse with the bottom of the tree
+// and so needs fewer nodes; either way nodes / leaves <= 1.5. Leaves are the input splats
+// (position, radius, normal, cone_sin 0, color). Interior spheres are the smallest spheres
+// enclosing their children's spheres; normals are area-weighted means (weight r²) with a cone
+// covering the children's cones (cone_sin >= 1: no bound); colors are rounded means of the
+// children's. O(n log n), parallel, the same bits for any thread count. Progress phase
+// "hierarchy". Throws Error when points is empty, when normals or radii are missing or of the
+// wrong length, on more than 2^31 points, or when a position, normal or radius is not finite
+// (radius also negative), naming the point.
 SphereTree build_sphere_tree(const PointSet& points, ThreadPool& pool,
                              Progress& progress = Progress::none(),
                              const SphereTreeOptions& options = {});

@@ -2,30 +2,48 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 
 #include "pointillist/core/point_set.hpp"
 #include "pointillist/core/progress.hpp"
 #include "pointillist/core/thread_pool.hpp"
+#include "pointillist/prep/radii.hpp"
 
 namespace pointillist {
 
 enum class NormalSource {
   Auto,  // keep the file's normals; else mesh normals for a mesh; else PCA
-  Keep,  // the file's normals (error if there are none)
+  Keep,  // the file's normals, normalized (error if there are none)
   Mesh,  // area-weighted vertex normals of the faces (error without faces)
-  Pca,   // PCA of the k nearest neighbours, oriented by MST propagation
+  Pca,   // PCA of the k nearest neighbours, oriented by MST propagation (pca_normals)
 };
 
 struct PrepareOptions {
   NormalSource normals = NormalSource::Auto;
-  std::uint32_t k = 16;         // neighbours for PCA normals
-  float radius_scale = 1.0f;    // multiplies every computed radius (and radii read from the file)
-  float coverage = 1.0f;        // point clouds: radius = mean 5-NN distance × coverage × scale
+  std::uint32_t k = 16;  // points per PCA neighbourhood, itself included; >= 3 (PcaNormalOptions)
+  // Multiplies every computed radius and the radii read from the file; > 0. Raise it to close
+  // holes in sparse scans, lower it for crisper (but possibly holey) renderings.
+  float radius_scale = 1.0f;
+  // Point clouds without radii: radius = mean 5-NN distance × coverage × radius_scale; > 0.
+  // See kDefaultCloudCoverage for how the default was chosen.
+  float coverage = kDefaultCloudCoverage;
+  // Names the input in error messages (e.g. the file path).
+  std::string input_name = "the input";
 };
 
-// Fills points.normals and points.radii (keeping the file's radii when present, scaled).
-// Mesh vertices used by no face are removed (as QSplat does), and so are faces' references
-// remapped. Throws Error with an explanation when the requested source is impossible.
+// Fills points.normals (unit length) and points.radii (world units):
+//  - normals as chosen by options.normals (NormalSource);
+//  - radii: the file's radii × radius_scale when present, else mesh_radii for a mesh, else
+//    cloud_radii.
+// For a mesh, vertices used by no face are removed first (as QSplat does) together with their
+// normals, colors and radii, and the faces are renumbered; a point set with no faces at all is a
+// point cloud and keeps every point. Comments are kept.
+// Throws OptionError for bad options, and Error (saying what to do) when the input has no points,
+// a non-finite coordinate, an attribute array of the wrong length or a face index out of range,
+// or when the requested normal source is impossible: Keep without normals in the input, Mesh
+// without faces, Pca (or Auto needing PCA) with fewer than 3 points.
+// Progress phases: "normals" (or "neighbours", "normals", "orientation" for PCA), "radii".
+// Deterministic for any thread count.
 void prepare_splats(PointSet& points, ThreadPool& pool, Progress& progress,
                     const PrepareOptions& options = {});
 

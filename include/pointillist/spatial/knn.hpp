@@ -12,21 +12,34 @@
 
 namespace pointillist {
 
-// For every point, the indices of its k nearest other points (itself excluded), nearest first,
-// as a flat row-major array of n*k entries (fewer than k neighbours exist only when n <= k; then
-// the missing entries repeat the last found neighbour, or the point itself when n == 1).
-// `squared_distances`, when not null, receives the matching squared distances.
-// Parallel over points; the result does not depend on the thread count.
 struct KnnOptions {
-  std::uint32_t k = 16;
+  std::uint32_t k = 16;  // neighbours per point (the point itself not counted)
+  // The caller has already put the points in spatial order (e.g. by `morton_order`): skip the
+  // internal reordering. Queries on shuffled points with this set run several times slower.
+  bool points_are_ordered = false;
 };
+
+// For every point, the indices of its k nearest other points (itself excluded), nearest first,
+// as a flat row-major array of n*k entries: row i is entries [i*k, i*k + k) and belongs to
+// points[i] (rows are in the caller's order, whatever order the queries run in). Fewer than k
+// neighbours exist only when n <= k; then the missing entries repeat the last found neighbour,
+// or the point itself when n == 1. `squared_distances`, when not null, receives the matching
+// squared Euclidean distances (n*k entries).
+// Equal distances: which of several equidistant points make the cut depends only on the points;
+// within a row, equal distances are ordered by index. Copies of a point (distance 0) are
+// neighbours like any other point. Parallel over points (progress phase "neighbours"); the result
+// does not depend on the thread count. Positions must be finite. Memory: the result plus about
+// 40 bytes per point while the kd-tree lives.
 std::vector<std::uint32_t> k_nearest_neighbours(std::span<const Vec3f> points, ThreadPool& pool,
                                                 const KnnOptions& options,
                                                 std::vector<float>* squared_distances = nullptr,
                                                 Progress& progress = Progress::none());
 
-// Permutation that sorts points along a Morton (Z-order) curve over their bounding box;
-// neighbour queries and tree builds run several times faster on spatially ordered input.
+// Permutation that sorts points along a Morton (Z-order) curve over their bounding box (21 bits
+// per axis, one scale for all three axes): entry j is the index of the j-th point along the
+// curve. Points in the same cell keep their index order; non-finite coordinates are clamped to
+// the box. Neighbour queries and tree builds run several times faster on spatially ordered input.
+// Parallel; the result does not depend on the thread count.
 std::vector<std::uint32_t> morton_order(std::span<const Vec3f> points, ThreadPool& pool);
 
 }  // namespace pointillist

@@ -1,0 +1,43 @@
+// Settings shared by the splat renderer and the reference triangle rasterizer.
+#pragma once
+
+#include "pointillist/core/math.hpp"
+
+namespace pointillist {
+
+enum class SplatShape {
+  Square,   // axis-aligned square of side = projected diameter
+  Circle,   // disc of the projected diameter (default)
+  Ellipse,  // disc seen at an angle: major axis = projected diameter, minor/major = max(|n·v|, 0.1)
+};
+
+// Shading model (per splat, or per pixel for the triangle reference), with every vector in eye
+// space, n the unit normal, v the unit vector to the eye, l = normalized light_dir_eye and
+// h = normalize(l + v):
+//   color = base·(ambient + diffuse·max(n·l, 0)) + specular·max(n·h, 0)^shininess   (n·l > 0)
+//   color = base·ambient                                                             (n·l ≤ 0)
+// clamped to [0, 1] and written as round(255·color). `base` is base_color, or the model's 8-bit
+// color divided by 255 when it has colors (the 8-bit values are treated as linear, no sRGB
+// decoding). The specular power is read from a 1024-interval table with linear interpolation
+// (exact at n·h = 0 and 1; elsewhere off by at most 1.2e-4 at shininess 32, 2e-3 at 128). Splats
+// are shaded once, with n the node normal and v the direction from the node centre to the eye.
+struct RenderSettings {
+  // Stop refining when a node's projected diameter 2·r·f/z is at most this many pixels. Larger
+  // values draw fewer, bigger splats (faster, coarser).
+  float threshold_px = 1.0f;
+  SplatShape shape = SplatShape::Circle;
+  Rgb8 background{0, 0, 0};
+  // Light direction in eye space (toward the light; x right, y up, z toward the viewer); the
+  // default is a headlight at the eye. Need not be unit length, must not be zero.
+  Vec3f light_dir_eye{0, 0, 1};
+  bool frustum_culling = true;   // turn off only to check that culling changes nothing
+  bool backface_culling = true;  // normal-cone culling of whole subtrees
+  // Surface color when the model has no colors (linear 0..1).
+  Vec3f base_color{0.8f, 0.8f, 0.8f};
+  float ambient = 0.08f;
+  float diffuse = 0.85f;
+  float specular = 0.25f;   // Blinn-Phong, white
+  float shininess = 32.0f;  // Blinn-Phong exponent, >= 0
+};
+
+}  // namespace pointillist

@@ -1,0 +1,43 @@
+// Z-buffered software splat rasterizer: draws a splat stream into color and depth buffers.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "pointillist/core/camera.hpp"
+#include "pointillist/core/thread_pool.hpp"
+#include "pointillist/render/settings.hpp"
+#include "pointillist/render/splat_stream.hpp"
+
+namespace pointillist {
+
+// Per-chunk work buffers of the rasterizer, kept across frames so that steady-state frames do not
+// allocate. The contents between calls are unspecified.
+struct RasterScratch {
+  struct Chunk {
+    std::vector<float> ellipse;  // 6 floats per splat (Ellipse shape only)
+    float y_min_px = 0, y_max_px = 0;  // rows the chunk's splats may touch (several bands only)
+  };
+  std::vector<Chunk> chunks;
+  std::vector<std::vector<std::uint32_t>> band_colors;  // one packed-color band per thread
+};
+
+// Clears color to settings.background and depth to +infinity, then draws every splat of
+// `stream` (positions and sizes in pixels of `camera`'s image, which must be color's and depth's
+// width × height) with a strict depth test on the splat's centre depth, so at equal depth the
+// earlier splat in stream order wins. Pixels are unit squares with centres at (i + 0.5, j + 0.5);
+// a splat covers the pixels whose centre lies inside its shape (closed), and a splat covering no
+// centre covers the pixel that contains its centre:
+//  * Square: |px − x| ≤ d/2 and |py − y| ≤ d/2, d = size_px;
+//  * Circle: (px − x)² + (py − y)² ≤ (d/2)²;
+//  * Ellipse: semi-major axis d/2, semi-minor axis (d/2)·max(|n·v|, 0.1) along the screen
+//    projection of the normal n (v: unit vector from the splat to the eye).
+// Splats are drawn in their `shaded` color. The image bits depend only on the arguments, not
+// on pool.thread_count(): rows are split into bands, and each band draws the splats that may
+// touch it in stream order.
+void rasterize_splats(const SplatStream& stream, const CameraFrame& camera,
+                      const RenderSettings& settings, ThreadPool& pool, RasterScratch& scratch,
+                      std::span<Rgb8> color, std::span<float> depth);
+
+}  // namespace pointillist

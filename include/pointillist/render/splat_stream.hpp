@@ -1,0 +1,54 @@
+// The splat stream: what selection produces and rasterizers consume (ARCHITECTURE.md, "Selection
+// is separate from rasterization").
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "pointillist/core/math.hpp"
+
+namespace pointillist {
+
+// A run of consecutive splats, structure of arrays. The arrays are buffers whose size is the
+// capacity; only the first `count` entries are splats. Buffers keep their memory across frames.
+// Positions and sizes are finite, below 1e9 px in magnitude (selection drops other splats).
+struct SplatChunk {
+  std::size_t count = 0;
+  std::vector<float> x_px;       // centre in pixels: column, 0 = left edge of the image
+  std::vector<float> y_px;       // centre in pixels: row, 0 = top edge (pixel centres at +0.5)
+  std::vector<float> depth;      // eye-space depth of the centre (> 0, world units)
+  std::vector<float> size_px;    // projected diameter 2·r·f/z in pixels
+  // Lit color (RenderSettings shading, evaluated once per splat), packed r | g << 8 | b << 16.
+  std::vector<std::uint32_t> shaded;
+  std::vector<Vec3f> normal;     // unit normal of the node, world space
+  std::vector<Rgb8> color;       // node color (filled only when the stream has_colors)
+  std::vector<std::uint32_t> node;  // index of the node in the tree
+
+  std::size_t capacity() const { return x_px.size(); }
+  // Grows every buffer to at least `n` entries (keeping the first `count`).
+  void reserve(std::size_t n, bool with_colors);
+};
+
+// The 8-bit channels of a packed color (SplatChunk::shaded).
+constexpr Rgb8 unpack_rgb(std::uint32_t c) {
+  return {static_cast<std::uint8_t>(c), static_cast<std::uint8_t>(c >> 8),
+          static_cast<std::uint8_t>(c >> 16)};
+}
+
+// Splats in stream order: chunk 0 first, each chunk in order. The order is the depth-first order
+// of the hierarchy and does not depend on the thread count; a rasterizer resolves equal depths in
+// favour of the earlier splat. Chunk boundaries depend only on the tree and the camera.
+struct SplatStream {
+  std::vector<SplatChunk> chunks;  // only the first `chunk_count` are in use
+  std::size_t chunk_count = 0;
+  bool has_colors = false;
+
+  std::size_t size() const {
+    std::size_t n = 0;
+    for (std::size_t c = 0; c < chunk_count; ++c) n += chunks[c].count;
+    return n;
+  }
+};
+
+}  // namespace pointillist

@@ -1,0 +1,382 @@
+// PLY reader: loads the file into memory (mmap, or inflate for .gz), parses the header, plans
+// which property feeds which PointSet array, and hands the body to the ascii or binary decoder.
+#include <sys/mman.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <optional>
+
+#include "io/file_bytes.hpp"
+#include "io/ply_body.hpp"
+#include "pointillist/core/error.hpp"
+#include "pointillist/core/thread_pool.hpp"
+#include "pointillist/io/ply.hpp"
+
+namespace pointillist {
+namespace ply {
+
+namespace {
+
+[[noreturn]] void fail_line(const std::string& path, std::size_t line, const std::string& what) {
+  throw FormatError(path + ": line " + std::to_string(line) + ": " + what);
+}
+
+ColorScale color_scale(ScalarType type) {
+  if (!is_integer(type)) return ColorScale::Unit;
+  return type == ScalarType::Uint16 ? ColorScale::Word : ColorScale::Byte;
+}
+
+struct VertexPlanResult {
+  bool normals = false, colors = false, radii = false;
+  ColorScale scales[3] = {};
+};
+
+// Assigns `targets` to the properties of the first alternative whose names are all present
+// (normals need nx, ny and nz; colors red green blue, else diffuse_*). Returns false if none is.
+bool assign_group(const std::string& path, const Element& element, ElementPlan& plan,
+                  std::initializer_list<std::initializer_list<const char*>> alternatives,
+                  std::initializer_list<Target> targets) {
+  for (const auto& names : alternatives) {
+    std::vector<int> found;
+    for (const char* name : names) {
+      const int index = element.find(name);
+      if (index < 0) break;
+      found.push_back(index);
+    }
+    if (found.size() != names.size()) continue;
+    auto target = targets.begin();
+    for (int index : found) {
+      const Property& property = element.properties[static_cast<std::size_t>(index)];
+      if (property.is_list)
+        fail_line(path, property.header_line,
+                  "element vertex: property " + property.name + " must be a scalar, not a list");
+      plan.properties[static_cast<std::size_t>(index)].target = *target++;
+    }
+    return true;
+  }
+  return false;
+}
+
+VertexPlanResult plan_vertex(const std::string& path, const Element& element, ElementPlan& plan,
+                             const PlyReadOptions& options) {
+  for (const char* axis : {"x", "y", "z"}) {
+    if (element.find(axis) < 0)
+      fail_line(path, element.header_line,
+                std::string("element vertex has no property ") + axis +
+                    " (positions need float properties x, y and z)");
+  }
+  VertexPlanResult result;
+  assign_group(path, element, plan, {{"x", "y", "z"}}, {kX, kY, kZ});
+  result.normals = assign_group(path, element, plan, {{"nx", "ny", "nz"}}, {kNx, kNy, kNz});
+  if (options.read_colors) {
+    result.colors =
+        assign_group(path, element, plan,
+                     {{"red", "green", "blue"}, {"diffuse_red", "diffuse_green", "diffuse_blue"}},
+                     {kRed, kGreen, kBlue});
+    if (result.colors) {
+      for (std::size_t j = 0; j < element.properties.size(); ++j) {
+        const Target t = plan.properties[j].target;
+        if (t >= kRed && t <= kBlue)
+          result.scales[t - kRed] = color_scale(element.properties[j].type);
+      }
+    }
+  }
+  result.radii = assign_group(path, element, plan, {{"radius"}, {"scale"}}, {kRadius});
+  return result;
+}
+
+void plan_face(const std::string& path, const Element& element, ElementPlan& plan) {
+  int index = element.find("vertex_indices");
+  if (index < 0) index = element.find("vertex_index");
+  if (index < 0) return;  // a face element without indices carries nothing we use
+  const Property& property = element.properties[static_cast<std::size_t>(index)];
+  if (!property.is_list)
+    fail_line(path, property.header_line,
+              "element face: property " + property.name +
+                  " must be a list (expected 'property list uchar int " + property.name + "')");
+  if (!is_integer(property.type))
+    fail_line(path, property.header_line,
+              "element face: list " + property.name + " must hold an integer type, found " +
+                  scalar_name(property.type));
+  plan.kind = ElementPlan::Kind::Face;
+  plan.properties[static_cast<std::size_t>(index)].is_face_indices = true;
+}
+
+// Turns progress in body bytes into units of the file size; a .gz file spends the first half
+// of its units on inflating and the second half on decoding.
+class ReadProgress {
+ public:
+  ReadProgress(Progress& progress, std::uint64_t total)
+      : phase_(progress, "read", total), total_(total) {}
+  void advance(std::uint64_t units) {
+    if (units == 0) return;
+    reported_.fetch_add(units, std::memory_order_relaxed);
+    phase_.advance(units);
+  }
+  void finish() {
+    const std::uint64_t done = reported_.load();
+    if (done < total_) phase_.advance(total_ - done);
+  }
+  std::uint64_t total() const { return total_; }
+
+ private:
+  ProgressPhase phase_;
+  std::uint64_t total_;
+  std::atomic<std::uint64_t> reported_{0};
+};
+
+// Normalizes in place; zero or non-finite normals become (0, 0, 1). When no normal is usable
+// the file had none in substance, and the array is dropped.
+void finish_normals(std::vector<Vec3f>& normals) {
+  bool any = false;
+  for (Vec3f& n : normals) {
+    const float length2 = dot(n, n);
+    // Already unit (what most writers store): nothing to do, and no square root.
+    if (length2 > 0.99999f && length2 < 1.00001f) {
+      any = true;
+      continue;
+    }
+    if (length2 > 0.0f && std::isfinite(length2)) {
+      n = n / std::sqrt(length2);
+      any = true;
+    } else {
+      n = {0, 0, 1};
+    }
+  }
+  if (!any) {
+    normals.clear();
+    normals.shrink_to_fit();
+  }
+}
+
+// Sizes a large output array. Asking for transparent huge pages before the first touch makes
+// filling hundreds of MB take a few hundred page faults instead of tens of thousands (measured:
+// the faults were a quarter of the time of a 200 MB binary read).
+template <class T>
+void resize_output(std::vector<T>& v, std::size_t n) {
+  constexpr std::size_t kHugePage = std::size_t{2} << 20;
+  v.reserve(n);
+  const auto begin = reinterpret_cast<std::uintptr_t>(v.data());
+  const std::uintptr_t first = (begin + kHugePage - 1) & ~(kHugePage - 1);
+  const std::uintptr_t last = (begin + n * sizeof(T)) & ~(kHugePage - 1);
+  if (last > first)
+    ::madvise(reinterpret_cast<void*>(first), last - first, MADV_HUGEPAGE);  // a hint only
+  v.resize(n);
+}
+
+// One read: the header, the plans, the output arrays. Not movable (ctx points into it).
+class PlyRead {
+ public:
+  PlyRead(const std::string& path, const PlyReadOptions& options, ReadProgress& progress)
+      : options_(options), progress_(progress) {
+    ctx.path = path;
+    ctx.pool = options.pool;
+  }
+  PlyRead(const PlyRead&) = delete;
+  PlyRead& operator=(const PlyRead&) = delete;
+
+  // Parses the header at the start of `data` (the whole file, or a prefix holding the whole
+  // header) and plans the body. Sets ctx.data to `data`.
+  void prepare(std::string_view data, bool compressed) {
+    header = parse_header(data, ctx.path);
+    ctx.data = data;
+    ctx.header = &header;
+    ctx.compressed = compressed;
+    ctx.plans.resize(header.elements.size());
+    int vertex_element = -1;
+    for (std::size_t e = 0; e < header.elements.size(); ++e) {
+      const Element& element = header.elements[e];
+      ElementPlan& plan = ctx.plans[e];
+      plan.properties.resize(element.properties.size());
+      if (element.name == "vertex") {
+        plan.kind = ElementPlan::Kind::Vertex;
+        vertex_plan_ = plan_vertex(ctx.path, element, plan, options_);
+        vertex_element = static_cast<int>(e);
+      } else if (element.name == "face") {
+        plan_face(ctx.path, element, plan);
+      }
+    }
+    if (vertex_element < 0)
+      fail_line(ctx.path, header.line_count,
+                "header declares no vertex element (expected 'element vertex <count>')");
+    const Element& vertices = header.elements[static_cast<std::size_t>(vertex_element)];
+    if (vertices.count == 0)
+      fail_line(ctx.path, vertices.header_line,
+                "element vertex has count 0: the file has no points");
+    ctx.vertex_count = vertices.count;
+  }
+
+  // Sizes the outputs; call after check_counts_fit(ctx) has passed. `body_size_estimate`: the
+  // bytes the body decoder will report, for scaling progress.
+  void allocate(std::uint64_t data_size_estimate) {
+    // Triangles hold 32-bit indices.
+    for (std::size_t e = 0; e < header.elements.size(); ++e) {
+      if (ctx.plans[e].kind == ElementPlan::Kind::Face && ctx.vertex_count > 0xffffffffu)
+        fail_line(ctx.path, header.elements[e].header_line,
+                  "faces cannot index more than 2^32 vertices (the file has " +
+                      std::to_string(ctx.vertex_count) + ")");
+    }
+    const auto n = static_cast<std::size_t>(ctx.vertex_count);
+    resize_output(points.positions, n);
+    if (vertex_plan_.normals) resize_output(points.normals, n);
+    if (vertex_plan_.colors) resize_output(points.colors, n);
+    if (vertex_plan_.radii) resize_output(points.radii, n);
+    ctx.vertex.positions = points.positions.data();
+    ctx.vertex.normals = vertex_plan_.normals ? points.normals.data() : nullptr;
+    ctx.vertex.colors = vertex_plan_.colors ? points.colors.data() : nullptr;
+    ctx.vertex.radii = vertex_plan_.radii ? points.radii.data() : nullptr;
+    std::copy_n(vertex_plan_.scales, 3, ctx.vertex.color_scale);
+    for (std::size_t e = 0; e < header.elements.size(); ++e) {
+      // Most faces are triangles; check_counts_fit bounds the count by the file size.
+      if (ctx.plans[e].kind == ElementPlan::Kind::Face)
+        points.triangles.reserve(points.triangles.size() +
+                                 static_cast<std::size_t>(header.elements[e].count));
+    }
+    // Units per decoded byte: the rest of the file size (half of it after inflating).
+    const std::uint64_t total = progress_.total();
+    const std::uint64_t units_left = ctx.compressed ? total - total / 2 : total;
+    const double units_per_byte =
+        data_size_estimate == 0 ? 0.0 : double(units_left) / double(data_size_estimate);
+    progress_.advance(static_cast<std::uint64_t>(double(header.body_offset) * units_per_byte));
+    ctx.on_bytes = [this, units_per_byte](std::uint64_t body_bytes) {
+      progress_.advance(static_cast<std::uint64_t>(double(body_bytes) * units_per_byte));
+    };
+  }
+
+  PointSet finish() {
+    if (points.has_normals()) finish_normals(points.normals);
+    points.comments = header.comments;
+    progress_.finish();
+    return std::move(points);
+  }
+
+  Header header;
+  BodyContext ctx;
+  PointSet points;
+
+ private:
+  const PlyReadOptions& options_;
+  ReadProgress& progress_;
+  VertexPlanResult vertex_plan_;
+};
+
+// True once `data` holds a whole "end_header" line.
+bool has_header_end(std::string_view data) {
+  for (std::size_t at = data.find("end_header"); at != std::string_view::npos;
+       at = data.find("end_header", at + 1)) {
+    if (at > 0 && data[at - 1] != '\n') continue;
+    std::size_t p = at + 10;
+    while (p < data.size() && (data[p] == ' ' || data[p] == '\t' || data[p] == '\r')) ++p;
+    if (p < data.size() && data[p] == '\n') return true;
+  }
+  return false;
+}
+
+struct StreamOverflow {};
+
+// The reading side of read_gzip_streaming: waits for the header, then parses the body as it
+// is inflated.
+PointSet parse_stream(io_detail::GzipInflater& inflater,
+                      const std::function<StreamState(std::size_t)>& wait, const std::string& path,
+                      const PlyReadOptions& options, ReadProgress& progress) {
+  StreamState state = wait(1 << 16);
+  while (!state.finished && !has_header_end({inflater.data(), state.available}))
+    state = wait(std::max<std::size_t>(state.available * 2, 1 << 16));
+  PlyRead read(path, options, progress);
+  read.prepare({inflater.data(), state.available}, true);
+  if (read.header.format != Format::Ascii) {
+    state = wait(std::numeric_limits<std::size_t>::max());
+    read.ctx.data = {inflater.data(), state.available};
+    check_counts_fit(read.ctx);
+    read.allocate(state.available);
+    decode_binary_body(read.ctx, read.points.triangles);
+    return read.finish();
+  }
+  // Until the end, the capacity stands in for the size in the count check; if that check
+  // fails, wait for the real size and check again for the exact message.
+  read.ctx.data = {inflater.data(), inflater.capacity()};
+  try {
+    check_counts_fit(read.ctx);
+  } catch (const FormatError&) {
+    state = wait(std::numeric_limits<std::size_t>::max());
+    read.ctx.data = {inflater.data(), state.available};
+    check_counts_fit(read.ctx);
+    throw;
+  }
+  read.allocate(inflater.capacity());
+  decode_ascii_stream(read.ctx, read.points.triangles, wait);
+  return read.finish();
+}
+
+// Inflating on one thread while parsing on another: the ascii body is parsed as it appears.
+// Returns nothing when the gzip trailer under-stated the size (a multi-member or > 4 GiB file);
+// the caller then starts over with a growing buffer.
+std::optional<PointSet> read_gzip_streaming(const io_detail::FileBytes& raw,
+                                            const std::string& path, const PlyReadOptions& options,
+                                            ReadProgress& progress,
+                                            const std::function<void(std::uint64_t)>& on_inflate) {
+  io_detail::GzipInflater inflater(raw.view(), path);
+  const auto wait = [&](std::size_t bytes) {
+    bool finished = false;
+    const std::size_t available = inflater.wait_for(bytes, finished);
+    if (finished && inflater.overflowed()) throw StreamOverflow{};
+    return StreamState{available, finished};
+  };
+  std::optional<PointSet> result;
+  try {
+    options.pool->run(2, [&](std::size_t task) {
+      if (task == 0) {
+        inflater.run(false, on_inflate);
+        return;
+      }
+      try {
+        result = parse_stream(inflater, wait, path, options, progress);
+      } catch (...) {
+        inflater.cancel();
+        throw;
+      }
+    });
+  } catch (const StreamOverflow&) {
+    return std::nullopt;
+  }
+  return result;
+}
+
+}  // namespace
+}  // namespace ply
+
+PointSet read_ply(const std::string& path, Progress& progress, const PlyReadOptions& options) {
+  using namespace ply;
+  io_detail::FileBytes raw = io_detail::FileBytes::map(path);
+  ReadProgress read_progress(progress, raw.file_size());
+  // Inflating earns the first half of the progress units of a .gz file.
+  std::uint64_t inflated = 0;
+  const auto on_inflate = [&](std::uint64_t consumed) {
+    read_progress.advance((inflated + consumed) / 2 - inflated / 2);
+    inflated += consumed;
+  };
+
+  const bool gzip = io_detail::has_gzip_magic(raw.view());
+  if (gzip && options.pool && options.pool->thread_count() >= 2) {
+    if (auto points = read_gzip_streaming(raw, path, options, read_progress, on_inflate))
+      return std::move(*points);
+  }
+  const io_detail::FileBytes bytes =
+      gzip
+          ? io_detail::FileBytes::inflate(
+                raw, path, inflated == 0 ? std::function<void(std::uint64_t)>(on_inflate) : nullptr)
+          : std::move(raw);
+  PlyRead read(path, options, read_progress);
+  read.prepare(bytes.view(), bytes.was_compressed());
+  check_counts_fit(read.ctx);
+  read.allocate(bytes.view().size());
+  if (read.header.format == Format::Ascii)
+    decode_ascii_body(read.ctx, read.points.triangles);
+  else
+    decode_binary_body(read.ctx, read.points.triangles);
+  return read.finish();
+}
+
+}  // namespace pointillist

@@ -1,0 +1,111 @@
+// The shading model of RenderSettings (see render/settings.hpp), shared by the splat rasterizer
+// and the reference triangle rasterizer so that both give the same color for the same surface.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <string>
+
+#include "pointillist/core/camera.hpp"
+#include "pointillist/core/error.hpp"
+#include "pointillist/core/math.hpp"
+#include "pointillist/render/settings.hpp"
+#include "render/simd.hpp"
+
+namespace pointillist::render_detail {
+
+// Eye-space coordinates of a world direction: x right, y up, z toward the viewer.
+inline Vec3f to_eye(const CameraFrame& cam, Vec3f world_dir) {
+  return {dot(world_dir, cam.right), dot(world_dir, cam.up), -dot(world_dir, cam.forward)};
+}
+
+// round(255·c) for c clamped to [0, 1]; NaN gives 0. (std::max(0, c) is maxss: no branch.)
+inline std::uint8_t to_unorm8(float c) {
+  return static_cast<std::uint8_t>(std::min(1.0f, std::max(0.0f, c)) * 255.0f + 0.5f);
+}
+
+// The model of RenderSettings, evaluated in world space: light_dir_eye is turned into a world
+// direction once, so callers pass world-space normals and view vectors.
+class Shader {
+ public:
+  static constexpr int kTableIntervals = 1024;
+
+  // Throws OptionError for a zero or non-finite light direction or an invalid shininess.
+  Shader(const RenderSettings& s, const CameraFrame& cam) {
+    const float len = length(s.light_dir_eye);
+    if (!(len > 0.0f) || !std::isfinite(len)) {
+      throw OptionError("light direction (" + std::to_string(s.light_dir_eye.x) + ", " +
+                        std::to_string(s.light_dir_eye.y) + ", " +
+                        std::to_string(s.light_dir_eye.z) +
+                        ") is zero or not finite; give a direction toward the light in eye space");
+    }
+    if (!(s.shininess >= 0.0f) || !std::isfinite(s.shininess)) {
+      throw OptionError("shininess " + std::to_string(s.shininess) +
+                        " is invalid; give a finite exponent >= 0");
+    }
+    const Vec3f l = s.light_dir_eye / len;
+    light_ = normalized(cam.right * l.x + cam.up * l.y - cam.forward * l.z);
+    ambient_ = s.ambient;
+    diffuse_ = s.diffuse;
+    specular_ = s.specular;
+    base_ = s.base_color;
+    for (int i = 0; i <= kTableIntervals; ++i) {
+      const float p = std::pow(static_cast<float>(i) / kTableIntervals, s.shininess);
+      power_[i] = p < 1e-30f ? 0.0f : p;  // no denormals in the interpolation
+    }
+    power_[kTableIntervals + 1] = 1.0f;  // interpolation guard
+  }
+
+  Vec3f base_color() const { return base_; }
+
+  // t^shininess for t in [0, 1] (linear interpolation in the table).
+  float power(float t) const {
+    t = std::min(1.0f, std::max(0.0f, t));
+    const float u = t * kTableIntervals;
+    const int i = static_cast<int>(u);
+    const float f = u - static_cast<float>(i);
+    return power_[i] + (power_[i + 1] - power_[i]) * f;
+  }
+
+  // n: unit normal, v: unit vector to the eye, both in world space; base: linear 0..1.
+  Rgb8 shade(Vec3f n, Vec3f v, Vec3f base) const {
+    const float ndl = dot(n, light_);
+    const float k = ambient_ + diffuse_ * std::max(0.0f, ndl);
+    // h is zero only when the light is exactly behind the surface (then n·l ≤ 0: no highlight);
+    // the max keeps the division finite there.
+    const Vec3f h = light_ + v;
+    const float ndh = dot(n, h) / std::sqrt(std::max(dot(h, h), 1e-30f));
+    const float spec = ndl > 0.0f ? specular_ * power(ndh) : 0.0f;
+    return {to_unorm8(base.x * k + spec), to_unorm8(base.y * k + spec),
+            to_unorm8(base.z * k + spec)};
+  }
+
+  // shade() for four surfaces at once (components of n, v and base as lanes). Writes
+  // round(255·c) per channel into r, g, b.
+  void shade4(const Float4 n[3], const Float4 v[3], const Float4 base[3], Int4 out[3]) const {
+    const Float4 zero = splat4(0.0f), one = splat4(1.0f);
+    const Float4 ndl = n[0] * light_.x + n[1] * light_.y + n[2] * light_.z;
+    const Float4 k = ambient_ + diffuse_ * max4(zero, ndl);
+    const Float4 hx = v[0] + light_.x, hy = v[1] + light_.y, hz = v[2] + light_.z;
+    const Float4 hh = max4(splat4(1e-30f), hx * hx + hy * hy + hz * hz);
+    const Float4 ndh = (n[0] * hx + n[1] * hy + n[2] * hz) / sqrt4(hh);
+    // The power table, lane by lane (as power()).
+    const Float4 u = min4(one, max4(zero, ndh)) * static_cast<float>(kTableIntervals);
+    const Int4 i = to_int4(u);
+    const Float4 f = u - to_float4(i);
+    const Float4 p0{power_[i[0]], power_[i[1]], power_[i[2]], power_[i[3]]};
+    const Float4 p1{power_[i[0] + 1], power_[i[1] + 1], power_[i[2] + 1], power_[i[3] + 1]};
+    const Float4 spec = select4(ndl > zero, specular_ * (p0 + (p1 - p0) * f), zero);
+    for (int c = 0; c < 3; ++c) {
+      out[c] = to_int4(min4(one, max4(zero, base[c] * k + spec)) * 255.0f + 0.5f);
+    }
+  }
+
+ private:
+  Vec3f light_, base_;
+  float ambient_ = 0, diffuse_ = 0, specular_ = 0;
+  std::array<float, kTableIntervals + 2> power_{};
+};
+
+}  // namespace pointillist::render_detail

@@ -1,0 +1,425 @@
+// Z-buffered splat rasterizer (square, circle and normal-oriented ellipse kernels, as in the
+// software and OpenGL drivers of QSplat: Rusinkiewicz & Levoy, SIGGRAPH 2000, section 4.1).
+//
+// Deterministic in parallel: the image is split into horizontal bands; every band draws all the
+// splats that touch it in stream order with a strict depth test, so each pixel sees the same
+// sequence of splats for any band layout and thread count (ties go to the earlier splat).
+#include "pointillist/render/splat_raster.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <cassert>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include "render/simd.hpp"
+
+namespace pointillist {
+namespace {
+
+constexpr int kBandsPerThread = 3;
+constexpr int kBandPixels = 1 << 17;
+constexpr float kMinEllipseRatio = 0.1f;
+constexpr int kEllipseStride = 6;  // A, 2B, C, half extent x / r, half extent y / r, ratio
+// A disc of radius ≥ √½ px, or a square of half side ≥ ½ px, always holds a pixel centre.
+constexpr float kDiscAlwaysCovers = 0.70711f;
+constexpr float kSquareAlwaysCovers = 0.5f;
+
+// Four pixels of a row at once.
+using render_detail::Float4;
+using render_detail::Int4;
+using render_detail::kLanes;
+using render_detail::load4;
+using render_detail::select4;
+using render_detail::splat4;
+using render_detail::store4;
+
+inline std::uint32_t pack(Rgb8 c) {
+  return static_cast<std::uint32_t>(c.r) | static_cast<std::uint32_t>(c.g) << 8 |
+         static_cast<std::uint32_t>(c.b) << 16;
+}
+
+// One band of the image: depths in the output buffer (full image, rows top to bottom) and packed
+// colors (0x00BBGGRR) in a band-sized buffer whose first row is the band's first row.
+struct Target {
+  std::uint32_t* color;
+  float* depth;
+  int width, height;
+  int row_begin, row_end;
+  float width_f, height_f;
+};
+
+// v clamped to [lo, hi]; NaN gives lo. Keeps coordinates of splats next to the eye (huge or
+// infinite) in the range where float-to-int conversion is defined.
+inline float clampf(float v, float lo, float hi) { return std::min(hi, std::max(lo, v)); }
+// floor and ceil for |v| < 2^31 (cheaper than the SSE2 sequences of std::floor/std::ceil).
+inline int floor_int(float v) {
+  const int t = static_cast<int>(v);
+  return t - (v < static_cast<float>(t));
+}
+inline int ceil_int(float v) {
+  const int t = static_cast<int>(v);
+  return t + (v > static_cast<float>(t));
+}
+
+inline void plot(const Target& t, int i, int j, float z, std::uint32_t c) {
+  if (i < 0 || i >= t.width || j < t.row_begin || j >= t.row_end) return;
+  const std::size_t w = static_cast<std::size_t>(t.width);
+  const std::size_t p = static_cast<std::size_t>(j) * w + i;
+  if (z < t.depth[p]) {
+    t.depth[p] = z;
+    t.color[static_cast<std::size_t>(j - t.row_begin) * w + i] = c;
+  }
+}
+
+// Pixels whose centre lies in [x − hx, x + hx] × [y − hy, y + hy], clipped to the band.
+struct PixelBox {
+  int i0, i1, j0, j1;
+};
+inline PixelBox pixel_box(const Target& t, float x, float y, float hx, float hy) {
+  // ceil(x − hx − ½), floor(x + hx − ½), ceil(y − hy − ½), floor(y + hy − ½) of the clamped
+  // values, all four at once: truncate, then step up (ceil lanes) or down (floor lanes).
+  const Float4 v = render_detail::min4(
+      Float4{t.width_f, t.width_f, t.height_f, t.height_f},
+      render_detail::max4(splat4(-1.0f),
+                          Float4{x - hx - 0.5f, x + hx - 0.5f, y - hy - 0.5f, y + hy - 0.5f}));
+  const Int4 truncated = render_detail::to_int4(v);
+  const Float4 back = render_detail::to_float4(truncated);
+  const Int4 ceil_lanes{-1, 0, -1, 0};
+  const Int4 r = truncated - ((v > back) & ceil_lanes) + ((v < back) & ~ceil_lanes);
+  return {std::max(r[0], 0), std::min(r[1], t.width - 1), std::max(r[2], t.row_begin),
+          std::min(r[3], t.row_end - 1)};
+}
+
+// The pixel holding (x, y) and the offset from (x, y) to its centre (the nearest centre).
+struct NearestCentre {
+  int i, j;
+  float dx, dy;
+};
+inline NearestCentre nearest_centre(const Target& t, float x, float y) {
+  const int i = floor_int(clampf(x, -1.0f, t.width_f + 1.0f));
+  const int j = floor_int(clampf(y, -1.0f, t.height_f + 1.0f));
+  return {i, j, static_cast<float>(i) + 0.5f - x, static_cast<float>(j) + 0.5f - y};
+}
+
+// Depth-tests and writes the pixels of box `b` that the shape covers. `inside(dx)` takes the
+// x offsets from the splat centre to four pixel centres and returns a test of a row's y offset
+// dy that gives the lanes inside the shape. Four pixels at a time, column group by column
+// group (the x part of the test is computed once per group). Lanes outside the shape are
+// written back unchanged; they are in the band's own rows, so no other thread touches them. The
+// last group of a row is shifted left to stay in the image (pixels seen twice are unchanged the
+// second time: the depth test is strict). Needs width ≥ 4.
+template <class Inside>
+inline void fill_box(const Target& t, const PixelBox& b, float x, float y, float z,
+                     std::uint32_t c, Inside inside) {
+  const Float4 lane_centre{0.5f, 1.5f, 2.5f, 3.5f};
+  const Float4 zv = splat4(z);
+  const Int4 cv = Int4{} + static_cast<std::int32_t>(c);
+  const std::size_t w = static_cast<std::size_t>(t.width);
+  // When rows are a whole number of groups, groups start at multiples of four: every access is
+  // then 16-byte aligned, and the next splat (usually a neighbour) reads exactly what this one
+  // stored, which store-to-load forwarding handles (a partial overlap would stall).
+  const int first = (t.width % kLanes == 0) ? (b.i0 & ~(kLanes - 1)) : b.i0;
+  for (int i = first; i <= b.i1; i += kLanes) {
+    const int s = std::min(i, t.width - kLanes);
+    // (s + k + 0.5) is exact, so each lane rounds once, as nearest_centre does.
+    const auto row_test = inside((static_cast<float>(s) + lane_centre) - x);
+    float* depth = t.depth + static_cast<std::size_t>(b.j0) * w + s;
+    std::uint32_t* color = t.color + static_cast<std::size_t>(b.j0 - t.row_begin) * w + s;
+    float cy = static_cast<float>(b.j0) + 0.5f;
+    for (int j = b.j0; j <= b.j1; ++j, cy += 1.0f, depth += w, color += w) {
+      const Float4 old_depth = load4(depth);
+      const Int4 m = row_test(cy - y) & (zv < old_depth);
+      store4(depth, select4(m, zv, old_depth));
+      store4(color, select4(m, cv, load4(color)));
+    }
+  }
+}
+
+// The same one pixel at a time, for images narrower than four pixels.
+template <class Inside>
+inline void fill_box_narrow(const Target& t, const PixelBox& b, float x, float y, float z,
+                            std::uint32_t c, Inside inside) {
+  for (int j = b.j0; j <= b.j1; ++j) {
+    const float dy = static_cast<float>(j) + 0.5f - y;
+    for (int i = b.i0; i <= b.i1; ++i) {
+      if (inside(splat4(static_cast<float>(i) + 0.5f - x))(dy)[0]) plot(t, i, j, z, c);
+    }
+  }
+}
+
+template <class Inside>
+inline void fill(const Target& t, const PixelBox& b, float x, float y, float z, std::uint32_t c,
+                 Inside inside) {
+  if (t.width >= kLanes) {
+    fill_box(t, b, x, y, z, c, inside);
+  } else {
+    fill_box_narrow(t, b, x, y, z, c, inside);
+  }
+}
+
+inline void draw_square(const Target& t, float x, float y, float z, float r, std::uint32_t c) {
+  if (r < kSquareAlwaysCovers) {
+    const NearestCentre n = nearest_centre(t, x, y);
+    if (!(std::abs(n.dx) <= r && std::abs(n.dy) <= r)) {
+      plot(t, n.i, n.j, z, c);
+      return;
+    }
+  }
+  const Float4 rv = splat4(r);
+  // Rows are within the box already; columns are tested because of the shifted last group.
+  fill(t, pixel_box(t, x, y, r, r), x, y, z, c, [&](Float4 dx) {
+    const Int4 in_x = (dx <= rv) & (-dx <= rv);
+    return [in_x](float) { return in_x; };
+  });
+}
+
+inline void draw_circle(const Target& t, float x, float y, float z, float r, std::uint32_t c) {
+  const float r2 = r * r;
+  if (r < kDiscAlwaysCovers) {
+    const NearestCentre n = nearest_centre(t, x, y);
+    if (!(n.dx * n.dx + n.dy * n.dy <= r2)) {
+      plot(t, n.i, n.j, z, c);
+      return;
+    }
+  }
+  const Float4 r2v = splat4(r2);
+  fill(t, pixel_box(t, x, y, r, r), x, y, z, c, [&](Float4 dx) {
+    const Float4 dx2 = dx * dx;
+    return [dx2, r2v](float dy) { return dx2 + dy * dy <= r2v; };
+  });
+}
+
+// Ellipse {d : A·dx² + 2B·dx·dy + C·dy² ≤ r²} (see ellipse_parameters).
+inline void draw_ellipse(const Target& t, float x, float y, float z, float r, const float* e,
+                         std::uint32_t c) {
+  const float a = e[0], b2 = e[1], cc = e[2];
+  const float hx = r * e[3], hy = r * e[4];
+  const float r2 = r * r;
+  if (r * e[5] < kDiscAlwaysCovers) {
+    // Thin: may hold no pixel centre. The box is small here (r < 7.1 px as ratio ≥ 0.1).
+    const NearestCentre n = nearest_centre(t, x, y);
+    bool covers = false;
+    const int i0 = ceil_int(clampf(x - hx - 0.5f, -2.0f, t.width_f + 1.0f));
+    const int i1 = floor_int(clampf(x + hx - 0.5f, -2.0f, t.width_f + 1.0f));
+    const int j0 = ceil_int(clampf(y - hy - 0.5f, -2.0f, t.height_f + 1.0f));
+    const int j1 = floor_int(clampf(y + hy - 0.5f, -2.0f, t.height_f + 1.0f));
+    for (int j = j0; j <= j1 && !covers; ++j) {
+      for (int i = i0; i <= i1 && !covers; ++i) {
+        const float dx = static_cast<float>(i) + 0.5f - x, dy = static_cast<float>(j) + 0.5f - y;
+        covers = a * dx * dx + b2 * dx * dy + cc * dy * dy <= r2;  // as in the lanes below
+      }
+    }
+    if (!covers) {
+      plot(t, n.i, n.j, z, c);
+      return;
+    }
+  }
+  const Float4 av = splat4(a), r2v = splat4(r2);
+  fill(t, pixel_box(t, x, y, hx, hy), x, y, z, c, [&](Float4 dx) {
+    const Float4 adx2 = av * dx * dx, b2dx = b2 * dx;
+    return [=](float dy) { return adx2 + b2dx * dy + cc * dy * dy <= r2v; };
+  });
+}
+
+// Ellipse of a disc with eye-space normal ne seen along ve: minor axis (ax, ay) along the screen
+// projection of the normal (pixel y runs down), minor/major = max(|n·v|, 0.1). With q = ratio²
+// the ellipse is dᵀ·M·d ≤ r², M = a·aᵀ/q + b·bᵀ (b ⟂ a), so A = ax²/q + ay², B = ax·ay·(1/q − 1),
+// C = ay²/q + ax²; its bounding box has half extents r·√(ax²·q + ay²) and r·√(ay²·q + ax²).
+inline void ellipse_parameters(Vec3f ne, Vec3f ve, float* e) {
+  float ax = ne.x, ay = -ne.y;
+  const float len = std::sqrt(ax * ax + ay * ay);
+  float ratio = std::min(std::max(std::abs(dot(ne, ve)), kMinEllipseRatio), 1.0f);
+  if (len > 1e-6f) {
+    ax /= len;
+    ay /= len;
+  } else {
+    ax = 1.0f;
+    ay = 0.0f;
+    ratio = 1.0f;
+  }
+  const float q = ratio * ratio, inv_q = 1.0f / q;
+  e[0] = ax * ax * inv_q + ay * ay;
+  e[1] = 2.0f * ax * ay * (inv_q - 1.0f);
+  e[2] = ay * ay * inv_q + ax * ax;
+  e[3] = std::sqrt(ax * ax * q + ay * ay);
+  e[4] = std::sqrt(ay * ay * q + ax * ax);
+  e[5] = ratio;
+}
+
+struct BandLayout {
+  int count = 1;
+  int rows_log2 = 0;  // rows per band = 2^rows_log2 (the last band may be shorter)
+  int rows() const { return 1 << rows_log2; }
+};
+
+// Bands small enough for their depths and colors to stay in a core's L2 cache (about
+// kBandPixels pixels), and at least kBandsPerThread per thread so that threads share the work
+// evenly. The layout changes speed only, never the image.
+BandLayout choose_bands(int width, int height, unsigned threads) {
+  BandLayout b;
+  const int wanted = static_cast<int>(threads) * kBandsPerThread;
+  b.rows_log2 = 2;
+  while ((2 << b.rows_log2) * width <= kBandPixels && (height >> (b.rows_log2 + 1)) >= wanted) {
+    ++b.rows_log2;
+  }
+  b.count = (height + b.rows() - 1) >> b.rows_log2;
+  return b;
+}
+
+// Ellipse parameters of every splat of `chunk`.
+void prepare_ellipses(const SplatChunk& chunk, const CameraFrame& cam, RasterScratch::Chunk& out) {
+  const std::size_t n = chunk.count;
+  if (out.ellipse.size() < kEllipseStride * n) {
+    out.ellipse.resize(std::max(kEllipseStride * n, 2 * out.ellipse.size()));
+  }
+  const float half_w = 0.5f * static_cast<float>(cam.width);
+  const float half_h = 0.5f * static_cast<float>(cam.height);
+  const float inv_f = 1.0f / cam.focal_px;
+  const Vec3f right = cam.right, up = cam.up, back = -cam.forward;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3f nw = chunk.normal[i];
+    const Vec3f ne{dot(nw, right), dot(nw, up), dot(nw, back)};
+    // Unit vector to the eye in eye space: −(x_e/z, y_e/z, −1), normalized.
+    const float a = (chunk.x_px[i] - half_w) * inv_f, b = (chunk.y_px[i] - half_h) * inv_f;
+    const float inv_len = 1.0f / std::sqrt(a * a + b * b + 1.0f);
+    ellipse_parameters(ne, Vec3f{-a * inv_len, b * inv_len, inv_len},
+                       &out.ellipse[kEllipseStride * i]);
+  }
+}
+
+// Rows touched by the chunk's splats: [min(y − r), max(y + r)] (r = size/2), so that a band can
+// skip chunks that miss it (a chunk is a subtree, so its splats are close together on screen).
+void row_extent(const SplatChunk& chunk, RasterScratch::Chunk& out) {
+  float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+  for (std::size_t i = 0; i < chunk.count; ++i) {
+    const float r = 0.5f * chunk.size_px[i];
+    lo = std::min(lo, chunk.y_px[i] - r);
+    hi = std::max(hi, chunk.y_px[i] + r);
+  }
+  out.y_min_px = lo;
+  out.y_max_px = hi;
+}
+
+template <SplatShape kShape>
+inline void draw_one(const Target& t, const SplatChunk& s, const RasterScratch::Chunk& sc,
+                     std::size_t i) {
+  const float r = 0.5f * s.size_px[i];
+  const std::uint32_t c = s.shaded[i];
+  if constexpr (kShape == SplatShape::Square) {
+    draw_square(t, s.x_px[i], s.y_px[i], s.depth[i], r, c);
+  } else if constexpr (kShape == SplatShape::Circle) {
+    draw_circle(t, s.x_px[i], s.y_px[i], s.depth[i], r, c);
+  } else {
+    draw_ellipse(t, s.x_px[i], s.y_px[i], s.depth[i], r, &sc.ellipse[kEllipseStride * i], c);
+  }
+}
+
+// Draws every splat that may touch the band, chunk by chunk in stream order. A splat touches
+// rows whose centre is within its radius of y, and the row holding y, so y + r ≥ first row and
+// y − r < end row is a safe test.
+template <SplatShape kShape>
+void draw_band(const SplatStream& stream, const RasterScratch& scratch, bool banded,
+               const Target& t) {
+  const float band_lo = static_cast<float>(t.row_begin), band_hi = static_cast<float>(t.row_end);
+  for (std::size_t c = 0; c < stream.chunk_count; ++c) {
+    const SplatChunk& s = stream.chunks[c];
+    const RasterScratch::Chunk& sc = scratch.chunks[c];
+    if (!banded || (sc.y_min_px >= band_lo && sc.y_max_px < band_hi)) {
+      for (std::size_t i = 0; i < s.count; ++i) draw_one<kShape>(t, s, sc, i);
+      continue;
+    }
+    if (!(sc.y_max_px >= band_lo && sc.y_min_px < band_hi)) continue;
+    for (std::size_t i = 0; i < s.count; ++i) {
+      const float y = s.y_px[i], r = 0.5f * s.size_px[i];
+      if (y + r >= band_lo && y - r < band_hi) draw_one<kShape>(t, s, sc, i);
+    }
+  }
+}
+
+void clear_band(const Target& t, Rgb8 background) {
+  const std::size_t w = static_cast<std::size_t>(t.width);
+  const std::size_t rows = static_cast<std::size_t>(t.row_end - t.row_begin);
+  std::fill(t.color, t.color + rows * w, pack(background));
+  std::fill(t.depth + static_cast<std::size_t>(t.row_begin) * w,
+            t.depth + static_cast<std::size_t>(t.row_end) * w,
+            std::numeric_limits<float>::infinity());
+}
+
+// The band's packed 0x00BBGGRR pixels to 3-byte pixels of the output, four at a time (three
+// little-endian words).
+void unpack_band(const Target& t, std::span<Rgb8> out) {
+  static_assert(sizeof(Rgb8) == 3);
+  const std::size_t w = static_cast<std::size_t>(t.width);
+  const std::size_t n = static_cast<std::size_t>(t.row_end - t.row_begin) * w;
+  const std::uint32_t* in = t.color;
+  Rgb8* dst = out.data() + static_cast<std::size_t>(t.row_begin) * w;
+  auto* bytes = reinterpret_cast<unsigned char*>(dst);
+  std::size_t p = 0;
+  if constexpr (std::endian::native == std::endian::little) {
+    for (; p + 4 <= n; p += 4) {
+      const std::uint32_t a = in[p], b = in[p + 1], c = in[p + 2], d = in[p + 3];
+      const std::uint32_t words[3] = {a | b << 24, b >> 8 | c << 16, c >> 16 | d << 8};
+      std::memcpy(bytes + 3 * p, words, sizeof words);
+    }
+  }
+  for (; p < n; ++p) {
+    const std::uint32_t c = in[p];
+    dst[p] = Rgb8{static_cast<std::uint8_t>(c), static_cast<std::uint8_t>(c >> 8),
+                  static_cast<std::uint8_t>(c >> 16)};
+  }
+}
+
+}  // namespace
+
+void rasterize_splats(const SplatStream& stream, const CameraFrame& camera,
+                      const RenderSettings& settings, ThreadPool& pool, RasterScratch& scratch,
+                      std::span<Rgb8> color, std::span<float> depth) {
+  [[maybe_unused]] const std::size_t pixels =
+      static_cast<std::size_t>(camera.width) * static_cast<std::size_t>(camera.height);
+  assert(color.size() == pixels && depth.size() == pixels);
+  const bool ellipses = settings.shape == SplatShape::Ellipse;
+  const BandLayout bands = choose_bands(camera.width, camera.height, pool.thread_count());
+  const bool banded = bands.count > 1;
+
+  if (scratch.chunks.size() < stream.chunk_count) scratch.chunks.resize(stream.chunk_count);
+  if (ellipses || banded) pool.run(stream.chunk_count, [&](std::size_t c) {
+    if (ellipses) prepare_ellipses(stream.chunks[c], camera, scratch.chunks[c]);
+    if (banded) row_extent(stream.chunks[c], scratch.chunks[c]);
+  });
+
+  // One worker per thread takes bands off a shared counter and packs colors in its own
+  // band-sized buffer; which worker draws a band does not matter.
+  const std::size_t workers =
+      std::min<std::size_t>(pool.thread_count(), static_cast<std::size_t>(bands.count));
+  const std::size_t band_pixels =
+      static_cast<std::size_t>(bands.rows()) * static_cast<std::size_t>(camera.width);
+  scratch.band_colors.resize(std::max(scratch.band_colors.size(), workers));
+  for (std::size_t k = 0; k < workers; ++k) scratch.band_colors[k].resize(band_pixels);
+  std::atomic<int> next_band{0};
+  pool.run(workers, [&](std::size_t worker) {
+    for (int b = next_band++; b < bands.count; b = next_band++) {
+      const Target t{scratch.band_colors[worker].data(),
+                     depth.data(),
+                     camera.width,
+                     camera.height,
+                     b << bands.rows_log2,
+                     std::min(camera.height, (b + 1) << bands.rows_log2),
+                     static_cast<float>(camera.width),
+                     static_cast<float>(camera.height)};
+      clear_band(t, settings.background);
+      switch (settings.shape) {
+        case SplatShape::Square: draw_band<SplatShape::Square>(stream, scratch, banded, t); break;
+        case SplatShape::Circle: draw_band<SplatShape::Circle>(stream, scratch, banded, t); break;
+        case SplatShape::Ellipse:
+          draw_band<SplatShape::Ellipse>(stream, scratch, banded, t);
+          break;
+      }
+      unpack_band(t, color);
+    }
+  });
+}
+
+}  // namespace pointillist

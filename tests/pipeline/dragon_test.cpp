@@ -1,0 +1,41 @@
+// The Stanford dragon (fetched by scripts/fetch-models.sh): the splat rendering's silhouette must
+// match a z-buffered rendering of the dragon's own triangles.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "pointillist/io/ply.hpp"
+#include "pointillist/lod/sphere_tree.hpp"
+#include "pointillist/prep/prepare.hpp"
+#include "pointillist/render/mesh_reference.hpp"
+#include "pointillist/render/render.hpp"
+#include "testing/testing.hpp"
+
+using namespace pointillist;
+
+TEST(Dragon, SplatSilhouetteMatchesTheTriangleMesh) {
+  const auto path = pointillist::testing::cached_model("dragon_vrip.ply.gz");
+  if (path.empty()) GTEST_SKIP() << "dragon not fetched (run scripts/fetch-models.sh)";
+  ThreadPool pool(2);
+  const PointSet mesh = read_ply(path.string());
+  ASSERT_EQ(mesh.size(), 437645u);
+  PointSet splats = mesh;
+  prepare_splats(splats, pool, Progress::none());
+  const SphereTree tree = build_sphere_tree(splats, pool);
+  for (float az : {0.0f, 90.0f, 215.0f}) {
+    const Camera cam = orbit_camera(tree.view_sphere,
+                                    {.azimuth_deg = az, .elevation_deg = 15, .width = 480, .height = 360});
+    Frame splat_frame, mesh_frame;
+    render(tree.view(), cam, RenderSettings{}, pool, splat_frame);
+    render_mesh_reference(mesh, cam, RenderSettings{}, mesh_frame);
+    std::size_t both = 0, either = 0;
+    for (std::size_t i = 0; i < splat_frame.depth.size(); ++i) {
+      const bool s = std::isfinite(splat_frame.depth[i]);
+      const bool m = std::isfinite(mesh_frame.depth[i]);
+      both += s && m;
+      either += s || m;
+    }
+    ASSERT_GT(either, 10000u);
+    EXPECT_GE(double(both) / double(either), 0.97) << "azimuth " << az;
+  }
+}

@@ -1,0 +1,162 @@
+// Cloud radii: the defining formula on a grid and brute force, and hole-free coverage of
+// randomly sampled analytic surfaces.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "pointillist/core/error.hpp"
+#include "pointillist/prep/normals.hpp"
+#include "pointillist/prep/radii.hpp"
+#include "pointillist/scene/analytic.hpp"
+
+using namespace pointillist;
+
+TEST(CloudRadii, RegularGridGivesMeanFiveNeighbourDistanceTimesCoverageAndScale) {
+  // A 20 × 20 square grid with spacing h. An interior point's 5 nearest: 4 at h, then one of
+  // the 4 diagonal ones at h√2, so the mean is (4 + √2) h / 5.
+  const float h = 0.25f;
+  std::vector<Vec3f> p;
+  for (int y = 0; y < 20; ++y) {
+    for (int x = 0; x < 20; ++x) p.push_back({x * h, y * h, 1.0f});
+  }
+  ThreadPool pool(2);
+  const std::vector<float> r =
+      cloud_radii(p, pool, Progress::none(), {.coverage = 1.5f, .scale = 2.0f});
+  const float expected = (4.0f + std::sqrt(2.0f)) * h / 5.0f * 1.5f * 2.0f;
+  for (int y = 1; y < 19; ++y) {
+    for (int x = 1; x < 19; ++x) EXPECT_FLOAT_EQ(r[std::size_t(y * 20 + x)], expected);
+  }
+  // A corner point: 2 at h, 1 at h√2, 2 at 2h.
+  EXPECT_FLOAT_EQ(r[0], (2.0f + std::sqrt(2.0f) + 4.0f) * h / 5.0f * 1.5f * 2.0f);
+  // The default coverage is the documented constant.
+  const std::vector<float> d = cloud_radii(p, pool);
+  EXPECT_FLOAT_EQ(d[21], (4.0f + std::sqrt(2.0f)) * h / 5.0f * kDefaultCloudCoverage);
+}
+
+TEST(CloudRadii, MatchBruteForceOnRandomPoints) {
+  const SurfaceSamples s = sample_scene(torus_scene(), 1500, 8);
+  const std::vector<Vec3f>& p = s.points.positions;
+  ThreadPool pool(2);
+  const std::vector<float> r =
+      cloud_radii(p, pool, Progress::none(), {.neighbours = 3, .coverage = 1.0f});
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    std::vector<float> d;
+    for (std::size_t j = 0; j < p.size(); ++j) {
+      if (j != i) d.push_back(distance(p[i], p[j]));
+    }
+    std::partial_sort(d.begin(), d.begin() + 3, d.end());
+    EXPECT_NEAR(r[i], (d[0] + d[1] + d[2]) / 3.0f, 1e-6f) << "point " << i;
+  }
+}
+
+TEST(CloudRadii, RejectsZeroNeighbours) {
+  ThreadPool pool(1);
+  const std::vector<Vec3f> p = {{0, 0, 0}, {1, 0, 0}};
+  EXPECT_THROW(cloud_radii(p, pool, Progress::none(), {.neighbours = 0}), OptionError);
+}
+
+namespace {
+
+// Independent oracle for coverage: a uniform grid over the samples (cells as wide as the
+// largest radius, so every disc that can cover a point lies in the 27 cells around it).
+class SampleGrid {
+ public:
+  SampleGrid(const std::vector<Vec3f>& points, float cell) : cell_(cell) {
+    for (const Vec3f& p : points) box_.extend(p);
+    for (int a = 0; a < 3; ++a) {
+      size_[a] = std::int64_t((box_.hi[a] - box_.lo[a]) / cell) + 1;
+    }
+    std::vector<std::int64_t> cell_of(points.size());
+    begin_.assign(std::size_t(size_[0] * size_[1] * size_[2]) + 1, 0);
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      cell_of[i] = index(coord(points[i], 0), coord(points[i], 1), coord(points[i], 2));
+      ++begin_[std::size_t(cell_of[i]) + 1];
+    }
+    for (std::size_t c = 1; c < begin_.size(); ++c) begin_[c] += begin_[c - 1];
+    items_.resize(points.size());
+    std::vector<std::uint32_t> fill(begin_.begin(), begin_.end() - 1);
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      items_[fill[std::size_t(cell_of[i])]++] = std::uint32_t(i);
+    }
+  }
+
+  // Calls fn(i) for the samples in the 27 cells around q (q's own cell first, where a covering
+  // disc is most likely) until it returns true; says whether one did.
+  template <class Fn>
+  bool any_near(Vec3f q, Fn&& fn) const {
+    const std::int64_t c[3] = {coord(q, 0), coord(q, 1), coord(q, 2)};
+    const auto visit = [&](std::int64_t x, std::int64_t y, std::int64_t z) {
+      if (x < 0 || y < 0 || z < 0 || x >= size_[0] || y >= size_[1] || z >= size_[2]) return false;
+      const auto cell = std::size_t(index(x, y, z));
+      for (std::uint32_t e = begin_[cell]; e < begin_[cell + 1]; ++e) {
+        if (fn(items_[e])) return true;
+      }
+      return false;
+    };
+    if (visit(c[0], c[1], c[2])) return true;
+    for (std::int64_t dz = -1; dz <= 1; ++dz) {
+      for (std::int64_t dy = -1; dy <= 1; ++dy) {
+        for (std::int64_t dx = -1; dx <= 1; ++dx) {
+          if ((dx != 0 || dy != 0 || dz != 0) && visit(c[0] + dx, c[1] + dy, c[2] + dz)) {
+            return true;
+          }
+        }
+      }
+    }
+    return false;
+  }
+
+ private:
+  std::int64_t coord(Vec3f p, int axis) const {
+    const auto c = std::int64_t(std::floor((p[axis] - box_.lo[axis]) / cell_));
+    return std::clamp<std::int64_t>(c, -1, size_[axis]);  // probes just outside the box
+  }
+  std::int64_t index(std::int64_t x, std::int64_t y, std::int64_t z) const {
+    return (z * size_[1] + y) * size_[0] + x;
+  }
+
+  float cell_;
+  Aabb box_;
+  std::int64_t size_[3] = {1, 1, 1};
+  std::vector<std::uint32_t> begin_, items_;
+};
+
+// Fraction of `probes` random surface points inside no sample's disc (centre, PCA normal, radius
+// at `coverage`), measured in the disc's plane: the holes a renderer of those discs would show
+// seen head-on.
+double uncovered_fraction(const AnalyticScene& scene, std::size_t samples, std::uint64_t seed,
+                          std::size_t probes, float coverage = kDefaultCloudCoverage) {
+  const SurfaceSamples s = sample_scene(scene, samples, seed);
+  ThreadPool pool(2);
+  const std::vector<Vec3f>& p = s.points.positions;
+  const std::vector<Vec3f> n = pca_normals(p, pool);
+  const std::vector<float> r = cloud_radii(p, pool, Progress::none(), {.coverage = coverage});
+  const SampleGrid grid(p, *std::max_element(r.begin(), r.end()));
+  const SurfaceSamples probe = sample_scene(scene, probes, seed + 1000);
+  std::size_t uncovered = 0;
+  for (const Vec3f q : probe.points.positions) {
+    uncovered += !grid.any_near(q, [&](std::uint32_t i) {
+      const Vec3f d = q - p[i];
+      const Vec3f in_plane = d - n[i] * dot(d, n[i]);
+      return length_squared(in_plane) <= r[i] * r[i];
+    });
+  }
+  return double(uncovered) / double(probes);
+}
+
+}  // namespace
+
+TEST(CloudRadii, DefaultCoverageLeavesNoHolesOnRandomlySampledSurfaces) {
+  // 10 to 50 probes per sample: enough to see the 1e-4 of the surface left open at coverage 1.6,
+  // some 25% below the smallest coverage found safe (2.1).
+  EXPECT_EQ(uncovered_fraction(sphere_scene(), 2'000, 21, 100'000), 0.0);
+  EXPECT_EQ(uncovered_fraction(sphere_scene(), 20'000, 22, 200'000), 0.0);
+  EXPECT_EQ(uncovered_fraction(torus_scene(), 20'000, 23, 200'000), 0.0);
+  EXPECT_EQ(uncovered_fraction(demo_scene(), 30'000, 24, 300'000), 0.0);
+}
+
+TEST(CloudRadii, CoverageOfOneLeavesHoles) {
+  // The check above can fail: at coverage 1 about 1% of such a surface is uncovered.
+  EXPECT_GT(uncovered_fraction(sphere_scene(), 5'000, 25, 100'000, 1.0f), 0.003);
+}

@@ -1,0 +1,144 @@
+// PCA normals and their MST orientation against the exact normals of analytic surfaces.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "pointillist/core/error.hpp"
+#include "pointillist/prep/normals.hpp"
+#include "pointillist/scene/analytic.hpp"
+
+using namespace pointillist;
+
+namespace {
+
+double angle_deg(Vec3f a, Vec3f b) {
+  const double c =
+      std::clamp(double(dot(a, b)) / (double(length(a)) * double(length(b))), -1.0, 1.0);
+  return std::acos(c) * 180.0 / 3.14159265358979323846;
+}
+
+struct NormalErrors {
+  double mean_deg = 0;     // mean of the unoriented angle (the PCA line against the true normal)
+  std::size_t inward = 0;  // normals with dot(estimate, true) <= 0
+  std::size_t not_unit = 0;
+};
+
+NormalErrors compare(const std::vector<Vec3f>& estimated, const std::vector<Vec3f>& truth) {
+  NormalErrors e;
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    const double a = angle_deg(estimated[i], truth[i]);
+    e.mean_deg += std::min(a, 180.0 - a);
+    e.inward += dot(estimated[i], truth[i]) <= 0.0f;
+    e.not_unit += std::abs(length(estimated[i]) - 1.0f) > 1e-5f;
+  }
+  e.mean_deg /= double(truth.size());
+  return e;
+}
+
+}  // namespace
+
+TEST(PcaNormals, SphereNormalsAreAccurateAndAllOutward) {
+  const SurfaceSamples s = sample_scene(sphere_scene(1.0f), 20'000, 1);
+  ThreadPool pool(2);
+  const std::vector<Vec3f> n = pca_normals(s.points.positions, pool);
+  ASSERT_EQ(n.size(), s.points.size());
+  const NormalErrors e = compare(n, s.true_normals);
+  EXPECT_LT(e.mean_deg, 1.0);
+  EXPECT_EQ(e.inward, 0u);
+  EXPECT_EQ(e.not_unit, 0u);
+}
+
+TEST(PcaNormals, TorusNormalsAreAccurateAndAllOutward) {
+  // The inner half of a torus is saddle-shaped and faces the centroid: orientation must come
+  // from propagation, not from the direction away from the centre.
+  const SurfaceSamples s = sample_scene(torus_scene(1.0f, 0.35f), 40'000, 2);
+  ThreadPool pool(2);
+  const NormalErrors e = compare(pca_normals(s.points.positions, pool), s.true_normals);
+  EXPECT_LT(e.mean_deg, 1.0);
+  EXPECT_EQ(e.inward, 0u);
+}
+
+TEST(PcaNormals, CubeFacesAreExactAwayFromEdgesAndAllOutward) {
+  const AnalyticScene scene = cube_scene(1.0f);
+  const std::size_t count = 30'000;
+  const SurfaceSamples s = sample_scene(scene, count, 3);
+  ThreadPool pool(2);
+  const std::vector<Vec3f> n = pca_normals(s.points.positions, pool);
+  // With `spacing` the side of the square each sample owns, 16 neighbours of a random sample
+  // lie within about 2.3 spacings (rarely more than 3.5); beyond 4 spacings from every edge
+  // a neighbourhood is flat and its normal is exact up to rounding.
+  const double spacing = std::sqrt(surface_area(scene) / double(count));
+  std::size_t interior = 0, off = 0, inward = 0;
+  for (std::size_t i = 0; i < count; ++i) {
+    inward += dot(n[i], s.true_normals[i]) <= 0.0f;
+    if (s.edge_distance[i] > 4.0 * spacing) {
+      ++interior;
+      off += angle_deg(n[i], s.true_normals[i]) > 1.0;
+    }
+  }
+  EXPECT_GT(interior, count / 2);
+  EXPECT_EQ(off, 0u) << "of " << interior << " points away from edges";
+  EXPECT_EQ(inward, 0u);
+}
+
+TEST(PcaNormals, EachSeparateShapeIsOrientedOutward) {
+  // Sphere, torus and cube apart from each other: three components of the neighbour graph,
+  // each seeded on its own.
+  const SurfaceSamples s = sample_scene(demo_scene(), 40'000, 4);
+  ThreadPool pool(2);
+  const std::vector<Vec3f> n = pca_normals(s.points.positions, pool);
+  std::size_t inward[3] = {0, 0, 0}, total[3] = {0, 0, 0};
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    ++total[s.shape_ids[i]];
+    inward[s.shape_ids[i]] += dot(n[i], s.true_normals[i]) <= 0.0f;
+  }
+  for (int shape = 0; shape < 3; ++shape) {
+    EXPECT_GT(total[shape], 1000u);
+    EXPECT_EQ(inward[shape], 0u) << "shape " << shape;
+  }
+}
+
+TEST(PcaNormals, IsolatedClustersAreSeededAwayFromTheCentroid) {
+  // Two small flat patches far apart, facing each other across the centroid: each must get
+  // normals pointing away from the centroid (x < 0 patch: -x, x > 0 patch: +x).
+  std::vector<Vec3f> p;
+  for (int side : {-1, 1}) {
+    for (int y = 0; y < 10; ++y) {
+      for (int z = 0; z < 10; ++z) {
+        // A slight bulge keeps the seed (the farthest point) unambiguous.
+        const float fy = 0.1f * float(y - 4.5f), fz = 0.1f * float(z - 4.5f);
+        p.push_back({float(side) * (10.0f - 0.2f * (fy * fy + fz * fz)), fy, fz});
+      }
+    }
+  }
+  ThreadPool pool(2);
+  const std::vector<Vec3f> n = pca_normals(p, pool, Progress::none(), {.k = 8});
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    EXPECT_GT(n[i].x * p[i].x, 0.0f) << "point " << i;
+  }
+}
+
+TEST(PcaNormals, SameBitsForAnyThreadCount) {
+  const SurfaceSamples s = sample_scene(demo_scene(), 20'000, 5);
+  ThreadPool one(1), three(3);
+  const std::vector<Vec3f> a = pca_normals(s.points.positions, one);
+  const std::vector<Vec3f> b = pca_normals(s.points.positions, three);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) ASSERT_TRUE(a[i] == b[i]) << "point " << i;
+}
+
+TEST(PcaNormals, RejectsTooFewPointsAndTooSmallK) {
+  ThreadPool pool(1);
+  const std::vector<Vec3f> two = {{0, 0, 0}, {1, 0, 0}};
+  try {
+    pca_normals(two, pool);
+    FAIL() << "expected an Error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("at least 3 points"), std::string::npos) << e.what();
+  }
+  const std::vector<Vec3f> three = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  EXPECT_THROW(pca_normals(three, pool, Progress::none(), {.k = 2}), OptionError);
+  // Three points make a plane: k larger than the cloud is fine.
+  const std::vector<Vec3f> n = pca_normals(three, pool);
+  for (const Vec3f& v : n) EXPECT_NEAR(std::abs(v.z), 1.0f, 1e-6f);
+}

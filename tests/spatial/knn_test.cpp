@@ -1,0 +1,185 @@
+// kNN against brute force, Morton order as a spatially coherent permutation.
+#include "pointillist/spatial/knn.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <random>
+#include <set>
+
+using namespace pointillist;
+
+namespace {
+
+std::vector<Vec3f> random_points(std::size_t n, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<Vec3f> p(n);
+  for (Vec3f& v : p) v = {u(rng), u(rng), u(rng)};
+  return p;
+}
+
+// Points on a 3D integer grid: many exactly equal distances.
+std::vector<Vec3f> grid_points(int side) {
+  std::vector<Vec3f> p;
+  for (int z = 0; z < side; ++z) {
+    for (int y = 0; y < side; ++y) {
+      for (int x = 0; x < side; ++x) p.push_back({float(x), float(y), float(z)});
+    }
+  }
+  return p;
+}
+
+// The k smallest squared distances from point i to the other points, sorted (the oracle).
+std::vector<float> brute_force_d2(const std::vector<Vec3f>& p, std::size_t i, std::size_t k) {
+  std::vector<float> d;
+  for (std::size_t j = 0; j < p.size(); ++j) {
+    if (j != i) d.push_back(length_squared(p[j] - p[i]));
+  }
+  std::partial_sort(d.begin(), d.begin() + std::ptrdiff_t(k), d.end());
+  d.resize(k);
+  return d;
+}
+
+// Checks every row against brute force: the distances match the k smallest (so equal distances
+// may swap indices), indices are distinct, not the point itself, and really at those distances.
+void expect_matches_brute_force(const std::vector<Vec3f>& p, std::uint32_t k, unsigned threads) {
+  ThreadPool pool(threads);
+  std::vector<float> d2;
+  const auto nb = k_nearest_neighbours(p, pool, {.k = k}, &d2);
+  ASSERT_EQ(nb.size(), p.size() * k);
+  ASSERT_EQ(d2.size(), p.size() * k);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const std::vector<float> oracle = brute_force_d2(p, i, k);
+    std::set<std::uint32_t> seen;
+    for (std::uint32_t j = 0; j < k; ++j) {
+      const std::uint32_t m = nb[i * k + j];
+      ASSERT_LT(m, p.size());
+      EXPECT_NE(m, i) << "point " << i;
+      EXPECT_TRUE(seen.insert(m).second) << "point " << i << " lists " << m << " twice";
+      EXPECT_EQ(d2[i * k + j], length_squared(p[m] - p[i])) << "point " << i;
+      EXPECT_FLOAT_EQ(d2[i * k + j], oracle[j]) << "point " << i << " neighbour " << j;
+    }
+  }
+}
+
+}  // namespace
+
+TEST(KNearestNeighbours, MatchesBruteForceOnRandomPoints) {
+  expect_matches_brute_force(random_points(2000, 7), 16, 2);
+}
+
+TEST(KNearestNeighbours, MatchesBruteForceWithEqualDistancesOnAGrid) {
+  expect_matches_brute_force(grid_points(12), 8, 2);
+}
+
+TEST(KNearestNeighbours, EqualDistancesAreOrderedByIndex) {
+  const std::vector<Vec3f> p = grid_points(6);
+  ThreadPool pool(2);
+  std::vector<float> d2;
+  const std::uint32_t k = 6;
+  const auto nb = k_nearest_neighbours(p, pool, {.k = k}, &d2);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    for (std::uint32_t j = 1; j < k; ++j) {
+      ASSERT_LE(d2[i * k + j - 1], d2[i * k + j]);
+      if (d2[i * k + j - 1] == d2[i * k + j]) {
+        EXPECT_LT(nb[i * k + j - 1], nb[i * k + j]);
+      }
+    }
+  }
+  // An interior grid point has exactly its 6 face neighbours at distance 1.
+  const std::size_t centre = 2 + 6 * (2 + 6 * 2);
+  const std::vector<std::uint32_t> expected = {centre - 36, centre - 6, centre - 1,
+                                               centre + 1,  centre + 6, centre + 36};
+  EXPECT_EQ(std::vector<std::uint32_t>(nb.begin() + centre * k, nb.begin() + centre * k + k),
+            expected);
+}
+
+TEST(KNearestNeighbours, SameResultForAnyThreadCountAndOrderFlag) {
+  const std::vector<Vec3f> p = random_points(3000, 11);
+  ThreadPool one(1), three(3);
+  std::vector<float> d_one, d_three;
+  const auto a = k_nearest_neighbours(p, one, {.k = 10}, &d_one);
+  const auto b = k_nearest_neighbours(p, three, {.k = 10}, &d_three);
+  EXPECT_EQ(a, b);
+  EXPECT_EQ(d_one, d_three);
+  // Telling it the (random) points are ordered must change only speed, not the answer.
+  const auto c = k_nearest_neighbours(p, three, {.k = 10, .points_are_ordered = true});
+  EXPECT_EQ(a, c);
+}
+
+TEST(KNearestNeighbours, FewerPointsThanKRepeatTheLastNeighbour) {
+  ThreadPool pool(2);
+  const std::vector<Vec3f> p = {{0, 0, 0}, {1, 0, 0}, {3, 0, 0}};
+  std::vector<float> d2;
+  const auto nb = k_nearest_neighbours(p, pool, {.k = 4}, &d2);
+  EXPECT_EQ(nb, (std::vector<std::uint32_t>{1, 2, 2, 2, 0, 2, 2, 2, 1, 0, 0, 0}));
+  EXPECT_EQ(d2, (std::vector<float>{1, 9, 9, 9, 1, 4, 4, 4, 4, 9, 9, 9}));
+
+  const std::vector<Vec3f> single = {{5, 5, 5}};
+  EXPECT_EQ(k_nearest_neighbours(single, pool, {.k = 2}), (std::vector<std::uint32_t>{0, 0}));
+  EXPECT_TRUE(k_nearest_neighbours({}, pool, {.k = 3}).empty());
+}
+
+TEST(KNearestNeighbours, DuplicatePointsAreNeighboursAtDistanceZero) {
+  ThreadPool pool(2);
+  std::vector<Vec3f> p(5, Vec3f{1, 2, 3});
+  p.push_back({1, 2, 4});
+  std::vector<float> d2;
+  const auto nb = k_nearest_neighbours(p, pool, {.k = 3}, &d2);
+  // Point 2 has four copies at distance 0; the three lowest indices other than itself win.
+  EXPECT_EQ(std::vector<std::uint32_t>(nb.begin() + 6, nb.begin() + 9),
+            (std::vector<std::uint32_t>{0, 1, 3}));
+  EXPECT_EQ(std::vector<float>(d2.begin() + 6, d2.begin() + 9), (std::vector<float>{0, 0, 0}));
+  EXPECT_EQ(std::vector<float>(d2.begin() + 15, d2.begin() + 18), (std::vector<float>{1, 1, 1}));
+}
+
+TEST(MortonOrder, IsAPermutation) {
+  ThreadPool pool(2);
+  for (std::size_t n : {std::size_t{0}, std::size_t{1}, std::size_t{1000}, std::size_t{150'000}}) {
+    const auto order = morton_order(random_points(n, 3), pool);
+    ASSERT_EQ(order.size(), n);
+    std::vector<std::uint32_t> sorted = order;
+    std::sort(sorted.begin(), sorted.end());
+    std::vector<std::uint32_t> identity(n);
+    std::iota(identity.begin(), identity.end(), 0u);
+    EXPECT_EQ(sorted, identity) << n << " points";
+  }
+}
+
+TEST(MortonOrder, FollowsTheZCurveOnA2x2x2Grid) {
+  // Morton code bit order is x (lowest), then y, then z.
+  std::vector<Vec3f> p;
+  for (int i = 7; i >= 0; --i) p.push_back({float(i & 1), float((i >> 1) & 1), float(i >> 2)});
+  ThreadPool pool(1);
+  EXPECT_EQ(morton_order(p, pool), (std::vector<std::uint32_t>{7, 6, 5, 4, 3, 2, 1, 0}));
+}
+
+TEST(MortonOrder, ConsecutivePointsAreClose) {
+  // Random order: consecutive points are about 1 apart in the unit cube [-1, 1]^3. Along the
+  // curve they must be about as close as a grid of that density (2 / n^(1/3) ≈ 0.04 here).
+  const std::size_t n = 200'000;
+  const std::vector<Vec3f> p = random_points(n, 5);
+  ThreadPool one(1), two(2);
+  const auto order = morton_order(p, two);
+  EXPECT_EQ(order, morton_order(p, one));
+  double random_sum = 0, ordered_sum = 0;
+  for (std::size_t i = 1; i < n; ++i) {
+    random_sum += distance(p[i], p[i - 1]);
+    ordered_sum += distance(p[order[i]], p[order[i - 1]]);
+  }
+  EXPECT_GT(random_sum / double(n), 0.9);
+  EXPECT_LT(ordered_sum / double(n), 0.06);
+}
+
+TEST(MortonOrder, EqualPointsKeepIndexOrderAndNanDoesNotBreakIt) {
+  ThreadPool pool(2);
+  std::vector<Vec3f> p(4, Vec3f{1, 1, 1});
+  p.push_back({0, 0, 0});
+  p.push_back({std::nanf(""), 0, 0});
+  const auto order = morton_order(p, pool);
+  // NaN clamps to the low corner of its axis, tying with (0,0,0) at code 0; index breaks the tie.
+  EXPECT_EQ(order, (std::vector<std::uint32_t>{4, 5, 0, 1, 2, 3}));
+}
