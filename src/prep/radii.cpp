@@ -1,5 +1,6 @@
 // Splat radii. Meshes: Rusinkiewicz & Levoy, "QSplat: A multiresolution point rendering system
-// for large meshes", SIGGRAPH 2000, section 3.1 (spheres of adjacent vertices touch). Clouds: the
+// for large meshes", SIGGRAPH 2000, section 3.1, with the rule its preprocessor applies (the
+// smallest circle enclosing each incident triangle, ../shared/specs/qsplat-qs-format.md §8.2). Clouds: the
 // mean distance to the nearest neighbours, widened by a coverage factor (see radii.hpp).
 #include "pointillist/prep/radii.hpp"
 
@@ -16,6 +17,29 @@ namespace {
 
 constexpr std::size_t kGrain = 1 << 15;
 
+// Radius of the smallest circle enclosing triangle (a, b, c): half the longest edge when the
+// triangle is right or obtuse (that edge is then a diameter), otherwise the circumradius
+// |ab|·|bc|·|ca| / (2·|ab × ac|). Discs of this radius centred on the three corners cover the
+// whole triangle (the point of the triangle farthest from every corner is the circumcentre, or
+// the midpoint of the longest edge), so splats sized by it leave no hole in the mesh. Double
+// precision: the circumradius of a thin triangle is a quotient of small numbers.
+float enclosing_circle_radius(Vec3f a, Vec3f b, Vec3f c) {
+  const double ab[3] = {double(b.x) - a.x, double(b.y) - a.y, double(b.z) - a.z};
+  const double ac[3] = {double(c.x) - a.x, double(c.y) - a.y, double(c.z) - a.z};
+  const double bc[3] = {ac[0] - ab[0], ac[1] - ab[1], ac[2] - ab[2]};
+  auto dot3 = [](const double* u, const double* v) { return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]; };
+  const double lab = dot3(ab, ab), lac = dot3(ac, ac), lbc = dot3(bc, bc);
+  const double longest = std::max({lab, lac, lbc});
+  // An angle of 90° or more: at a (ab·ac ≤ 0), b (ba·bc ≤ 0) or c (ca·cb ≤ 0).
+  const bool obtuse = dot3(ab, ac) <= 0 || -dot3(ab, bc) <= 0 || dot3(ac, bc) <= 0;
+  if (obtuse) return static_cast<float>(0.5 * std::sqrt(longest));
+  const double cx = ab[1] * ac[2] - ab[2] * ac[1], cy = ab[2] * ac[0] - ab[0] * ac[2],
+               cz = ab[0] * ac[1] - ab[1] * ac[0];
+  const double twice_area = std::sqrt(cx * cx + cy * cy + cz * cz);
+  if (!(twice_area > 0)) return static_cast<float>(0.5 * std::sqrt(longest));
+  return static_cast<float>(std::sqrt(lab * lac * lbc) / (2.0 * twice_area));
+}
+
 }  // namespace
 
 std::vector<float> mesh_radii(std::span<const Vec3f> positions,
@@ -23,7 +47,6 @@ std::vector<float> mesh_radii(std::span<const Vec3f> positions,
                               ThreadPool& pool) {
   const std::size_t n = positions.size();
   std::vector<float> radii(n, 0.0f);
-  const float half = 0.5f * scale;
   prep_detail::for_each_vertex_range(pool, n, [&](std::uint32_t lo, std::uint32_t hi) {
     const std::uint32_t size = hi - lo;
     for (const auto& t : triangles) {
@@ -31,14 +54,12 @@ std::vector<float> mesh_radii(std::span<const Vec3f> positions,
       // v - lo < size (unsigned) tests lo <= v < hi.
       const std::uint32_t i0 = t[0] - lo, i1 = t[1] - lo, i2 = t[2] - lo;
       if (std::min({i0, i1, i2}) >= size) continue;
-      const float e01 = distance(positions[t[0]], positions[t[1]]);
-      const float e12 = distance(positions[t[1]], positions[t[2]]);
-      const float e20 = distance(positions[t[2]], positions[t[0]]);
-      if (i0 < size) radii[t[0]] = std::max(radii[t[0]], std::max(e01, e20));
-      if (i1 < size) radii[t[1]] = std::max(radii[t[1]], std::max(e01, e12));
-      if (i2 < size) radii[t[2]] = std::max(radii[t[2]], std::max(e12, e20));
+      const float r = enclosing_circle_radius(positions[t[0]], positions[t[1]], positions[t[2]]);
+      if (i0 < size) radii[t[0]] = std::max(radii[t[0]], r);
+      if (i1 < size) radii[t[1]] = std::max(radii[t[1]], r);
+      if (i2 < size) radii[t[2]] = std::max(radii[t[2]], r);
     }
-    for (std::uint32_t v = lo; v < hi; ++v) radii[v] *= half;
+    for (std::uint32_t v = lo; v < hi; ++v) radii[v] *= scale;
   });
   return radii;
 }

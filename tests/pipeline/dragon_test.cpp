@@ -33,14 +33,30 @@ TEST(Dragon, SplatSilhouetteMatchesTheTriangleMesh) {
     for (SplatShape shape : {SplatShape::Ellipse, SplatShape::Circle}) {
       Frame splat_frame;
       render(tree.view(), cam, RenderSettings{.shape = shape}, pool, splat_frame);
-      std::size_t both = 0, either = 0, mesh_pixels = 0;
-      for (std::size_t i = 0; i < splat_frame.depth.size(); ++i) {
-        const bool s = std::isfinite(splat_frame.depth[i]);
-        const bool m = std::isfinite(mesh_frame.depth[i]);
-        both += s && m;
-        either += s || m;
-        mesh_pixels += m;
+      std::size_t both = 0, either = 0, mesh_pixels = 0, holes = 0;
+      const int w = cam.width, h = cam.height;
+      auto mesh_at = [&](int x, int y) { return std::isfinite(mesh_frame.depth[std::size_t(y) * w + x]); };
+      for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+          const bool s = std::isfinite(splat_frame.depth[std::size_t(y) * w + x]);
+          const bool m = mesh_at(x, y);
+          both += s && m;
+          either += s || m;
+          mesh_pixels += m;
+          // A hole: a pixel the mesh covers, with all 8 neighbours covered too, left empty.
+          if (m && !s && x > 0 && y > 0 && x + 1 < w && y + 1 < h) {
+            bool interior = true;
+            for (int dy = -1; dy <= 1; ++dy)
+              for (int dx = -1; dx <= 1; ++dx) interior &= mesh_at(x + dx, y + dy);
+            holes += interior;
+          }
+        }
       }
+      // Circles: none. Ellipses: at most 2 isolated pixels (measured 1 in 172,800 at azimuths 0
+      // and 90): an interior node drawn as one ellipse of its mean normal does not always cover
+      // what its children's ellipses would where the surface curves away from the eye.
+      if (shape == SplatShape::Circle) EXPECT_EQ(holes, 0u) << "circle, azimuth " << az;
+      else EXPECT_LE(holes, 2u) << "ellipse, azimuth " << az;
       ASSERT_GT(mesh_pixels, 10000u);
       if (shape == SplatShape::Ellipse) {
         EXPECT_GE(double(both) / double(either), 0.97) << "ellipse, azimuth " << az;

@@ -113,29 +113,44 @@ TEST(MeshVertexNormals, SameBitsForAnyThreadCount) {
   for (std::size_t i = 0; i < a.size(); ++i) ASSERT_TRUE(a[i] == b[i]) << "vertex " << i;
 }
 
-TEST(MeshRadii, HalfTheLongestIncidentEdgeTimesScale) {
-  // A 3 × 4 rectangle split along its diagonal (length 5), and an unused vertex.
-  const std::vector<Vec3f> p = {{0, 0, 0}, {3, 0, 0}, {0, 4, 0}, {3, 4, 0}, {7, 7, 7}};
-  const std::vector<Triangle> t = {{0, 1, 2}, {1, 3, 2}};
+TEST(MeshRadii, SmallestEnclosingCircleOfIncidentTrianglesTimesScale) {
+  // A 3 × 4 rectangle split along its diagonal (two right triangles: radius = half the diagonal,
+  // 2.5), an equilateral triangle of side 2 sharing vertex 3 (circumradius 2/√3), an obtuse
+  // triangle (half its longest edge, 5) and an unused vertex.
+  const float s3 = std::sqrt(3.0f);
+  const std::vector<Vec3f> p = {{0, 0, 0},  {3, 0, 0},           {0, 4, 0},   {3, 4, 0},
+                                {5, 4, 0},  {4, 4 + s3, 0},      {7, 7, 7},   {20, 0, 0},
+                                {30, 0, 0}, {25, 1, 0}};
+  const std::vector<Triangle> t = {{0, 1, 2}, {1, 3, 2}, {3, 4, 5}, {7, 8, 9}};
   ThreadPool pool(2);
-  // Vertex 0: edges 3, 4; vertex 1: 3, 4, 5; vertex 2: 4, 5, 3; vertex 3: 4, 3.
-  EXPECT_EQ(mesh_radii(p, t, 1.0f, pool), (std::vector<float>{2.0f, 2.5f, 2.5f, 2.0f, 0.0f}));
-  EXPECT_EQ(mesh_radii(p, t, 2.0f, pool), (std::vector<float>{4.0f, 5.0f, 5.0f, 4.0f, 0.0f}));
+  const std::vector<float> r1 = mesh_radii(p, t, 1.0f, pool);
+  const std::vector<float> expected = {2.5f, 2.5f, 2.5f, 2.5f, 2 / s3, 2 / s3, 0.0f, 5.0f, 5.0f, 5.0f};
+  ASSERT_EQ(r1.size(), expected.size());
+  for (std::size_t i = 0; i < expected.size(); ++i) EXPECT_NEAR(r1[i], expected[i], 1e-5f) << i;
+  const std::vector<float> r2 = mesh_radii(p, t, 2.0f, pool);
+  for (std::size_t i = 0; i < expected.size(); ++i) EXPECT_NEAR(r2[i], 2 * expected[i], 2e-5f) << i;
 }
 
-TEST(MeshRadii, IcosphereRadiiMatchEdgeLengths) {
-  const Mesh m = icosphere(5);  // 10242 vertices: split between threads
-  ThreadPool pool(3);
+TEST(MeshRadii, DiscsAtTheCornersCoverEveryTriangle) {
+  // The property the rule exists for: every point of every triangle lies within the radius of at
+  // least one of its corners. Checked on a perturbed icosphere by sampling each triangle densely.
+  Mesh m = icosphere(3);
+  for (std::size_t i = 0; i < m.positions.size(); ++i) {
+    m.positions[i] *= 1.0f + 0.05f * std::sin(float(i) * 12.9898f);
+  }
+  ThreadPool pool(2);
   const std::vector<float> r = mesh_radii(m.positions, m.triangles, 1.0f, pool);
-  // Oracle: the longest edge at each vertex, from an explicit edge list.
-  std::vector<float> longest(m.positions.size(), 0.0f);
   for (const Triangle& f : m.triangles) {
-    for (int e = 0; e < 3; ++e) {
-      const std::uint32_t a = f[e], b = f[(e + 1) % 3];
-      const float len = distance(m.positions[a], m.positions[b]);
-      longest[a] = std::max(longest[a], len);
-      longest[b] = std::max(longest[b], len);
+    const Vec3f a = m.positions[f[0]], b = m.positions[f[1]], c = m.positions[f[2]];
+    for (int i = 0; i <= 20; ++i) {
+      for (int j = 0; i + j <= 20; ++j) {
+        const float u = float(i) / 20, v = float(j) / 20;
+        const Vec3f q = a + (b - a) * u + (c - a) * v;
+        const bool covered = distance(q, a) <= r[f[0]] * 1.0001f ||
+                             distance(q, b) <= r[f[1]] * 1.0001f ||
+                             distance(q, c) <= r[f[2]] * 1.0001f;
+        ASSERT_TRUE(covered) << "triangle " << f[0] << "," << f[1] << "," << f[2];
+      }
     }
   }
-  for (std::size_t i = 0; i < r.size(); ++i) EXPECT_FLOAT_EQ(r[i], 0.5f * longest[i]);
 }

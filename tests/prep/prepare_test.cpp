@@ -50,10 +50,11 @@ TEST(PrepareSplats, DropsUnreferencedMeshVerticesAndRemapsFaces) {
   EXPECT_EQ(p.colors[1], (Rgb8{2, 2, 2}));
   EXPECT_EQ(p.colors[3], (Rgb8{5, 5, 5}));
   EXPECT_EQ(p.triangles, (std::vector<std::array<std::uint32_t, 3>>{{0, 1, 2}, {1, 3, 2}}));
-  // Auto on a mesh without normals: face normals (+z) and QSplat radii (half the longest edge).
+  // Auto on a mesh without normals: face normals (+z) and QSplat radii (the smallest circle around
+  // each incident triangle: both are right triangles with hypotenuse 5).
   ASSERT_EQ(p.normals.size(), 4u);
   for (const Vec3f& n : p.normals) EXPECT_TRUE((n == Vec3f{0, 0, 1}));
-  EXPECT_EQ(p.radii, (std::vector<float>{2.0f, 2.5f, 2.5f, 2.0f}));
+  EXPECT_EQ(p.radii, (std::vector<float>{2.5f, 2.5f, 2.5f, 2.5f}));
   EXPECT_EQ(p.comments, (std::vector<std::string>{"made by hand"}));
 }
 
@@ -116,11 +117,10 @@ TEST(PrepareSplats, PcaOnAMeshKeepsMeshRadii) {
   ThreadPool pool(1);
   prepare_splats(p, pool, Progress::none(), {.normals = NormalSource::Pca});
   for (const Vec3f& n : p.normals) EXPECT_NEAR(std::abs(n.z), 1.0f, 1e-6f);
-  // Diagonals run from (x + 1, y) to (x, y + 1): every vertex touches one (√2 long) except the
-  // corners (0, 0) and (9, 9), whose edges are all 1 long.
+  // Every triangle is a right isosceles one with a √2 hypotenuse: its smallest enclosing circle
+  // has radius √2/2, and every vertex is in at least one triangle.
   for (std::size_t i = 0; i < 100; ++i) {
-    const float expected = (i == 0 || i == 99) ? 0.5f : 0.5f * std::sqrt(2.0f);
-    EXPECT_FLOAT_EQ(p.radii[i], expected) << "vertex " << i;
+    EXPECT_FLOAT_EQ(p.radii[i], 0.5f * std::sqrt(2.0f)) << "vertex " << i;
   }
 }
 

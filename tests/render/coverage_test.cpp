@@ -22,6 +22,7 @@ struct Overlap {
   double iou = 0;
   int holes = 0;  // uncovered pixels whose reference pixel and 8 neighbours are all covered
   int reference_pixels = 0;
+  int missed = 0;  // reference pixels left uncovered (holes and silhouette edge)
 };
 
 template <class ReferenceCovered>
@@ -36,6 +37,7 @@ Overlap compare(const Frame& frame, ReferenceCovered ref) {
       both += r && s;
       either += r || s;
       o.reference_pixels += r;
+      o.missed += r && !s;
       if (r && !s && x > 0 && y > 0 && x + 1 < w && y + 1 < h) {
         bool interior = true;
         for (int dy = -1; dy <= 1; ++dy)
@@ -111,8 +113,16 @@ TEST(Coverage, DragonSplatSilhouetteMatchesItsTriangles) {
       Frame splats;
       render(tree.view(), cam, s, pool, splats);
       const Overlap o = compare(splats, [&](int x, int y) { return covered(triangles, x, y); });
-      EXPECT_GE(o.iou, 0.97) << "azimuth " << az << " shape " << int(shape);
       EXPECT_GT(o.reference_pixels, 100000);
+      // Ellipses follow the silhouette; circles (QSplat's radii: the smallest circle around each
+      // incident triangle) stick out by a splat radius there (IoU 0.970 at azimuth 0), so for
+      // them the test asserts coverage: every mesh pixel but a thousandth of the edge.
+      if (shape == SplatShape::Ellipse) {
+        EXPECT_GE(o.iou, 0.97) << "azimuth " << az << " ellipse";
+      } else {
+        EXPECT_GE(o.iou, 0.95) << "azimuth " << az << " circle";
+        EXPECT_LE(o.missed, o.reference_pixels / 1000) << "azimuth " << az << " circle";
+      }
     }
   }
 }

@@ -12,8 +12,12 @@
 
 namespace pointillist {
 
-// QSplat's rule for meshes: the spheres of two vertices joined by an edge touch, i.e. each
-// radius is half the longest edge incident to the vertex, times `scale` (world units). Vertices
+// QSplat's rule for meshes, as its preprocessor applies it: each radius is the largest, over the
+// triangles incident to the vertex, of the radius of the triangle's smallest enclosing circle
+// (half the longest edge for a right or obtuse triangle, the circumradius otherwise), times
+// `scale` (world units). Spheres of two vertices joined by an edge therefore at least touch, and
+// unlike "half the longest incident edge" (which leaves a gap at the centre of every acute
+// triangle: 0.577 vs 0.5 edge lengths for an equilateral one) the splats cover every triangle. Vertices
 // in no triangle get 0. Preconditions: every index < positions.size(). Parallel; the result does
 // not depend on the thread count.
 std::vector<float> mesh_radii(std::span<const Vec3f> positions,
