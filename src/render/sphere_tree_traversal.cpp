@@ -40,7 +40,7 @@ constexpr std::uint8_t kTestFrustum = 1;
 constexpr std::uint8_t kTestBackface = 2;
 constexpr std::uint8_t kDecidedDraw = 4;  // top-level item already visited: just draw it
 constexpr std::size_t kTargetTasks = 128;
-constexpr std::size_t kInitialChunkCapacity = 1024;
+constexpr std::size_t kInitialChunkCapacity = 128;
 constexpr float kMaxCoordinate = 1e9f;  // pixels; larger (or NaN) splat coordinates are dropped
 
 struct Pending {
