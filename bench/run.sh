@@ -11,13 +11,70 @@ models="${POINTILLIST_MODELS:-${XDG_CACHE_HOME:-$HOME/.cache}/pointillist/models
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
+csv="$work/results.csv"
+: > "$csv"
 for b in io prep lod render; do
   if [ -x "$bin/bench/${b}_bench" ]; then
     echo "== ${b}_bench"
-    "$bin/bench/${b}_bench" --benchmark_filter='^((?!Small).)*$' --benchmark_min_time=0.5 2>&1 |
-      grep -v '^\*\*\*'
+    # Human-readable output on the terminal, CSV (one header line per program) for the summary.
+    "$bin/bench/${b}_bench" --benchmark_filter='^((?!Small).)*$' --benchmark_min_time=0.5 \
+      --benchmark_out="$work/${b}.csv" --benchmark_out_format=csv 2>&1 | grep -v '^\*\*\*'
+    cat "$work/${b}.csv" >> "$csv"
   fi
 done
+
+# summary: one line per figure, each against the baseline measured in the same run.
+#   kind "rate": items (or bytes) per second, ratio = value / baseline (higher is better)
+#   kind "time": ms, ratio = value / baseline (how many baseline runs one run costs)
+summary() {
+  awk -F, '
+    /^name,/ { delete col; for (i = 1; i <= NF; ++i) col[$i] = i; next }
+    /^"/ {
+      name = $1; gsub(/"/, "", name)
+      t[name] = $col["real_time"]; items[name] = $col["items_per_second"]
+      bytes[name] = $col["bytes_per_second"]
+      if ("splats" in col) splats[name] = $col["splats"]
+      if ("ms_select" in col) { sel[name] = $col["ms_select"]; ras[name] = $col["ms_raster"] }
+    }
+    function row(what, value, unit, base, base_unit, ratio) {
+      printf "%-46s %12s %-10s %12s %-10s %8s\n", what, value, unit, base, base_unit, ratio
+    }
+    function rate(what, n, b, scale, unit, field,   v, w) {
+      v = (field == "bytes") ? bytes[n] : items[n]; w = (field == "bytes") ? bytes[b] : items[b]
+      if (v == "" || w == "") return
+      row(what, sprintf("%.1f", v / scale), unit, sprintf("%.1f", w / scale), unit,
+          sprintf("%.2f", v / w))
+    }
+    function time(what, n, b,   v, w) {
+      if (t[n] == "" || t[b] == "") return
+      row(what, sprintf("%.1f", t[n]), "ms", sprintf("%.1f", t[b]), "ms", sprintf("%.2f", t[n] / t[b]))
+    }
+    END {
+      printf "\n== summary (ratio = value / baseline measured in the same run)\n"
+      row("figure", "value", "", "baseline", "", "ratio")
+      rate("PLY load, binary, 10M points (MB/s)", "BM_PlyLoadBinary/10000000",
+           "BM_BaselineBulkReadBinary/10000000", 1e6, "MB/s", "bytes")
+      time("PLY load, dragon .ply.gz (vs gunzip alone)", "BM_PlyLoadDragonGz", "BM_BaselineGunzipDragon")
+      rate("kNN k=16, 1M points (points/s)", "BM_Knn16/1000000", "BM_BaselineBoundingBox/1000000", 1e6, "M/s", "items")
+      rate("PCA normals, 1M points (points/s)", "BM_PcaNormals/1000000", "BM_BaselineBoundingBox/1000000", 1e6, "M/s", "items")
+      rate("cloud radii, 1M points (points/s)", "BM_CloudRadii/1000000", "BM_BaselineBoundingBox/1000000", 1e6, "M/s", "items")
+      time("prepare dragon mesh (normals+radii)", "BM_PrepareDragonMesh", "BM_BaselineGunzipDragon")
+      rate("hierarchy build, 437k points (points/s)", "BM_BuildSphereTree/437645", "BM_BaselineSortFloats/437645", 1e6, "M/s", "items")
+      rate("hierarchy build, 10M points (points/s)", "BM_BuildSphereTree/10000000", "BM_BaselineSortFloats/10000000", 1e6, "M/s", "items")
+      time("hierarchy build, dragon (vs sorting 437k floats)", "BM_BuildSphereTreeDragon", "BM_BaselineSortFloats/437645")
+      b = "BM_BaselineProjectDragonPoints"
+      for (th = 1; th <= 4; th *= 2) {
+        n = "BM_RenderDragon/" th "/real_time"
+        if (t[n] == "" || t[b] == "") continue
+        row("render dragon 1280x720, threshold " th " px (ms)", sprintf("%.2f", t[n]), "ms",
+            sprintf("%.2f", t[b]), "ms", sprintf("%.2f", t[n] / t[b]))
+        row("  splats/s (baseline: leaf points projected/s)", sprintf("%.1f", items[n] / 1e6), "M/s",
+            sprintf("%.1f", items[b] / 1e6), "M/s", sprintf("%.2f", items[n] / items[b]))
+        row("  splats drawn; ms select + raster", sprintf("%d", splats[n]), "splats",
+            sprintf("%.2f+%.2f", sel[n], ras[n]), "ms", "")
+      }
+    }' "$csv"
+}
 
 seconds() {  # seconds CMD...: wall time of one run
   local t0 t1
@@ -27,13 +84,15 @@ seconds() {  # seconds CMD...: wall time of one run
 
 echo
 echo "== end-to-end convert (wall time; baseline = reading the same input bytes once)"
-printf '%-34s %10s %12s %12s %10s\n' input points "convert s" "baseline s" ratio
+printf '%-34s %10s %12s %12s %12s %10s\n' input points "convert s" "M points/s" "baseline s" ratio
 row() {  # row NAME POINTS INPUT BASELINE_CMD...
   local name=$1 points=$2 input=$3; shift 3
   local c b
   c=$(seconds "$cli" convert -q "$input" -o "$work/out.ptl")
   b=$(seconds "$@")
-  printf '%-34s %10s %12.3f %12.3f %10.1f\n' "$name" "$points" "$c" "$b" "$(awk -v a="$c" -v b="$b" 'BEGIN { printf "%.3f", a / b }')"
+  printf '%-34s %10s %12.3f %12.2f %12.3f %10.1f\n' "$name" "$points" "$c" \
+    "$(awk -v a="$c" -v n="$points" 'BEGIN { printf "%.3f", n / a / 1e6 }')" "$b" \
+    "$(awk -v a="$c" -v b="$b" 'BEGIN { printf "%.3f", a / b }')"
 }
 if [ -f "$models/dragon_vrip.ply.gz" ]; then
   row "dragon_vrip.ply.gz (mesh)" 437645 "$models/dragon_vrip.ply.gz" \
@@ -44,3 +103,5 @@ if [ -z "${BENCH_QUICK:-}" ]; then
   row "generated cloud (no normals)" 10000000 "$work/cloud10m.ply" \
     sh -c "cat '$work/cloud10m.ply' > /dev/null"
 fi
+
+summary
