@@ -67,4 +67,12 @@ struct GenerateOptions {
 };
 int run_generate(const GenerateOptions& options);
 
+struct CompareOptions {
+  std::string reference;
+  std::string test;
+  std::optional<Rgb8> background;  // unset = the reference's top-left pixel
+  std::string json_output;         // empty = none, "-" = stdout (instead of the text)
+};
+int run_compare(const CompareOptions& options);
+
 }  // namespace pointillist::cli

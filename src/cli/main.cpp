@@ -1,6 +1,7 @@
 // The `pointillist` command: convert scans to splat models, render them, inspect files, demo.
 #include <CLI/CLI.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <new>
 #include <sstream>
@@ -42,6 +43,18 @@ std::vector<float> parse_floats(const std::string& text, std::size_t count, cons
 Vec3f parse_vec3(const std::string& text, const std::string& option) {
   const auto v = parse_floats(text, 3, ',', option);
   return {v[0], v[1], v[2]};
+}
+
+// "R,G,B" with each component a whole number 0-255.
+pointillist::Rgb8 parse_rgb8(const std::string& text, const std::string& option) {
+  const Vec3f c = parse_vec3(text, option);
+  for (float v : {c.x, c.y, c.z}) {
+    if (v < 0 || v > 255 || v != std::floor(v)) {
+      throw OptionError(option + " '" + text + "': components must be whole numbers 0-255");
+    }
+  }
+  return {static_cast<std::uint8_t>(c.x), static_cast<std::uint8_t>(c.y),
+          static_cast<std::uint8_t>(c.z)};
 }
 
 void add_threads(CLI::App* app, unsigned& threads) {
@@ -154,6 +167,24 @@ int main(int argc, char** argv) {
   generate_cmd->add_flag("--with-normals", generate.with_normals, "Also write exact normals");
   generate_cmd->add_flag("-q,--quiet", generate.quiet, "No summary line");
 
+  // compare
+  pc::CompareOptions compare;
+  std::string compare_background;
+  auto* compare_cmd = app.add_subcommand(
+      "compare", "Compare a render with a reference image of the same size: PSNR, SSIM, hole "
+                 "pixels, silhouette IoU");
+  compare_cmd->add_option("reference", compare.reference, "Reference PNG")
+      ->required()
+      ->check(CLI::ExistingFile);
+  compare_cmd->add_option("test", compare.test, "PNG to measure against the reference")
+      ->required()
+      ->check(CLI::ExistingFile);
+  compare_cmd->add_option("--background", compare_background,
+                          "Background color R,G,B (0-255) for the silhouette masks (default: the "
+                          "reference's top-left pixel)");
+  compare_cmd->add_option("--json", compare.json_output,
+                          "Also write the metrics as JSON to FILE (- = stdout, instead of text)");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -178,17 +209,18 @@ int main(int argc, char** argv) {
       if (!eye.empty()) render.view.eye = parse_vec3(eye, "--eye");
       if (!target.empty()) render.view.target = parse_vec3(target, "--target");
       if (!up.empty()) render.view.up = parse_vec3(up, "--up");
-      const Vec3f bg = parse_vec3(background, "--background");
-      for (float c : {bg.x, bg.y, bg.z}) {
-        if (c < 0 || c > 255) throw OptionError("--background '" + background + "': components must be 0-255");
-      }
-      render.settings.background = {static_cast<std::uint8_t>(bg.x), static_cast<std::uint8_t>(bg.y),
-                                    static_cast<std::uint8_t>(bg.z)};
+      render.settings.background = parse_rgb8(background, "--background");
       return pc::run_render(render);
     }
     if (*info_cmd) return pc::run_info(info);
     if (*demo_cmd) return pc::run_demo(demo);
     if (*generate_cmd) return pc::run_generate(generate);
+    if (*compare_cmd) {
+      if (!compare_background.empty()) {
+        compare.background = parse_rgb8(compare_background, "--background");
+      }
+      return pc::run_compare(compare);
+    }
   } catch (const pointillist::Error& e) {
     std::fprintf(stderr, "pointillist: error: %s\n", e.what());
     return 1;

@@ -1,0 +1,597 @@
+// Sequential Point Trees (Dachsbacher, Vogelgsang & Stamminger, "Sequential Point Trees",
+// SIGGRAPH 2003, sections 3 and 4): octree point hierarchy, perpendicular and tangential
+// errors, and the list sorted by r_max; split into spatial chunks (our addition).
+//
+// The build runs in four passes:
+//   1. the order: points sorted by (Morton code in the bounding cube, input index), so every
+//      octree cell is a contiguous range and a node's children are found by binary search;
+//   2. the plan: ranges larger than the grain are split sequentially into "top" nodes, the rest
+//      become tasks;
+//   3. the subtrees: each task builds its range bottom-up (post-order) with its errors; then
+//      the top nodes are combined from their children;
+//   4. the list: nodes are sorted by (range, parent error descending, pre-order) and gathered
+//      into the structure of arrays.
+// Node attributes depend only on the children and the final order only on the tree, so the
+// result is the same bits for any thread count or grain.
+#include "pointillist/lod/sequential_point_tree.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cassert>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <string>
+
+#include "pointillist/core/error.hpp"
+
+namespace pointillist {
+namespace {
+
+constexpr std::size_t kMaxPoints = std::size_t{1} << 31;
+constexpr std::uint32_t kMaxChunkLevel = 10;
+constexpr int kLevels = 21;                 // octree depth of the finest Morton cells
+constexpr std::uint8_t kLeafLevel = kLevels;
+constexpr std::size_t kPointGrain = 65536;  // points per task in the per-point passes
+constexpr std::size_t kSortBlock = 1 << 14;
+constexpr std::uint32_t kTaskRef = 0x80000000u;  // child reference: task id, not top node
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+struct MortonKey {
+  std::uint64_t code = 0;
+  std::uint32_t index = 0;
+};
+constexpr bool operator<(const MortonKey& a, const MortonKey& b) {
+  return a.code != b.code ? a.code < b.code : a.index < b.index;
+}
+
+// A node during the build. [begin, begin + count) is its range of the Morton order; ordering by
+// (begin ascending, count descending) is the pre-order, since no two nodes share a range.
+struct BuildNode {
+  Vec3f center;
+  Vec3f normal;
+  float diameter = 0;
+  float error = 0;
+  float color[3] = {0, 0, 0};  // mean colour, channels in [0, 1]
+  std::uint32_t parent = kSptNoParent;
+  std::uint32_t begin = 0;
+  std::uint32_t count = 0;
+  std::uint8_t level = kLeafLevel;  // depth of the smallest octree cell holding the points
+  bool leaf = true;
+};
+
+// ---- Input checks --------------------------------------------------------------------------
+
+std::string vec_text(Vec3f v) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "(%g, %g, %g)", v.x, v.y, v.z);
+  return buf;
+}
+
+void check_input(const PointSet& points, const SequentialPointTreeOptions& options) {
+  const std::string what = "cannot build a sequential point tree";
+  const std::size_t n = points.size();
+  if (n == 0) throw Error(what + " from an empty point set; the input has no points");
+  if (n > kMaxPoints) {
+    throw Error(what + " over " + std::to_string(n) +
+                " points: the limit is 2^31 (2147483648); split the input into chunks");
+  }
+  if (!points.has_normals()) throw Error(what + ": the points have no normals; estimate them first");
+  if (!points.has_radii()) {
+    throw Error(what + ": the points have no splat radii; compute them first");
+  }
+  const auto check_size = [&](std::size_t size, const char* attribute) {
+    if (size != n) {
+      throw Error(what + ": " + std::to_string(size) + " " + attribute + " for " +
+                  std::to_string(n) + " points; expected one per point");
+    }
+  };
+  check_size(points.normals.size(), "normals");
+  check_size(points.radii.size(), "radii");
+  if (points.has_colors()) check_size(points.colors.size(), "colors");
+  if (options.chunk_level > kMaxChunkLevel) {
+    throw OptionError(what + ": chunk_level " + std::to_string(options.chunk_level) +
+                      " is out of range; use 0 to " + std::to_string(kMaxChunkLevel));
+  }
+  if (!(options.color_tolerance >= 0)) {
+    throw OptionError(what + ": color_tolerance " + std::to_string(options.color_tolerance) +
+                      " must be a non-negative number (or +infinity to ignore colours)");
+  }
+}
+
+// Checks every point is finite and bounds the positions. Inner loops never throw: each chunk
+// notes its first bad point and the lowest one is reported.
+Aabb check_points_and_bound(const PointSet& points, ThreadPool& pool) {
+  const std::size_t n = points.size();
+  const std::size_t chunks = (n + kPointGrain - 1) / kPointGrain;
+  std::vector<Aabb> boxes(chunks);
+  std::vector<std::size_t> first_bad(chunks, n);
+  parallel_for(pool, n, kPointGrain, [&](std::size_t begin, std::size_t end) {
+    const std::size_t c = begin / kPointGrain;
+    Aabb box;
+    for (std::size_t i = begin; i < end; ++i) {
+      const bool ok = is_finite(points.positions[i]) && is_finite(points.normals[i]) &&
+                      std::isfinite(points.radii[i]) && points.radii[i] >= 0;
+      if (!ok && first_bad[c] == n) first_bad[c] = i;
+      box.extend(points.positions[i]);
+    }
+    boxes[c] = box;
+  });
+  Aabb bounds;
+  for (std::size_t c = 0; c < chunks; ++c) {
+    if (const std::size_t i = first_bad[c]; i != n) {
+      const std::string where =
+          "cannot build a sequential point tree: point " + std::to_string(i) + ": ";
+      if (!is_finite(points.positions[i])) {
+        throw Error(where + "position " + vec_text(points.positions[i]) +
+                    " is not finite; remove or repair the point");
+      }
+      if (!is_finite(points.normals[i])) {
+        throw Error(where + "normal " + vec_text(points.normals[i]) +
+                    " is not finite; re-estimate the normals");
+      }
+      throw Error(where + "splat radius " + std::to_string(points.radii[i]) +
+                  " is not a finite non-negative number; recompute the radii");
+    }
+    bounds.extend(boxes[c]);
+  }
+  return bounds;
+}
+
+float max_distance(const std::vector<Vec3f>& positions, Vec3f center, ThreadPool& pool) {
+  const std::size_t chunks = (positions.size() + kPointGrain - 1) / kPointGrain;
+  std::vector<float> d2(chunks, 0.0f);
+  parallel_for(pool, positions.size(), kPointGrain, [&](std::size_t begin, std::size_t end) {
+    float m = 0;
+    for (std::size_t i = begin; i < end; ++i) m = std::max(m, length_squared(positions[i] - center));
+    d2[begin / kPointGrain] = m;
+  });
+  return std::sqrt(*std::max_element(d2.begin(), d2.end()));
+}
+
+// ---- Pass 1: Morton order ------------------------------------------------------------------
+
+// Spreads the low 21 bits of v to every third bit.
+std::uint64_t spread_bits(std::uint32_t v) {
+  std::uint64_t x = v & 0x1fffffu;
+  x = (x | x << 32) & 0x1f00000000ffffull;
+  x = (x | x << 16) & 0x1f0000ff0000ffull;
+  x = (x | x << 8) & 0x100f00f00f00f00full;
+  x = (x | x << 4) & 0x10c30c30c30c30c3ull;
+  x = (x | x << 2) & 0x1249249249249249ull;
+  return x;
+}
+
+// Sorts blocks in parallel, then merges pairs of runs level by level. `less` must be a strict
+// total order on the elements (unique keys), so the result does not depend on the blocking.
+template <typename T, typename Less>
+void parallel_sort(std::vector<T>& v, ThreadPool& pool, Less less) {
+  const std::size_t n = v.size(), blocks = (n + kSortBlock - 1) / kSortBlock;
+  if (blocks <= 1) {
+    std::sort(v.begin(), v.end(), less);
+    return;
+  }
+  const auto edge = [&](std::size_t block) { return std::min(n, block * kSortBlock); };
+  pool.run(blocks, [&](std::size_t b) { std::sort(v.data() + edge(b), v.data() + edge(b + 1), less); });
+  std::vector<T> other(n);
+  T* src = v.data();
+  T* dst = other.data();
+  for (std::size_t width = 1; width < blocks; width *= 2) {
+    pool.run((blocks + 2 * width - 1) / (2 * width), [&](std::size_t pair) {
+      const std::size_t lo = edge(2 * pair * width), mid = edge((2 * pair + 1) * width),
+                        hi = edge((2 * pair + 2) * width);
+      std::merge(src + lo, src + mid, src + mid, src + hi, dst + lo, less);
+    });
+    std::swap(src, dst);
+  }
+  if (src != v.data()) v.swap(other);
+}
+
+std::vector<MortonKey> morton_order(const std::vector<Vec3f>& positions, const Aabb& bounds,
+                                    ThreadPool& pool) {
+  const Vec3f e = bounds.extent();
+  const double side = std::max({double(e.x), double(e.y), double(e.z)});
+  const double scale = side > 0 ? double(1u << kLevels) / side : 0.0;
+  const auto cell = [&](float p, float lo) {
+    const double q = std::floor((double(p) - lo) * scale);
+    return static_cast<std::uint32_t>(std::clamp(q, 0.0, double((1u << kLevels) - 1)));
+  };
+  std::vector<MortonKey> keys(positions.size());
+  parallel_for(pool, positions.size(), kPointGrain, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const Vec3f p = positions[i];
+      keys[i] = {spread_bits(cell(p.x, bounds.lo.x)) << 2 | spread_bits(cell(p.y, bounds.lo.y)) << 1 |
+                     spread_bits(cell(p.z, bounds.lo.z)),
+                 static_cast<std::uint32_t>(i)};
+    }
+  });
+  parallel_sort(keys, pool, std::less<MortonKey>{});
+  return keys;
+}
+
+// ---- Pass 2: splitting a range into children -----------------------------------------------
+
+struct Split {
+  std::uint8_t level = 0;        // depth of the cell holding the whole range
+  std::uint32_t child_count = 0;
+  std::uint32_t edge[9] = {};    // child k covers [edge[k], edge[k + 1])
+};
+
+// Children of the range [begin, end) (at least 2 points): the non-empty octants of the smallest
+// cell holding it, or, when all codes are equal, at most 8 equal groups in order.
+Split split_range(std::span<const MortonKey> keys, std::uint32_t begin, std::uint32_t end) {
+  Split s;
+  s.edge[0] = begin;
+  const std::uint64_t diff = keys[begin].code ^ keys[end - 1].code;
+  if (diff == 0) {
+    const std::uint32_t n = end - begin, parts = std::min<std::uint32_t>(8, n);
+    s.level = kLeafLevel;
+    s.child_count = parts;
+    for (std::uint32_t k = 1; k <= parts; ++k) {
+      s.edge[k] = begin + static_cast<std::uint32_t>(std::uint64_t{n} * k / parts);
+    }
+    return s;
+  }
+  const int level = (std::countl_zero(diff) - 1) / 3;  // codes use the low 63 bits
+  const int shift = 3 * (kLevels - 1 - level);
+  s.level = static_cast<std::uint8_t>(level);
+  std::uint32_t at = begin;
+  for (std::uint32_t digit = 0; digit < 8 && at < end; ++digit) {
+    const auto* first = keys.data() + at;
+    const auto* stop = std::partition_point(first, keys.data() + end, [&](const MortonKey& k) {
+      return ((k.code >> shift) & 7u) <= digit;
+    });
+    const auto next = static_cast<std::uint32_t>(stop - keys.data());
+    if (next > at) s.edge[++s.child_count] = next;
+    at = next;
+  }
+  return s;
+}
+
+// ---- Pass 3: nodes -------------------------------------------------------------------------
+
+struct NodeMaker {
+  std::span<const MortonKey> keys;
+  const PointSet& points;
+  bool has_colors;
+  float color_tolerance;
+
+  std::uint32_t add_leaf(std::uint32_t k, std::vector<BuildNode>& nodes) const {
+    const std::uint32_t p = keys[k].index;
+    BuildNode node;
+    node.center = points.positions[p];
+    node.normal = normalized(points.normals[p]);
+    node.diameter = 2 * points.radii[p];
+    node.begin = k;
+    node.count = 1;
+    if (has_colors) {
+      const Rgb8 c = points.colors[p];
+      node.color[0] = c.r / 255.0f;
+      node.color[1] = c.g / 255.0f;
+      node.color[2] = c.b / 255.0f;
+    }
+    nodes.push_back(node);
+    return static_cast<std::uint32_t>(nodes.size() - 1);
+  }
+
+  // Appends the interior node over `children` (indices into `nodes`) and links them to it.
+  std::uint32_t add_interior(std::span<const std::uint32_t> children, const Split& split,
+                             std::vector<BuildNode>& nodes) const {
+    SptDisc discs[8];
+    for (std::size_t k = 0; k < children.size(); ++k) {
+      const BuildNode& c = nodes[children[k]];
+      discs[k] = {c.center, c.normal, c.diameter * 0.5f};
+    }
+    const SptNodeGeometry g = spt_combine_children({discs, children.size()});
+    BuildNode node;
+    node.center = g.center;
+    node.normal = g.normal;
+    node.diameter = g.diameter;
+    node.error = static_cast<float>(
+        std::hypot(double(g.perpendicular_error), double(g.tangential_error)));
+    node.begin = split.edge[0];
+    node.count = split.edge[split.child_count] - split.edge[0];
+    node.level = split.level;
+    node.leaf = false;
+    if (has_colors) {
+      for (const std::uint32_t c : children) {
+        for (int a = 0; a < 3; ++a) node.color[a] += nodes[c].color[a];
+      }
+      for (float& channel : node.color) channel /= static_cast<float>(children.size());
+      for (const std::uint32_t c : children) {
+        float d2 = 0;
+        for (int a = 0; a < 3; ++a) d2 += (nodes[c].color[a] - node.color[a]) * (nodes[c].color[a] - node.color[a]);
+        // Over a colour edge the node may only be drawn once its whole disc is below the bound.
+        if (std::sqrt(d2) > color_tolerance) node.error = std::max(node.error, node.diameter);
+      }
+    }
+    for (const std::uint32_t c : children) node.error = std::max(node.error, nodes[c].error);
+    nodes.push_back(node);
+    const auto index = static_cast<std::uint32_t>(nodes.size() - 1);
+    for (const std::uint32_t c : children) nodes[c].parent = index;
+    return index;
+  }
+
+  // Builds the subtree over [begin, end) in post-order; returns its root's index.
+  std::uint32_t build(std::uint32_t begin, std::uint32_t end, std::vector<BuildNode>& nodes) const {
+    if (end - begin == 1) return add_leaf(begin, nodes);
+    const Split split = split_range(keys, begin, end);
+    std::uint32_t children[8];
+    for (std::uint32_t k = 0; k < split.child_count; ++k) {
+      children[k] = build(split.edge[k], split.edge[k + 1], nodes);
+    }
+    return add_interior({children, split.child_count}, split, nodes);
+  }
+};
+
+// Top of the tree above the task subtrees, in post-order.
+struct TopNode {
+  Split split;
+  std::uint32_t child_ref[8] = {};  // top node index, or kTaskRef | task id
+};
+
+struct Plan {
+  std::vector<TopNode> top;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> tasks;  // point ranges [first, second)
+};
+
+std::uint32_t plan_range(std::span<const MortonKey> keys, std::uint32_t begin, std::uint32_t end,
+                         std::size_t grain, Plan& plan) {
+  if (end - begin <= grain) {
+    plan.tasks.emplace_back(begin, end);
+    return kTaskRef | static_cast<std::uint32_t>(plan.tasks.size() - 1);
+  }
+  TopNode node;
+  node.split = split_range(keys, begin, end);
+  for (std::uint32_t k = 0; k < node.split.child_count; ++k) {
+    node.child_ref[k] = plan_range(keys, node.split.edge[k], node.split.edge[k + 1], grain, plan);
+  }
+  plan.top.push_back(node);
+  return static_cast<std::uint32_t>(plan.top.size() - 1);
+}
+
+// All nodes: the task subtrees one after the other, then the top nodes; children always come
+// before their parent.
+std::vector<BuildNode> build_nodes(const NodeMaker& maker, std::size_t grain, ThreadPool& pool,
+                                   ProgressPhase& phase) {
+  Plan plan;
+  const auto n = static_cast<std::uint32_t>(maker.keys.size());
+  plan_range(maker.keys, 0, n, std::max<std::size_t>(grain, 1), plan);
+
+  std::vector<std::vector<BuildNode>> task_nodes(plan.tasks.size());
+  pool.run(plan.tasks.size(), [&](std::size_t t) {
+    const auto [begin, end] = plan.tasks[t];
+    task_nodes[t].reserve(2 * std::size_t{end - begin});
+    maker.build(begin, end, task_nodes[t]);
+    task_nodes[t].shrink_to_fit();
+    phase.advance(end - begin);
+  });
+  std::vector<std::size_t> task_base(plan.tasks.size() + 1, 0);
+  for (std::size_t t = 0; t < plan.tasks.size(); ++t) {
+    task_base[t + 1] = task_base[t] + task_nodes[t].size();
+  }
+  std::vector<BuildNode> nodes(task_base.back());
+  nodes.reserve(task_base.back() + plan.top.size());
+  pool.run(plan.tasks.size(), [&](std::size_t t) {
+    const auto base = static_cast<std::uint32_t>(task_base[t]);
+    for (BuildNode& node : task_nodes[t]) {
+      if (node.parent != kSptNoParent) node.parent += base;
+    }
+    std::copy(task_nodes[t].begin(), task_nodes[t].end(), nodes.begin() + task_base[t]);
+    std::vector<BuildNode>().swap(task_nodes[t]);
+  });
+  const std::size_t top_base = nodes.size();
+  for (const TopNode& top : plan.top) {
+    std::uint32_t children[8];
+    for (std::uint32_t k = 0; k < top.split.child_count; ++k) {
+      const std::uint32_t ref = top.child_ref[k];
+      children[k] = static_cast<std::uint32_t>(
+          ref & kTaskRef ? task_base[(ref & ~kTaskRef) + 1] - 1 : top_base + ref);
+    }
+    maker.add_interior({children, top.split.child_count}, top.split, nodes);
+  }
+  return nodes;
+}
+
+// ---- Pass 4: the sequential list -----------------------------------------------------------
+
+struct ListKey {
+  std::uint32_t range = 0;  // 0 = top list, k + 1 = chunk k
+  float parent_error = 0;
+  std::uint32_t begin = 0, count = 0;
+  std::uint32_t node = 0;
+};
+constexpr bool list_before(const ListKey& a, const ListKey& b) {
+  if (a.range != b.range) return a.range < b.range;
+  if (a.parent_error != b.parent_error) return a.parent_error > b.parent_error;
+  if (a.begin != b.begin) return a.begin < b.begin;
+  return a.count > b.count;
+}
+
+void fill_list(const std::vector<BuildNode>& nodes, std::uint32_t chunk_level, bool has_colors,
+               ThreadPool& pool, SequentialPointTree& tree) {
+  const std::size_t count = nodes.size();
+  const auto is_top = [&](const BuildNode& nd) { return !nd.leaf && nd.level < chunk_level; };
+  // Chunk roots: not top, parent top (or none); disjoint ranges, so sorting by begin gives the
+  // Morton order of their cells.
+  std::vector<std::uint32_t> roots;
+  for (std::uint32_t i = 0; i < count; ++i) {
+    const BuildNode& nd = nodes[i];
+    if (!is_top(nd) && (nd.parent == kSptNoParent || is_top(nodes[nd.parent]))) roots.push_back(i);
+  }
+  std::sort(roots.begin(), roots.end(),
+            [&](std::uint32_t a, std::uint32_t b) { return nodes[a].begin < nodes[b].begin; });
+
+  std::vector<ListKey> keys(count);
+  parallel_for(pool, count, kPointGrain, [&](std::size_t first, std::size_t last) {
+    for (std::size_t i = first; i < last; ++i) {
+      const BuildNode& nd = nodes[i];
+      std::uint32_t range = 0;
+      if (!is_top(nd)) {
+        // The chunk is the last root starting at or before this node's range.
+        const auto it = std::upper_bound(roots.begin(), roots.end(), nd.begin,
+                                         [&](std::uint32_t b, std::uint32_t r) { return b < nodes[r].begin; });
+        range = static_cast<std::uint32_t>(it - roots.begin());
+      }
+      keys[i] = {range, nd.parent == kSptNoParent ? kInf : nodes[nd.parent].error, nd.begin,
+                 nd.count, static_cast<std::uint32_t>(i)};
+    }
+  });
+  parallel_sort(keys, pool, list_before);
+
+  std::vector<std::uint32_t> position(count);
+  parallel_for(pool, count, kPointGrain, [&](std::size_t first, std::size_t last) {
+    for (std::size_t i = first; i < last; ++i) position[keys[i].node] = static_cast<std::uint32_t>(i);
+  });
+  for (auto* v : {&tree.center_x, &tree.center_y, &tree.center_z, &tree.normal_x, &tree.normal_y,
+                  &tree.normal_z, &tree.diameter, &tree.error, &tree.parent_error}) {
+    v->resize(count);
+  }
+  tree.is_leaf.resize(count);
+  tree.parent.resize(count);
+  if (has_colors) tree.colors.resize(count);
+  parallel_for(pool, count, kPointGrain, [&](std::size_t first, std::size_t last) {
+    for (std::size_t i = first; i < last; ++i) {
+      const BuildNode& nd = nodes[keys[i].node];
+      tree.center_x[i] = nd.center.x;
+      tree.center_y[i] = nd.center.y;
+      tree.center_z[i] = nd.center.z;
+      tree.normal_x[i] = nd.normal.x;
+      tree.normal_y[i] = nd.normal.y;
+      tree.normal_z[i] = nd.normal.z;
+      tree.diameter[i] = nd.diameter;
+      tree.error[i] = nd.error;
+      tree.parent_error[i] = keys[i].parent_error;
+      tree.is_leaf[i] = nd.leaf ? 1 : 0;
+      tree.parent[i] = nd.parent == kSptNoParent ? kSptNoParent : position[nd.parent];
+      if (has_colors) {
+        const auto byte = [](float c) {
+          return static_cast<std::uint8_t>(std::clamp(std::lround(c * 255.0f), 0l, 255l));
+        };
+        tree.colors[i] = {byte(nd.color[0]), byte(nd.color[1]), byte(nd.color[2])};
+      }
+    }
+  });
+
+  // Range boundaries of the sorted keys; each chunk root sorts first in its chunk (its parent
+  // error bounds every other parent error of the chunk, and it is first in pre-order).
+  tree.chunk_level = chunk_level;
+  tree.chunks.resize(roots.size());
+  std::uint32_t at = 0;
+  while (at < count && keys[at].range == 0) ++at;
+  tree.top_end = at;
+  for (std::size_t k = 0; k < roots.size(); ++k) {
+    SptChunk& chunk = tree.chunks[k];
+    chunk.begin = at;
+    while (at < count && keys[at].range == k + 1) ++at;
+    chunk.end = at;
+    const BuildNode& root = nodes[roots[k]];
+    assert(position[roots[k]] == chunk.begin);
+    chunk.bounds = {root.center, root.diameter * 0.5f};
+  }
+}
+
+// Smallest float >= x, so a bound computed in double stays a bound once stored as float.
+float round_up(double x) {
+  float f = static_cast<float>(x);
+  if (static_cast<double>(f) < x) f = std::nextafter(f, kInf);
+  return f;
+}
+
+struct D3 {
+  double x = 0, y = 0, z = 0;
+};
+D3 to_d3(Vec3f v) { return {v.x, v.y, v.z}; }
+D3 operator-(D3 a, D3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+D3 operator*(D3 a, double s) { return {a.x * s, a.y * s, a.z * s}; }
+D3 operator+(D3 a, D3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+double dot(D3 a, D3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+D3 cross(D3 a, D3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+D3 unit(D3 a) { return a * (1.0 / std::sqrt(dot(a, a))); }
+
+// Half-extent of a disc of radius r and unit normal m along the unit direction u.
+double disc_half_extent(double r, D3 m, D3 u) {
+  const double c = dot(m, u);
+  return r * std::sqrt(std::max(0.0, 1.0 - c * c));
+}
+
+}  // namespace
+
+SptNodeGeometry spt_combine_children(std::span<const SptDisc> children) {
+  assert(!children.empty());
+  const double inv = 1.0 / static_cast<double>(children.size());
+  D3 center_sum, normal_sum;
+  for (const SptDisc& c : children) {
+    center_sum = center_sum + to_d3(c.center);
+    normal_sum = normal_sum + to_d3(c.normal);
+  }
+  SptNodeGeometry g;
+  const D3 cm = center_sum * inv;
+  g.center = {float(cm.x), float(cm.y), float(cm.z)};
+  const double normal_len = std::sqrt(dot(normal_sum, normal_sum));
+  // Normals that cancel (a thin sheet seen from both sides) have no mean; use the first child's.
+  const D3 nm = normal_len > 1e-6 * static_cast<double>(children.size())
+                    ? normal_sum * (1.0 / normal_len)
+                    : to_d3(normalized(children[0].normal));
+  g.normal = normalized(Vec3f{float(nm.x), float(nm.y), float(nm.z)});
+
+  // Everything below is measured from the stored (float) centre and normal.
+  const D3 c0 = to_d3(g.center), n = unit(to_d3(g.normal));
+  double radius = 0, top = -INFINITY, bottom = INFINITY;
+  for (const SptDisc& c : children) {
+    const D3 d = to_d3(c.center) - c0;
+    const double r = c.radius;
+    radius = std::max(radius, std::sqrt(dot(d, d)) + r);
+    const double h = dot(d, n), s = disc_half_extent(r, unit(to_d3(normalized(c.normal))), n);
+    top = std::max(top, h + s);
+    bottom = std::min(bottom, h - s);
+  }
+  g.diameter = round_up(2 * radius);
+  g.perpendicular_error = static_cast<float>(top - bottom);
+
+  // Plane frame: t1 from the world axis least aligned with n.
+  const double ax = std::abs(n.x), ay = std::abs(n.y), az = std::abs(n.z);
+  const D3 axis = ax <= ay && ax <= az ? D3{1, 0, 0} : (ay <= az ? D3{0, 1, 0} : D3{0, 0, 1});
+  const D3 t1 = unit(axis - n * dot(axis, n)), t2 = cross(n, t1);
+  double narrowest = INFINITY;
+  for (int j = 0; j < 8; ++j) {
+    const double angle = j * (3.14159265358979323846 / 8);
+    const D3 u = t1 * std::cos(angle) + t2 * std::sin(angle);
+    double hi = -INFINITY, lo = INFINITY;
+    for (const SptDisc& c : children) {
+      const double h = dot(to_d3(c.center) - c0, u);
+      const double s = disc_half_extent(c.radius, unit(to_d3(normalized(c.normal))), u);
+      hi = std::max(hi, h + s);
+      lo = std::min(lo, h - s);
+    }
+    narrowest = std::min(narrowest, hi - lo);
+  }
+  g.tangential_error = static_cast<float>(std::max(0.0, double(g.diameter) - narrowest));
+  return g;
+}
+
+SequentialPointTree build_sequential_point_tree(const PointSet& points, ThreadPool& pool,
+                                                Progress& progress,
+                                                const SequentialPointTreeOptions& options) {
+  check_input(points, options);
+  SequentialPointTree tree;
+  tree.has_colors = points.has_colors();
+  tree.leaf_count = points.size();
+  tree.bounds = check_points_and_bound(points, pool);
+  tree.view_sphere = {tree.bounds.center(),
+                      max_distance(points.positions, tree.bounds.center(), pool)};
+
+  std::vector<BuildNode> nodes;
+  {
+    ProgressPhase phase(progress, "hierarchy", points.size());
+    const std::vector<MortonKey> keys = morton_order(points.positions, tree.bounds, pool);
+    const NodeMaker maker{keys, points, tree.has_colors, options.color_tolerance};
+    nodes = build_nodes(maker, options.parallel_grain_points, pool, phase);
+  }
+  ProgressPhase phase(progress, "sequential list", nodes.size());
+  fill_list(nodes, options.chunk_level, tree.has_colors, pool, tree);
+  phase.advance(nodes.size());
+  return tree;
+}
+
+}  // namespace pointillist
