@@ -40,6 +40,11 @@ struct RenderOptions {
   PrepareOptions prepare;    // for .ply inputs
   unsigned threads = 0;
   bool quiet = false;
+  // Frame sequences (see README "Frame sequences"): 0 = off.
+  unsigned orbit_frames = 0;  // --path orbit:N
+  double frame_ms = 0;        // --frame-ms T: hold this frame time
+  unsigned refine_frames = 0; // --refine K
+  std::string frames_out;     // --frames-out DIR: write every frame there
 };
 int run_render(const RenderOptions& options);
 

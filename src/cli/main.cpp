@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <new>
 #include <sstream>
 #include <string>
@@ -38,6 +39,22 @@ std::vector<float> parse_floats(const std::string& text, std::size_t count, cons
                       " numbers separated by '" + sep + "'");
   }
   return values;
+}
+
+// "orbit:N" (1 <= N <= 100000) -> N.
+unsigned parse_orbit_path(const std::string& text) {
+  const std::string prefix = "orbit:";
+  if (text.rfind(prefix, 0) == 0) {
+    const std::string count = text.substr(prefix.size());
+    char* end = nullptr;
+    const unsigned long n = std::strtoul(count.c_str(), &end, 10);
+    if (!count.empty() && *end == '\0' && n >= 1 && n <= 100000 && count[0] != '-') {
+      return static_cast<unsigned>(n);
+    }
+  }
+  throw pointillist::OptionError("--path '" + text +
+                                 "' is not a camera path; give orbit:N with N frames from 1 to 100000 "
+                                 "(e.g. --path orbit:120)");
 }
 
 Vec3f parse_vec3(const std::string& text, const std::string& option) {
@@ -130,6 +147,19 @@ int main(int argc, char** argv) {
       ->default_str("0,0,0");
   render_cmd->add_option("--depth", render.depth_output, "Also write a 16-bit depth PNG");
   render_cmd->add_option("--stats", render.stats_output, "Write statistics as JSON (- = stdout)");
+  std::string path;
+  render_cmd->add_option("--path", path,
+                         "Render a sequence of frames along a camera path: orbit:N = N frames "
+                         "around the model (azimuth +0..360 degrees from --view)");
+  render_cmd->add_option("--frame-ms", render.frame_ms,
+                         "With --path: adjust the threshold frame to frame to hold T ms per frame")
+      ->check(CLI::Range(0.1, 100000.0));
+  render_cmd->add_option("--refine", render.refine_frames,
+                         "Then render K frames refining to full detail, as a viewer does when the "
+                         "camera stops")
+      ->check(CLI::Range(1u, 100000u));
+  render_cmd->add_option("--frames-out", render.frames_out,
+                         "Write every frame of a sequence to DIR/frame_NNNNN.png");
   add_prepare_options(render_cmd, render.prepare);
   add_threads(render_cmd, render.threads);
   render_cmd->add_flag("-q,--quiet", render.quiet, "No progress bars and no summary");
@@ -210,6 +240,7 @@ int main(int argc, char** argv) {
       if (!target.empty()) render.view.target = parse_vec3(target, "--target");
       if (!up.empty()) render.view.up = parse_vec3(up, "--up");
       render.settings.background = parse_rgb8(background, "--background");
+      if (!path.empty()) render.orbit_frames = parse_orbit_path(path);
       return pc::run_render(render);
     }
     if (*info_cmd) return pc::run_info(info);

@@ -1,8 +1,11 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
+#include <vector>
 
 #include "cli/commands.hpp"
 #include "cli/model_loading.hpp"
@@ -11,6 +14,7 @@
 #include "pointillist/core/error.hpp"
 #include "pointillist/io/png.hpp"
 #include "pointillist/render/depth_image.hpp"
+#include "pointillist/render/frame_control.hpp"
 
 namespace pointillist::cli {
 
@@ -37,8 +41,7 @@ Camera make_camera(const ViewOptions& v, const SphereTreeView& tree) {
                                          .height = v.height});
 }
 
-void write_stats(const std::string& where, const RenderStats& s) {
-  const std::string json = stats_to_json(s);
+void write_text(const std::string& where, const std::string& json) {
   if (where == "-") {
     std::fputs(json.c_str(), stdout);
     return;
@@ -50,25 +53,121 @@ void write_stats(const std::string& where, const RenderStats& s) {
   }
 }
 
+namespace {
+
+// Frames a sequence renders before the frame-time controller is judged (the hit rate).
+constexpr std::size_t kSettleFrames = 5;
+
+std::string frame_path(const std::string& dir, std::size_t index) {
+  char name[32];
+  std::snprintf(name, sizeof name, "frame_%05zu.png", index);
+  return (std::filesystem::path(dir) / name).string();
+}
+
+void check_sequence_options(const RenderOptions& o) {
+  if (o.frame_ms > 0 && o.orbit_frames == 0) {
+    throw OptionError("--frame-ms holds a frame time over a sequence of frames; add --path orbit:N "
+                      "(N frames around the model)");
+  }
+  if (o.orbit_frames > 0 && (o.view.eye || o.view.target || o.view.up)) {
+    throw OptionError("--path orbit:N moves the camera around the orbit; it cannot be combined "
+                      "with --eye/--target/--up (use --view and --distance)");
+  }
+  if (!o.frames_out.empty() && o.orbit_frames == 0 && o.refine_frames == 0) {
+    throw OptionError("--frames-out writes the frames of a sequence; add --path orbit:N or --refine K");
+  }
+  if (!o.frames_out.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(o.frames_out, ec);
+    if (ec) {
+      throw IoError(o.frames_out + ": cannot create the frames folder (" + ec.message() +
+                    "); give a writable path to --frames-out");
+    }
+  }
+}
+
+// Renders the path (and/or the idle refinement) a viewer would show; returns every frame's record
+// and leaves the last frame in `frame`.
+std::vector<FrameRecord> render_sequence(const RenderOptions& o, const SphereTreeView& tree,
+                                         ThreadPool& pool, Frame& frame) {
+  check_sequence_options(o);
+  const float finest = std::min(1.0f, o.settings.threshold_px);
+  std::optional<FrameTimeController> control;
+  if (o.frame_ms > 0) {
+    control.emplace(FrameControlOptions{.target_ms = o.frame_ms, .finest = finest},
+                    o.settings.threshold_px);
+  }
+  std::vector<FrameRecord> records;
+  RenderSettings settings = o.settings;
+  ViewOptions view = o.view;
+  auto draw = [&](const char* phase, float threshold) {
+    settings.threshold_px = threshold;
+    render(tree, make_camera(view, tree), settings, pool, frame);
+    records.push_back({phase, view.azimuth_deg, threshold, frame.stats});
+    if (!o.frames_out.empty()) {
+      write_png_rgb8(frame_path(o.frames_out, records.size() - 1), frame.width, frame.height,
+                     frame.color);
+    }
+  };
+  for (unsigned i = 0; i < o.orbit_frames; ++i) {
+    view.azimuth_deg = o.view.azimuth_deg + 360.0f * static_cast<float>(i) /
+                                                static_cast<float>(o.orbit_frames);
+    draw("path", control ? control->parameter() : o.settings.threshold_px);
+    if (control) control->report(frame.stats.ms_total);
+  }
+  if (o.refine_frames > 0) {
+    const float start = control ? control->parameter() : o.settings.threshold_px;
+    for (float threshold : refinement_sequence(start, finest, o.refine_frames)) {
+      draw("refine", threshold);
+    }
+  }
+  return records;
+}
+
+}  // namespace
+
 int run_render(const RenderOptions& o) {
   ThreadPool pool(o.threads);
   TerminalProgress progress(!o.quiet && TerminalProgress::stderr_is_terminal());
   const LoadedModel model = LoadedModel::open(o.input, o.prepare, pool, progress);
-  const Camera camera = make_camera(o.view, model.tree());
   Frame frame;
-  render(model.tree(), camera, o.settings, pool, frame);
+  const bool sequence =
+      o.orbit_frames > 0 || o.refine_frames > 0 || o.frame_ms > 0 || !o.frames_out.empty();
+  std::vector<FrameRecord> records;
+  if (sequence) {
+    records = render_sequence(o, model.tree(), pool, frame);
+  } else {
+    render(model.tree(), make_camera(o.view, model.tree()), o.settings, pool, frame);
+  }
   write_png_rgb8(o.output, frame.width, frame.height, frame.color);
   if (!o.depth_output.empty()) {
     const auto depth16 = depth_to_gray16(frame);
     write_png_gray16(o.depth_output, frame.width, frame.height, depth16);
   }
-  if (!o.stats_output.empty()) write_stats(o.stats_output, frame.stats);
-  if (!o.quiet && o.stats_output != "-") {
-    std::printf("rendered %s: %dx%d, %llu splats, %.2f ms (select %.2f, raster %.2f) -> %s\n",
-                o.input.c_str(), frame.width, frame.height,
-                static_cast<unsigned long long>(frame.stats.splats), frame.stats.ms_total,
-                frame.stats.ms_select, frame.stats.ms_raster, o.output.c_str());
+  const float finest = std::min(1.0f, o.settings.threshold_px);
+  if (!o.stats_output.empty()) {
+    write_text(o.stats_output, sequence ? sequence_to_json(records, o.frame_ms, kSettleFrames, finest)
+                                        : stats_to_json(frame.stats));
   }
+  if (o.quiet || o.stats_output == "-") return 0;
+  if (sequence) {
+    double total = 0;
+    for (const FrameRecord& r : records) total += r.stats.ms_total;
+    std::printf("rendered %s: %zu frames at %dx%d, mean %.2f ms/frame", o.input.c_str(),
+                records.size(), frame.width, frame.height, total / double(records.size()));
+    if (o.frame_ms > 0) {
+      std::printf(", %.0f%% of frames after the first %zu within 20%% of %.1f ms",
+                  100.0 * hit_rate(records, o.frame_ms, kSettleFrames, finest), kSettleFrames,
+                  o.frame_ms);
+    }
+    std::printf("; last frame -> %s%s%s\n", o.output.c_str(),
+                o.frames_out.empty() ? "" : ", all frames -> ", o.frames_out.c_str());
+    return 0;
+  }
+  std::printf("rendered %s: %dx%d, %llu splats, %.2f ms (select %.2f, raster %.2f) -> %s\n",
+              o.input.c_str(), frame.width, frame.height,
+              static_cast<unsigned long long>(frame.stats.splats), frame.stats.ms_total,
+              frame.stats.ms_select, frame.stats.ms_raster, o.output.c_str());
   return 0;
 }
 

@@ -32,24 +32,29 @@ FrameTimeController::FrameTimeController(const FrameControlOptions& o, float ini
         "max_step " + std::to_string(o.max_step) + " must be a finite factor > 1");
   check(o.cost_exponent > 0 && std::isfinite(o.cost_exponent),
         "cost exponent " + std::to_string(o.cost_exponent) + " must be positive");
-  check(o.smoothing > 0 && o.smoothing <= 1,
-        "smoothing " + std::to_string(o.smoothing) + " must be in (0, 1]");
+  check(o.min_exponent > 0 && o.max_exponent >= o.min_exponent && std::isfinite(o.max_exponent),
+        "exponent bounds [" + std::to_string(o.min_exponent) + ", " +
+            std::to_string(o.max_exponent) + "] are invalid; give 0 < min <= max");
   check(std::isfinite(initial), "initial level of detail is not finite");
   parameter_ = std::clamp(initial, o.finest, o.coarsest);
+  exponent_ = std::clamp(o.cost_exponent, o.min_exponent, o.max_exponent);
 }
 
 void FrameTimeController::report(double frame_ms) {
   if (!std::isfinite(frame_ms) || frame_ms < 0) return;
-  const double e = options_.cost_exponent;
+  const double log_ms = std::log(std::max(frame_ms, 1e-6));
   const double log_p = std::log(static_cast<double>(parameter_));
-  const double log_k = std::log(std::max(frame_ms, 1e-6)) + e * log_p;
-  log_k_ = has_estimate_ ? log_k_ + options_.smoothing * (log_k - log_k_) : log_k;
-  has_estimate_ = true;
-  // Predicted time at the current parameter over the target: > 1 means too slow.
-  const double log_ratio = log_k_ - e * log_p - std::log(options_.target_ms);
+  if (has_last_ && std::abs(log_p - last_log_p_) > 0.02) {
+    const double observed = -(log_ms - last_log_ms_) / (log_p - last_log_p_);
+    exponent_ = 0.5 * (exponent_ + std::clamp(observed, options_.min_exponent, options_.max_exponent));
+  }
+  last_log_ms_ = log_ms;
+  last_log_p_ = log_p;
+  has_last_ = true;
+  const double log_ratio = log_ms - std::log(options_.target_ms);  // > 0: too slow
   if (std::abs(std::exp(log_ratio) - 1) <= options_.deadband) return;
-  const double log_step = std::clamp(options_.gain * log_ratio / e, -std::log(options_.max_step),
-                                     std::log(options_.max_step));
+  const double log_step = std::clamp(options_.gain * log_ratio / exponent_,
+                                     -std::log(options_.max_step), std::log(options_.max_step));
   const double next = static_cast<double>(parameter_) * std::exp(log_step);
   parameter_ = static_cast<float>(
       std::clamp(next, static_cast<double>(options_.finest), static_cast<double>(options_.coarsest)));

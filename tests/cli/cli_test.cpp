@@ -150,3 +150,71 @@ TEST(Cli, RenderingAPtlIsNotConvertedAgain) {
   EXPECT_NE(r.exit_code, 0);
   EXPECT_THAT(r.output, HasSubstr("already a Pointillist model"));
 }
+
+TEST(Cli, OrbitPathWithRefinementWritesEveryFrameAndEndsAtFullDetail) {
+  pointillist::testing::TempDir dir;
+  const auto ply = dir.file("scene.ply");
+  ASSERT_EQ(run("generate --scene torus --points 20000 -o " + ply).exit_code, 0);
+  const std::string frames = dir.file("frames");
+  const Result r = run("render " + ply + " -o " + dir.file("last.png") +
+                       " --size 96x64 --threshold 6 --path orbit:4 --refine 3 --frames-out " +
+                       frames + " --stats -");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  // 4 path frames at azimuths 0, 90, 180, 270 (threshold 6), then 3 refining to 1 px: 6, √6, 1.
+  for (const char* s : {"\"azimuth\": 0.000", "\"azimuth\": 90.000", "\"azimuth\": 180.000",
+                        "\"azimuth\": 270.000"}) {
+    EXPECT_THAT(r.output, HasSubstr(s));
+  }
+  std::size_t path = 0, refine = 0;
+  for (std::size_t at = 0; (at = r.output.find("\"phase\": \"path\"", at)) != std::string::npos; ++at) ++path;
+  for (std::size_t at = 0; (at = r.output.find("\"phase\": \"refine\"", at)) != std::string::npos; ++at) ++refine;
+  EXPECT_EQ(path, 4u);
+  EXPECT_EQ(refine, 3u);
+  EXPECT_THAT(r.output, HasSubstr("\"threshold\": 2.4495"));
+  const std::size_t last = r.output.rfind("\"phase\"");
+  EXPECT_NE(r.output.find("\"threshold\": 1.0000", last), std::string::npos);
+  for (int i = 0; i < 7; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "/frame_%05d.png", i);
+    EXPECT_TRUE(fs::exists(frames + name)) << name;
+  }
+  EXPECT_FALSE(fs::exists(frames + "/frame_00007.png"));
+  // The last frame is the -o image and is the full-detail one.
+  const ImageRgb8 last_png = read_png_rgb8(dir.file("last.png"));
+  const ImageRgb8 last_frame = read_png_rgb8(frames + "/frame_00006.png");
+  EXPECT_EQ(last_png.pixels, last_frame.pixels);
+}
+
+TEST(Cli, FrameTimeControlReportsAHitRate) {
+  pointillist::testing::TempDir dir;
+  const auto ply = dir.file("scene.ply");
+  ASSERT_EQ(run("generate --scene sphere --points 5000 -o " + ply).exit_code, 0);
+  // A generous target: a small image renders far faster, so every frame is at full detail and
+  // counts as a hit.
+  const Result r = run("render " + ply + " -o " + dir.file("x.png") +
+                       " --size 64x48 --path orbit:12 --frame-ms 1000 --stats -");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("\"target_ms\": 1000.000"));
+  EXPECT_THAT(r.output, HasSubstr("\"hit_rate\": 1.0000"));
+}
+
+TEST(Cli, BadSequenceOptionsAreExplained) {
+  pointillist::testing::TempDir dir;
+  const auto ply = dir.file("scene.ply");
+  ASSERT_EQ(run("generate --points 500 -o " + ply).exit_code, 0);
+  const std::string base = "render " + ply + " -o " + dir.file("x.png") + " --size 32x32 ";
+  Result r = run(base + "--path circle:4");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_THAT(r.output, HasSubstr("orbit:N"));
+  r = run(base + "--path orbit:0");
+  EXPECT_NE(r.exit_code, 0);
+  r = run(base + "--frame-ms 10");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_THAT(r.output, HasSubstr("--path"));
+  r = run(base + "--frames-out " + dir.file("f"));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_THAT(r.output, HasSubstr("--refine"));
+  r = run(base + "--path orbit:3 --eye 1,1,1 --target 0,0,0");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_THAT(r.output, HasSubstr("--eye"));
+}

@@ -77,6 +77,21 @@ TEST(FrameTimeController, ReconvergesAfterTheSceneGetsHeavier) {
   EXPECT_NEAR(c.parameter(), 2.58f, 0.12f);
 }
 
+TEST(FrameTimeController, CrossesARangeWhereTheParameterChangesNothing) {
+  // Splats of 2.5 px: thresholds below that draw the same splats (flat cost), above it the cost
+  // falls as p⁻². 3 ms fixed + 12 ms of splats; the 7 ms target needs p = 2.5·sqrt(12 / 4) = 4.33.
+  auto cost = [](float p) { return 3.0 + 12.0 * std::min(1.0, 6.25 / (double(p) * p)); };
+  FrameTimeController c({.target_ms = 7}, 1.0f);
+  int frames = 0;
+  while (std::abs(cost(c.parameter()) / 7 - 1) > 0.2 && frames < 100) {
+    c.report(cost(c.parameter()));
+    ++frames;
+  }
+  EXPECT_LE(frames, 10);
+  for (int frame = 0; frame < 20; ++frame) c.report(cost(c.parameter()));
+  EXPECT_NEAR(cost(c.parameter()), 7.0, 7.0 * 0.1);
+}
+
 TEST(FrameTimeController, FullDetailFasterThanTheTargetStaysAtFullDetail) {
   FrameTimeController c({.target_ms = 100}, 4.0f);
   for (int frame = 0; frame < 30; ++frame) c.report(model_ms(1, 10, c.parameter()));

@@ -27,19 +27,23 @@ struct FrameControlOptions {
   // The parameter changes by at most this factor per frame (> 1): one slow frame (a page fault,
   // another process) cannot throw the level of detail far off.
   double max_step = 2.0;
-  // Cost model: frame time ∝ parameter^(−cost_exponent). 2 for splats covering a surface.
+  // Cost model: frame time ∝ parameter^(−exponent) near the current parameter. The exponent is
+  // learnt from consecutive frames (it is 2 for splats covering a surface, near 0 where the
+  // parameter is below the size of the finest splats and changes nothing, and lower than 2
+  // when a fixed cost per frame dominates); this is its starting value.
   double cost_exponent = 2.0;
-  // Weight of the newest frame in the running estimate of the cost model's constant, in (0, 1].
-  // Lower filters timing noise better and follows a change of scene more slowly (about
-  // 1 / smoothing frames).
-  double smoothing = 0.35;
+  // Learnt exponents are clamped to [min_exponent, max_exponent]: a small exponent makes big
+  // steps (crossing a flat region quickly), bounded by max_step.
+  double min_exponent = 0.25;
+  double max_exponent = 4.0;
 };
 
 // Feedback controller for one view sequence. Usage per frame: render with parameter(), then
-// report(measured_ms). Each report updates a smoothed estimate of the cost model's constant
-// k = ms · p^e (in the logarithm); the parameter that would hit the target is (k / target)^(1/e),
-// and the controller moves `gain` of the way there (at most max_step), unless the time the
-// model predicts for the current parameter is already within the deadband. Deterministic: the
+// report(measured_ms). A frame within the deadband changes nothing; otherwise the parameter that
+// would hit the target under the local cost model is p·(ms / target)^(1/e), and the controller
+// moves `gain` of the way there in the logarithm (at most max_step). The local exponent e is
+// re-estimated from each pair of consecutive frames whose parameters differ by more than 2%
+// (e = −Δlog ms / Δlog p, clamped, averaged with the previous estimate). Deterministic: the
 // same measurements give the same parameters.
 class FrameTimeController {
  public:
@@ -59,8 +63,10 @@ class FrameTimeController {
  private:
   FrameControlOptions options_;
   float parameter_;
-  double log_k_ = 0;  // smoothed log(ms) + e·log(p)
-  bool has_estimate_ = false;
+  double exponent_;         // current estimate of the local cost exponent
+  double last_log_ms_ = 0;  // the previous frame, for the exponent estimate
+  double last_log_p_ = 0;
+  bool has_last_ = false;
 };
 
 // The parameters of `count` frames a viewer shows after the camera stops: from `start` down to
