@@ -30,7 +30,7 @@ namespace {
 
 constexpr std::size_t kMaxPoints = std::size_t{1} << 31;
 constexpr std::uint32_t kMaxChunkLevel = 10;
-constexpr int kLevels = 21;                 // octree depth of the finest Morton cells
+constexpr int kLevels = 21;  // octree depth of the finest Morton cells
 constexpr std::uint8_t kLeafLevel = kLevels;
 constexpr std::size_t kPointGrain = 65536;  // points per task in the per-point passes
 constexpr std::size_t kSortBlock = 1 << 14;
@@ -76,7 +76,9 @@ void check_input(const PointSet& points, const SequentialPointTreeOptions& optio
     throw Error(what + " over " + std::to_string(n) +
                 " points: the limit is 2^31 (2147483648); split the input into chunks");
   }
-  if (!points.has_normals()) throw Error(what + ": the points have no normals; estimate them first");
+  if (!points.has_normals()) {
+    throw Error(what + ": the points have no normals; estimate them first");
+  }
   if (!points.has_radii()) {
     throw Error(what + ": the points have no splat radii; compute them first");
   }
@@ -143,7 +145,9 @@ float max_distance(const std::vector<Vec3f>& positions, Vec3f center, ThreadPool
   std::vector<float> d2(chunks, 0.0f);
   parallel_for(pool, positions.size(), kPointGrain, [&](std::size_t begin, std::size_t end) {
     float m = 0;
-    for (std::size_t i = begin; i < end; ++i) m = std::max(m, length_squared(positions[i] - center));
+    for (std::size_t i = begin; i < end; ++i) {
+      m = std::max(m, length_squared(positions[i] - center));
+    }
     d2[begin / kPointGrain] = m;
   });
   return std::sqrt(*std::max_element(d2.begin(), d2.end()));
@@ -172,7 +176,8 @@ void parallel_sort(std::vector<T>& v, ThreadPool& pool, Less less) {
     return;
   }
   const auto edge = [&](std::size_t block) { return std::min(n, block * kSortBlock); };
-  pool.run(blocks, [&](std::size_t b) { std::sort(v.data() + edge(b), v.data() + edge(b + 1), less); });
+  pool.run(blocks,
+           [&](std::size_t b) { std::sort(v.data() + edge(b), v.data() + edge(b + 1), less); });
   std::vector<T> other(n);
   T* src = v.data();
   T* dst = other.data();
@@ -200,8 +205,8 @@ std::vector<MortonKey> morton_order(const std::vector<Vec3f>& positions, const A
   parallel_for(pool, positions.size(), kPointGrain, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       const Vec3f p = positions[i];
-      keys[i] = {spread_bits(cell(p.x, bounds.lo.x)) << 2 | spread_bits(cell(p.y, bounds.lo.y)) << 1 |
-                     spread_bits(cell(p.z, bounds.lo.z)),
+      keys[i] = {spread_bits(cell(p.x, bounds.lo.x)) << 2 |
+                     spread_bits(cell(p.y, bounds.lo.y)) << 1 | spread_bits(cell(p.z, bounds.lo.z)),
                  static_cast<std::uint32_t>(i)};
     }
   });
@@ -209,12 +214,35 @@ std::vector<MortonKey> morton_order(const std::vector<Vec3f>& positions, const A
   return keys;
 }
 
+// A splat in Morton order: the build reads these in sequence instead of gathering from the
+// input at random.
+struct SortedSplat {
+  Vec3f position;
+  Vec3f normal;
+  float radius = 0;
+  Rgb8 color;
+};
+
+std::vector<SortedSplat> gather_splats(const PointSet& points, std::span<const MortonKey> keys,
+                                       ThreadPool& pool) {
+  std::vector<SortedSplat> splats(keys.size());
+  const bool has_colors = points.has_colors();
+  parallel_for(pool, keys.size(), kPointGrain, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) {
+      const std::uint32_t p = keys[k].index;
+      splats[k] = {points.positions[p], normalized(points.normals[p]), points.radii[p],
+                   has_colors ? points.colors[p] : Rgb8{}};
+    }
+  });
+  return splats;
+}
+
 // ---- Pass 2: splitting a range into children -----------------------------------------------
 
 struct Split {
-  std::uint8_t level = 0;        // depth of the cell holding the whole range
+  std::uint8_t level = 0;  // depth of the cell holding the whole range
   std::uint32_t child_count = 0;
-  std::uint32_t edge[9] = {};    // child k covers [edge[k], edge[k + 1])
+  std::uint32_t edge[9] = {};  // child k covers [edge[k], edge[k + 1])
 };
 
 // Children of the range [begin, end) (at least 2 points): the non-empty octants of the smallest
@@ -250,33 +278,44 @@ Split split_range(std::span<const MortonKey> keys, std::uint32_t begin, std::uin
 
 // ---- Pass 3: nodes -------------------------------------------------------------------------
 
+// Where a task writes its nodes: consecutive slots of the final node array from `next` on.
+struct NodeOut {
+  std::span<BuildNode> nodes;
+  std::uint32_t next = 0;
+
+  std::uint32_t put(const BuildNode& node) {
+    nodes[next] = node;
+    return next++;
+  }
+};
+
 struct NodeMaker {
   std::span<const MortonKey> keys;
-  const PointSet& points;
+  std::span<const SortedSplat> splats;
   bool has_colors;
   float color_tolerance;
 
-  std::uint32_t add_leaf(std::uint32_t k, std::vector<BuildNode>& nodes) const {
-    const std::uint32_t p = keys[k].index;
+  std::uint32_t add_leaf(std::uint32_t k, NodeOut& out) const {
+    const SortedSplat& splat = splats[k];
     BuildNode node;
-    node.center = points.positions[p];
-    node.normal = normalized(points.normals[p]);
-    node.diameter = 2 * points.radii[p];
+    node.center = splat.position;
+    node.normal = splat.normal;
+    node.diameter = 2 * splat.radius;
     node.begin = k;
     node.count = 1;
     if (has_colors) {
-      const Rgb8 c = points.colors[p];
+      const Rgb8 c = splat.color;
       node.color[0] = c.r / 255.0f;
       node.color[1] = c.g / 255.0f;
       node.color[2] = c.b / 255.0f;
     }
-    nodes.push_back(node);
-    return static_cast<std::uint32_t>(nodes.size() - 1);
+    return out.put(node);
   }
 
   // Appends the interior node over `children` (indices into `nodes`) and links them to it.
   std::uint32_t add_interior(std::span<const std::uint32_t> children, const Split& split,
-                             std::vector<BuildNode>& nodes) const {
+                             NodeOut& out) const {
+    const std::span<BuildNode> nodes = out.nodes;
     SptDisc discs[8];
     for (std::size_t k = 0; k < children.size(); ++k) {
       const BuildNode& c = nodes[children[k]];
@@ -287,8 +326,8 @@ struct NodeMaker {
     node.center = g.center;
     node.normal = g.normal;
     node.diameter = g.diameter;
-    node.error = static_cast<float>(
-        std::hypot(double(g.perpendicular_error), double(g.tangential_error)));
+    node.error =
+        static_cast<float>(std::hypot(double(g.perpendicular_error), double(g.tangential_error)));
     node.begin = split.edge[0];
     node.count = split.edge[split.child_count] - split.edge[0];
     node.level = split.level;
@@ -300,27 +339,28 @@ struct NodeMaker {
       for (float& channel : node.color) channel /= static_cast<float>(children.size());
       for (const std::uint32_t c : children) {
         float d2 = 0;
-        for (int a = 0; a < 3; ++a) d2 += (nodes[c].color[a] - node.color[a]) * (nodes[c].color[a] - node.color[a]);
+        for (int a = 0; a < 3; ++a) {
+          d2 += (nodes[c].color[a] - node.color[a]) * (nodes[c].color[a] - node.color[a]);
+        }
         // Over a colour edge the node may only be drawn once its whole disc is below the bound.
         if (std::sqrt(d2) > color_tolerance) node.error = std::max(node.error, node.diameter);
       }
     }
     for (const std::uint32_t c : children) node.error = std::max(node.error, nodes[c].error);
-    nodes.push_back(node);
-    const auto index = static_cast<std::uint32_t>(nodes.size() - 1);
+    const std::uint32_t index = out.put(node);
     for (const std::uint32_t c : children) nodes[c].parent = index;
     return index;
   }
 
   // Builds the subtree over [begin, end) in post-order; returns its root's index.
-  std::uint32_t build(std::uint32_t begin, std::uint32_t end, std::vector<BuildNode>& nodes) const {
-    if (end - begin == 1) return add_leaf(begin, nodes);
+  std::uint32_t build(std::uint32_t begin, std::uint32_t end, NodeOut& out) const {
+    if (end - begin == 1) return add_leaf(begin, out);
     const Split split = split_range(keys, begin, end);
     std::uint32_t children[8];
     for (std::uint32_t k = 0; k < split.child_count; ++k) {
-      children[k] = build(split.edge[k], split.edge[k + 1], nodes);
+      children[k] = build(split.edge[k], split.edge[k + 1], out);
     }
-    return add_interior({children, split.child_count}, split, nodes);
+    return add_interior({children, split.child_count}, split, out);
   }
 };
 
@@ -350,62 +390,74 @@ std::uint32_t plan_range(std::span<const MortonKey> keys, std::uint32_t begin, s
   return static_cast<std::uint32_t>(plan.top.size() - 1);
 }
 
-// All nodes: the task subtrees one after the other, then the top nodes; children always come
-// before their parent.
+// Nodes of the subtree over [begin, end), without building it.
+std::uint32_t count_nodes(std::span<const MortonKey> keys, std::uint32_t begin, std::uint32_t end) {
+  if (end - begin == 1) return 1;
+  const Split split = split_range(keys, begin, end);
+  std::uint32_t total = 1;
+  for (std::uint32_t k = 0; k < split.child_count; ++k) {
+    total += count_nodes(keys, split.edge[k], split.edge[k + 1]);
+  }
+  return total;
+}
+
+// All nodes: the task subtrees one after the other (each in post-order), then the top nodes;
+// children always come before their parent. Tasks count their nodes first so that each writes
+// its final slots directly.
 std::vector<BuildNode> build_nodes(const NodeMaker& maker, std::size_t grain, ThreadPool& pool,
                                    ProgressPhase& phase) {
   Plan plan;
   const auto n = static_cast<std::uint32_t>(maker.keys.size());
   plan_range(maker.keys, 0, n, std::max<std::size_t>(grain, 1), plan);
 
-  std::vector<std::vector<BuildNode>> task_nodes(plan.tasks.size());
-  pool.run(plan.tasks.size(), [&](std::size_t t) {
+  const std::size_t task_count = plan.tasks.size();
+  std::vector<std::uint32_t> task_base(task_count + 1, 0);
+  pool.run(task_count, [&](std::size_t t) {
+    task_base[t + 1] = count_nodes(maker.keys, plan.tasks[t].first, plan.tasks[t].second);
+  });
+  for (std::size_t t = 0; t < task_count; ++t) task_base[t + 1] += task_base[t];
+  std::vector<BuildNode> nodes(std::size_t{task_base.back()} + plan.top.size());
+  pool.run(task_count, [&](std::size_t t) {
     const auto [begin, end] = plan.tasks[t];
-    task_nodes[t].reserve(2 * std::size_t{end - begin});
-    maker.build(begin, end, task_nodes[t]);
-    task_nodes[t].shrink_to_fit();
+    NodeOut out{nodes, task_base[t]};
+    maker.build(begin, end, out);
+    assert(out.next == task_base[t + 1]);
     phase.advance(end - begin);
   });
-  std::vector<std::size_t> task_base(plan.tasks.size() + 1, 0);
-  for (std::size_t t = 0; t < plan.tasks.size(); ++t) {
-    task_base[t + 1] = task_base[t] + task_nodes[t].size();
-  }
-  std::vector<BuildNode> nodes(task_base.back());
-  nodes.reserve(task_base.back() + plan.top.size());
-  pool.run(plan.tasks.size(), [&](std::size_t t) {
-    const auto base = static_cast<std::uint32_t>(task_base[t]);
-    for (BuildNode& node : task_nodes[t]) {
-      if (node.parent != kSptNoParent) node.parent += base;
-    }
-    std::copy(task_nodes[t].begin(), task_nodes[t].end(), nodes.begin() + task_base[t]);
-    std::vector<BuildNode>().swap(task_nodes[t]);
-  });
-  const std::size_t top_base = nodes.size();
+  const std::uint32_t top_base = task_base.back();
+  NodeOut out{nodes, top_base};
   for (const TopNode& top : plan.top) {
     std::uint32_t children[8];
     for (std::uint32_t k = 0; k < top.split.child_count; ++k) {
       const std::uint32_t ref = top.child_ref[k];
-      children[k] = static_cast<std::uint32_t>(
-          ref & kTaskRef ? task_base[(ref & ~kTaskRef) + 1] - 1 : top_base + ref);
+      // A task's root is its last node (post-order).
+      children[k] = ref & kTaskRef ? task_base[(ref & ~kTaskRef) + 1] - 1 : top_base + ref;
     }
-    maker.add_interior({children, top.split.child_count}, top.split, nodes);
+    maker.add_interior({children, top.split.child_count}, top.split, out);
   }
   return nodes;
 }
 
 // ---- Pass 4: the sequential list -----------------------------------------------------------
 
+// List order packed into two integers: (range, parent error descending) and the pre-order
+// (begin ascending, count descending). Non-negative floats order like their bit patterns.
 struct ListKey {
-  std::uint32_t range = 0;  // 0 = top list, k + 1 = chunk k
-  float parent_error = 0;
-  std::uint32_t begin = 0, count = 0;
+  std::uint64_t major = 0;
+  std::uint64_t minor = 0;
   std::uint32_t node = 0;
 };
 constexpr bool list_before(const ListKey& a, const ListKey& b) {
-  if (a.range != b.range) return a.range < b.range;
-  if (a.parent_error != b.parent_error) return a.parent_error > b.parent_error;
-  if (a.begin != b.begin) return a.begin < b.begin;
-  return a.count > b.count;
+  return a.major != b.major ? a.major < b.major : a.minor < b.minor;
+}
+ListKey list_key(std::uint32_t range, float parent_error, const BuildNode& node,
+                 std::uint32_t index) {
+  const std::uint32_t error_bits = std::bit_cast<std::uint32_t>(parent_error + 0.0f);  // -0 -> +0
+  return {std::uint64_t{range} << 32 | ~error_bits, std::uint64_t{node.begin} << 32 | ~node.count,
+          index};
+}
+constexpr std::uint32_t range_of(const ListKey& k) {
+  return static_cast<std::uint32_t>(k.major >> 32);
 }
 
 void fill_list(const std::vector<BuildNode>& nodes, std::uint32_t chunk_level, bool has_colors,
@@ -429,19 +481,22 @@ void fill_list(const std::vector<BuildNode>& nodes, std::uint32_t chunk_level, b
       std::uint32_t range = 0;
       if (!is_top(nd)) {
         // The chunk is the last root starting at or before this node's range.
-        const auto it = std::upper_bound(roots.begin(), roots.end(), nd.begin,
-                                         [&](std::uint32_t b, std::uint32_t r) { return b < nodes[r].begin; });
+        const auto it =
+            std::upper_bound(roots.begin(), roots.end(), nd.begin,
+                             [&](std::uint32_t b, std::uint32_t r) { return b < nodes[r].begin; });
         range = static_cast<std::uint32_t>(it - roots.begin());
       }
-      keys[i] = {range, nd.parent == kSptNoParent ? kInf : nodes[nd.parent].error, nd.begin,
-                 nd.count, static_cast<std::uint32_t>(i)};
+      keys[i] = list_key(range, nd.parent == kSptNoParent ? kInf : nodes[nd.parent].error, nd,
+                         static_cast<std::uint32_t>(i));
     }
   });
-  parallel_sort(keys, pool, list_before);
+  parallel_sort(keys, pool, [](const ListKey& a, const ListKey& b) { return list_before(a, b); });
 
   std::vector<std::uint32_t> position(count);
   parallel_for(pool, count, kPointGrain, [&](std::size_t first, std::size_t last) {
-    for (std::size_t i = first; i < last; ++i) position[keys[i].node] = static_cast<std::uint32_t>(i);
+    for (std::size_t i = first; i < last; ++i) {
+      position[keys[i].node] = static_cast<std::uint32_t>(i);
+    }
   });
   for (auto* v : {&tree.center_x, &tree.center_y, &tree.center_z, &tree.normal_x, &tree.normal_y,
                   &tree.normal_z, &tree.diameter, &tree.error, &tree.parent_error}) {
@@ -461,7 +516,7 @@ void fill_list(const std::vector<BuildNode>& nodes, std::uint32_t chunk_level, b
       tree.normal_z[i] = nd.normal.z;
       tree.diameter[i] = nd.diameter;
       tree.error[i] = nd.error;
-      tree.parent_error[i] = keys[i].parent_error;
+      tree.parent_error[i] = nd.parent == kSptNoParent ? kInf : nodes[nd.parent].error;
       tree.is_leaf[i] = nd.leaf ? 1 : 0;
       tree.parent[i] = nd.parent == kSptNoParent ? kSptNoParent : position[nd.parent];
       if (has_colors) {
@@ -478,12 +533,12 @@ void fill_list(const std::vector<BuildNode>& nodes, std::uint32_t chunk_level, b
   tree.chunk_level = chunk_level;
   tree.chunks.resize(roots.size());
   std::uint32_t at = 0;
-  while (at < count && keys[at].range == 0) ++at;
+  while (at < count && range_of(keys[at]) == 0) ++at;
   tree.top_end = at;
   for (std::size_t k = 0; k < roots.size(); ++k) {
     SptChunk& chunk = tree.chunks[k];
     chunk.begin = at;
-    while (at < count && keys[at].range == k + 1) ++at;
+    while (at < count && range_of(keys[at]) == k + 1) ++at;
     chunk.end = at;
     const BuildNode& root = nodes[roots[k]];
     assert(position[roots[k]] == chunk.begin);
@@ -506,8 +561,19 @@ D3 operator-(D3 a, D3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
 D3 operator*(D3 a, double s) { return {a.x * s, a.y * s, a.z * s}; }
 D3 operator+(D3 a, D3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
 double dot(D3 a, D3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-D3 cross(D3 a, D3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+D3 cross(D3 a, D3 b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
 D3 unit(D3 a) { return a * (1.0 / std::sqrt(dot(a, a))); }
+
+// The directions of the tangential error: angles jπ/8, j = 0..7, from t1 towards t2.
+constexpr int kTangentDirections = 8;
+constexpr double kDirectionCos[kTangentDirections] = {
+    1.0, 0.92387953251128674,  0.70710678118654752,  0.38268343236508977,
+    0.0, -0.38268343236508977, -0.70710678118654752, -0.92387953251128674};
+constexpr double kDirectionSin[kTangentDirections] = {
+    0.0, 0.38268343236508977, 0.70710678118654752, 0.92387953251128674,
+    1.0, 0.92387953251128674, 0.70710678118654752, 0.38268343236508977};
 
 // Half-extent of a disc of radius r and unit normal m along the unit direction u.
 double disc_half_extent(double r, D3 m, D3 u) {
@@ -537,35 +603,37 @@ SptNodeGeometry spt_combine_children(std::span<const SptDisc> children) {
 
   // Everything below is measured from the stored (float) centre and normal.
   const D3 c0 = to_d3(g.center), n = unit(to_d3(g.normal));
-  double radius = 0, top = -INFINITY, bottom = INFINITY;
-  for (const SptDisc& c : children) {
-    const D3 d = to_d3(c.center) - c0;
-    const double r = c.radius;
-    radius = std::max(radius, std::sqrt(dot(d, d)) + r);
-    const double h = dot(d, n), s = disc_half_extent(r, unit(to_d3(normalized(c.normal))), n);
-    top = std::max(top, h + s);
-    bottom = std::min(bottom, h - s);
-  }
-  g.diameter = round_up(2 * radius);
-  g.perpendicular_error = static_cast<float>(top - bottom);
-
   // Plane frame: t1 from the world axis least aligned with n.
   const double ax = std::abs(n.x), ay = std::abs(n.y), az = std::abs(n.z);
   const D3 axis = ax <= ay && ax <= az ? D3{1, 0, 0} : (ay <= az ? D3{0, 1, 0} : D3{0, 0, 1});
   const D3 t1 = unit(axis - n * dot(axis, n)), t2 = cross(n, t1);
-  double narrowest = INFINITY;
-  for (int j = 0; j < 8; ++j) {
-    const double angle = j * (3.14159265358979323846 / 8);
-    const D3 u = t1 * std::cos(angle) + t2 * std::sin(angle);
-    double hi = -INFINITY, lo = INFINITY;
-    for (const SptDisc& c : children) {
-      const double h = dot(to_d3(c.center) - c0, u);
-      const double s = disc_half_extent(c.radius, unit(to_d3(normalized(c.normal))), u);
-      hi = std::max(hi, h + s);
-      lo = std::min(lo, h - s);
+
+  double radius = 0, top = -INFINITY, bottom = INFINITY;
+  double hi[kTangentDirections], lo[kTangentDirections];
+  std::fill(hi, hi + kTangentDirections, -INFINITY);
+  std::fill(lo, lo + kTangentDirections, INFINITY);
+  for (const SptDisc& c : children) {
+    const D3 d = to_d3(c.center) - c0;
+    const D3 m = unit(to_d3(normalized(c.normal)));
+    const double r = c.radius;
+    radius = std::max(radius, std::sqrt(dot(d, d)) + r);
+    const double h = dot(d, n), s = disc_half_extent(r, m, n);
+    top = std::max(top, h + s);
+    bottom = std::min(bottom, h - s);
+    // Along u = cos·t1 + sin·t2, both the offset and the normal component are linear in (cos, sin).
+    const double d1 = dot(d, t1), d2 = dot(d, t2), m1 = dot(m, t1), m2 = dot(m, t2);
+    for (int j = 0; j < kTangentDirections; ++j) {
+      const double cj = kDirectionCos[j], sj = kDirectionSin[j];
+      const double along = d1 * cj + d2 * sj, mu = m1 * cj + m2 * sj;
+      const double half = r * std::sqrt(std::max(0.0, 1.0 - mu * mu));
+      hi[j] = std::max(hi[j], along + half);
+      lo[j] = std::min(lo[j], along - half);
     }
-    narrowest = std::min(narrowest, hi - lo);
   }
+  g.diameter = round_up(2 * radius);
+  g.perpendicular_error = static_cast<float>(top - bottom);
+  double narrowest = INFINITY;
+  for (int j = 0; j < kTangentDirections; ++j) narrowest = std::min(narrowest, hi[j] - lo[j]);
   g.tangential_error = static_cast<float>(std::max(0.0, double(g.diameter) - narrowest));
   return g;
 }
@@ -585,7 +653,8 @@ SequentialPointTree build_sequential_point_tree(const PointSet& points, ThreadPo
   {
     ProgressPhase phase(progress, "hierarchy", points.size());
     const std::vector<MortonKey> keys = morton_order(points.positions, tree.bounds, pool);
-    const NodeMaker maker{keys, points, tree.has_colors, options.color_tolerance};
+    const std::vector<SortedSplat> splats = gather_splats(points, keys, pool);
+    const NodeMaker maker{keys, splats, tree.has_colors, options.color_tolerance};
     nodes = build_nodes(maker, options.parallel_grain_points, pool, phase);
   }
   ProgressPhase phase(progress, "sequential list", nodes.size());

@@ -199,8 +199,10 @@ TEST(SequentialPointTree, StructureMatchesTheDefinition) {
   const auto children = children_of(t);
   std::size_t roots = 0;
   for (std::uint32_t i = 0; i < count; ++i) {
-    if (t.parent[i] == kSptNoParent) ++roots;
-    else EXPECT_LT(t.parent[i], i) << "parents come first";
+    if (t.parent[i] == kSptNoParent)
+      ++roots;
+    else
+      EXPECT_LT(t.parent[i], i) << "parents come first";
     if (t.is_leaf[i]) {
       EXPECT_TRUE(children[i].empty());
       const auto it = by_position.find({t.center_x[i], t.center_y[i], t.center_z[i]});
@@ -301,6 +303,20 @@ TEST(SequentialPointTree, DuplicatePositionsStillGiveATree) {
   for (const auto& c : children_of(t)) EXPECT_LE(c.size(), 8u);
   expect_one_node_per_leaf(t, 0.01f, 0.5f);
   expect_one_node_per_leaf(t, 0.01f, 1e-6f);
+
+  // Nothing but one spot (an empty bounding box): a balanced tree of up to 8 children.
+  PointSet same;
+  same.positions.assign(100, {1, 1, 1});
+  same.normals.assign(100, {0, 1, 0});
+  same.radii.assign(100, 0.1f);
+  const SequentialPointTree s = build(same);
+  EXPECT_EQ(std::count(s.is_leaf.begin(), s.is_leaf.end(), 1), 100);
+  for (const auto& c : children_of(s)) EXPECT_LE(c.size(), 8u);
+  for (std::uint32_t i = 0; i < s.node_count(); ++i) {
+    EXPECT_EQ(s.error[i], 0.0f);  // coincident parallel discs: nothing to lose
+    EXPECT_FLOAT_EQ(s.diameter[i], 0.2f);
+  }
+  expect_one_node_per_leaf(s, 0.01f, 1.0f);
 }
 
 TEST(SequentialPointTree, TinyEpsilonDrawsEveryLeafAtCloseRange) {

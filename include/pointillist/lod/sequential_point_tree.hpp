@@ -52,16 +52,16 @@
 // Sequential list. The nodes are stored as parallel arrays (one entry per node) and grouped
 // into contiguous ranges, each sorted by r_max descending (parent_error descending; ties in
 // pre-order, so within a range a node never comes after its descendants):
-//   [0, top_end)                 the top list: interior nodes whose octree cell is above
-//                                `chunk_level` (coarser than depth chunk_level);
+//   [0, top_end)                 the top list: interior nodes whose points span more than
+//                                one octree cell at depth `chunk_level`;
 //   chunks[k].begin .. end       chunk k: one subtree whose points lie in one octree cell at
 //                                depth chunk_level; its root is its first node. Chunks follow
 //                                each other in Morton order of their cells and cover
 //                                [top_end, node_count()) without gaps.
 // With chunk_level = 0 the top list is empty and the single chunk is the paper's list: all
-// nodes sorted by r_max descending, root first. A renderer processes each range only up to the
-// first node whose r_max is below the smallest eye distance of the range's bounding sphere,
-// since no later node of the range can be drawn.
+// nodes sorted by r_max descending, root first. A renderer can stop a range at the first node
+// with r_max <= the smallest eye distance to the range's bounding sphere (for chunks,
+// `bounds`): no later node of the range can be drawn.
 #pragma once
 
 #include <cstdint>
@@ -90,9 +90,9 @@ struct SequentialPointTree {
   std::vector<float> center_x, center_y, center_z;  // disc centre (world units)
   std::vector<float> normal_x, normal_y, normal_z;  // unit disc normal
   std::vector<float> diameter;                      // disc / bounding-sphere diameter (world units)
-  std::vector<float> error;         // e_g (world units); r_min = error / ε; 0 for leaves
-  std::vector<float> parent_error;  // e_g of the parent; r_max = parent_error / ε; +inf at root
-  std::vector<Rgb8> colors;         // mean colour of the subtree; empty when !has_colors
+  std::vector<float> error;           // e_g (world units); r_min = error / ε; 0 for leaves
+  std::vector<float> parent_error;    // e_g of the parent; r_max = parent_error / ε; +inf at root
+  std::vector<Rgb8> colors;           // mean colour of the subtree; empty when !has_colors
   std::vector<std::uint8_t> is_leaf;  // 1 for input splats, 0 for interior nodes
   std::vector<std::uint32_t> parent;  // list index of the parent (always smaller); root:
                                       // kSptNoParent
