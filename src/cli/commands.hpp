@@ -30,8 +30,12 @@ struct ViewOptions {
   std::optional<Vec3f> eye, target, up;
 };
 
+enum class LodScheme { QSplat, Spt };
+
 struct RenderOptions {
   std::string input;
+  LodScheme lod = LodScheme::QSplat;  // --lod qsplat|spt
+  float epsilon_px = 1.0f;            // --epsilon (spt)
   std::string output;
   ViewOptions view;
   RenderSettings settings;
@@ -48,9 +52,16 @@ struct RenderOptions {
 };
 int run_render(const RenderOptions& options);
 
+// The camera of `view` for a model: the orbit around tree.view_sphere, or the explicit
+// eye/target/up. Throws OptionError when only one of --eye/--target is given.
+Camera make_camera(const ViewOptions& view, const SphereTreeView& tree);
+
 struct InfoOptions {
   std::string input;
   unsigned threads = 0;
+  bool spt = false;        // --spt: build the Sequential Point Tree and report its list
+  ViewOptions view;        // for the SPT report: the view whose scanned fraction is given
+  float epsilon_px = 1.0f;
 };
 int run_info(const InfoOptions& options);
 

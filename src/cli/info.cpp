@@ -1,8 +1,11 @@
+#include <algorithm>
 #include <array>
 #include <cstdio>
 
 #include "cli/commands.hpp"
 #include "cli/model_loading.hpp"
+#include "pointillist/lod/sequential_point_tree.hpp"
+#include "pointillist/render/spt_render.hpp"
 
 namespace pointillist::cli {
 
@@ -51,6 +54,31 @@ int run_info(const InfoOptions& o) {
               t.view_sphere.radius);
   std::printf("file size:   %s (%.2f bytes/point)\n", human_bytes(double(model.file_size)).c_str(),
               leaves > 0 ? double(model.file_size) / leaves : 0.0);
+  if (o.spt) {
+    const SequentialPointTree spt = build_sequential_point_tree(sphere_tree_leaves(t), pool);
+    std::printf("sequential point tree (built in memory, chunk level %u):\n", spt.chunk_level);
+    std::printf("  list:      %zu entries (%.3f per point), top list %u, %zu chunks\n",
+                spt.node_count(), leaves > 0 ? double(spt.node_count()) / leaves : 0.0, spt.top_end,
+                spt.chunks.size());
+    const Camera camera = make_camera(o.view, t);
+    SplatStream stream;
+    SptSelectionStats s;
+    select_splats_spt(spt, make_camera_frame(camera), RenderSettings{}, {.epsilon_px = o.epsilon_px},
+                      pool, stream, s);
+    SptSelectionStats unculled;
+    select_splats_spt(spt, make_camera_frame(camera), RenderSettings{},
+                      {.epsilon_px = o.epsilon_px, .chunk_culling = false}, pool, stream, unculled);
+    std::printf("  view %g,%g at %dx%d, epsilon %g px: scans %llu entries (%.1f%% of the list; "
+                "%.1f%% without chunk culling), draws %llu splats, culls %llu of %llu chunks\n",
+                o.view.azimuth_deg, o.view.elevation_deg, o.view.width, o.view.height, o.epsilon_px,
+                static_cast<unsigned long long>(s.entries_scanned),
+                100.0 * double(s.entries_scanned) / double(std::max<std::uint64_t>(1, s.entries_total)),
+                100.0 * double(unculled.entries_scanned) /
+                    double(std::max<std::uint64_t>(1, unculled.entries_total)),
+                static_cast<unsigned long long>(s.splats),
+                static_cast<unsigned long long>(s.chunks_culled),
+                static_cast<unsigned long long>(s.chunks_total));
+  }
   if (!model.metadata.empty()) {
     std::printf("metadata:\n");
     std::size_t start = 0;

@@ -41,6 +41,23 @@ std::vector<float> parse_floats(const std::string& text, std::size_t count, cons
   return values;
 }
 
+// --size WxH and --view AZ,EL (may be empty) into `v`.
+void parse_size_and_view(const std::string& size, const std::string& view, pc::ViewOptions& v) {
+  const auto wh = parse_floats(size, 2, 'x', "--size");
+  v.width = static_cast<int>(wh[0]);
+  v.height = static_cast<int>(wh[1]);
+  if (wh[0] < 1 || wh[1] < 1 || wh[0] > 32768 || wh[1] > 32768 || wh[0] != v.width ||
+      wh[1] != v.height) {
+    throw pointillist::OptionError("--size '" + size +
+                                   "': width and height must be whole numbers from 1 to 32768");
+  }
+  if (!view.empty()) {
+    const auto ae = parse_floats(view, 2, ',', "--view");
+    v.azimuth_deg = ae[0];
+    v.elevation_deg = ae[1];
+  }
+}
+
 // "orbit:N" (1 <= N <= 100000) -> N.
 unsigned parse_orbit_path(const std::string& text) {
   const std::string prefix = "orbit:";
@@ -147,6 +164,17 @@ int main(int argc, char** argv) {
       ->default_str("0,0,0");
   render_cmd->add_option("--depth", render.depth_output, "Also write a 16-bit depth PNG");
   render_cmd->add_option("--stats", render.stats_output, "Write statistics as JSON (- = stdout)");
+  const std::map<std::string, pc::LodScheme> lods{{"qsplat", pc::LodScheme::QSplat},
+                                                  {"spt", pc::LodScheme::Spt}};
+  render_cmd->add_option("--lod", render.lod,
+                         "Level-of-detail scheme: qsplat (hierarchy traversal) or spt (Sequential "
+                         "Point Tree, one sequential pass)")
+      ->transform(CLI::CheckedTransformer(lods, CLI::ignore_case))
+      ->default_str("qsplat");
+  render_cmd->add_option("--epsilon", render.epsilon_px,
+                         "With --lod spt: allowed geometric error in pixels (1 = full detail)")
+      ->default_val(1.0f)
+      ->check(CLI::Range(0.001f, 1000.0f));
   std::string path;
   render_cmd->add_option("--path", path,
                          "Render a sequence of frames along a camera path: orbit:N = N frames "
@@ -170,6 +198,15 @@ int main(int argc, char** argv) {
   info_cmd->add_option("input", info.input, "Model or scan file")->required()->check(
       CLI::ExistingFile);
   add_threads(info_cmd, info.threads);
+  std::string info_view, info_size = "1280x720";
+  info_cmd->add_flag("--spt", info.spt,
+                     "Also build the Sequential Point Tree and report its list and the share of "
+                     "it one view scans");
+  info_cmd->add_option("--view", info_view, "With --spt: orbit view AZ,EL (default 0,0)");
+  info_cmd->add_option("--size", info_size, "With --spt: image size WxH")->default_str("1280x720");
+  info_cmd->add_option("--epsilon", info.epsilon_px, "With --spt: error bound, pixels")
+      ->default_val(1.0f)
+      ->check(CLI::Range(0.001f, 1000.0f));
 
   // demo
   pc::DemoOptions demo;
@@ -224,18 +261,7 @@ int main(int argc, char** argv) {
   try {
     if (*convert_cmd) return pc::run_convert(convert);
     if (*render_cmd) {
-      const auto wh = parse_floats(size, 2, 'x', "--size");
-      render.view.width = static_cast<int>(wh[0]);
-      render.view.height = static_cast<int>(wh[1]);
-      if (wh[0] < 1 || wh[1] < 1 || wh[0] > 32768 || wh[1] > 32768 ||
-          wh[0] != render.view.width || wh[1] != render.view.height) {
-        throw OptionError("--size '" + size + "': width and height must be whole numbers from 1 to 32768");
-      }
-      if (!view.empty()) {
-        const auto ae = parse_floats(view, 2, ',', "--view");
-        render.view.azimuth_deg = ae[0];
-        render.view.elevation_deg = ae[1];
-      }
+      parse_size_and_view(size, view, render.view);
       if (!eye.empty()) render.view.eye = parse_vec3(eye, "--eye");
       if (!target.empty()) render.view.target = parse_vec3(target, "--target");
       if (!up.empty()) render.view.up = parse_vec3(up, "--up");
@@ -243,7 +269,10 @@ int main(int argc, char** argv) {
       if (!path.empty()) render.orbit_frames = parse_orbit_path(path);
       return pc::run_render(render);
     }
-    if (*info_cmd) return pc::run_info(info);
+    if (*info_cmd) {
+      parse_size_and_view(info_size, info_view, info.view);
+      return pc::run_info(info);
+    }
     if (*demo_cmd) return pc::run_demo(demo);
     if (*generate_cmd) return pc::run_generate(generate);
     if (*compare_cmd) {

@@ -15,6 +15,7 @@
 #include "pointillist/io/png.hpp"
 #include "pointillist/render/depth_image.hpp"
 #include "pointillist/render/frame_control.hpp"
+#include "pointillist/render/spt_render.hpp"
 
 namespace pointillist::cli {
 
@@ -86,24 +87,70 @@ void check_sequence_options(const RenderOptions& o) {
   }
 }
 
+// Draws one frame with either level-of-detail scheme; `detail` is the QSplat threshold or the
+// SPT error bound (pixels).
+class FrameRenderer {
+ public:
+  FrameRenderer(const RenderOptions& o, const SphereTreeView& tree, ThreadPool& pool,
+                Progress& progress)
+      : o_(o), tree_(tree), pool_(pool) {
+    if (o.lod == LodScheme::Spt) {
+      spt_ = build_sequential_point_tree(sphere_tree_leaves(tree), pool, progress);
+    }
+  }
+  float initial_detail() const {
+    return o_.lod == LodScheme::Spt ? o_.epsilon_px : o_.settings.threshold_px;
+  }
+  void draw(const Camera& camera, float detail, Frame& frame) {
+    RenderSettings settings = o_.settings;
+    if (o_.lod == LodScheme::Spt) {
+      render_spt(spt_, camera, settings, {.epsilon_px = detail}, pool_, frame, &spt_stats_);
+    } else {
+      settings.threshold_px = detail;
+      render(tree_, camera, settings, pool_, frame);
+    }
+  }
+  // Extra --stats lines for the last frame.
+  std::string extra_json() const {
+    if (o_.lod != LodScheme::Spt) return "  \"lod\": \"qsplat\",\n";
+    char buf[512];
+    std::snprintf(buf, sizeof buf,
+                  "  \"lod\": \"spt\",\n  \"list_length\": %llu,\n  \"entries_scanned\": %llu,\n"
+                  "  \"fraction_scanned\": %.4f,\n  \"chunks\": %llu,\n  \"chunks_culled\": %llu,\n",
+                  static_cast<unsigned long long>(spt_stats_.entries_total),
+                  static_cast<unsigned long long>(spt_stats_.entries_scanned),
+                  spt_stats_.entries_total
+                      ? double(spt_stats_.entries_scanned) / double(spt_stats_.entries_total)
+                      : 0.0,
+                  static_cast<unsigned long long>(spt_stats_.chunks_total),
+                  static_cast<unsigned long long>(spt_stats_.chunks_culled));
+    return buf;
+  }
+
+ private:
+  const RenderOptions& o_;
+  const SphereTreeView& tree_;
+  ThreadPool& pool_;
+  SequentialPointTree spt_;
+  SptSelectionStats spt_stats_;
+};
+
 // Renders the path (and/or the idle refinement) a viewer would show; returns every frame's record
 // and leaves the last frame in `frame`.
 std::vector<FrameRecord> render_sequence(const RenderOptions& o, const SphereTreeView& tree,
-                                         ThreadPool& pool, Frame& frame) {
+                                         FrameRenderer& renderer, Frame& frame) {
   check_sequence_options(o);
-  const float finest = std::min(1.0f, o.settings.threshold_px);
+  const float start = renderer.initial_detail();
+  const float finest = std::min(1.0f, start);
   std::optional<FrameTimeController> control;
   if (o.frame_ms > 0) {
-    control.emplace(FrameControlOptions{.target_ms = o.frame_ms, .finest = finest},
-                    o.settings.threshold_px);
+    control.emplace(FrameControlOptions{.target_ms = o.frame_ms, .finest = finest}, start);
   }
   std::vector<FrameRecord> records;
-  RenderSettings settings = o.settings;
   ViewOptions view = o.view;
-  auto draw = [&](const char* phase, float threshold) {
-    settings.threshold_px = threshold;
-    render(tree, make_camera(view, tree), settings, pool, frame);
-    records.push_back({phase, view.azimuth_deg, threshold, frame.stats});
+  auto draw = [&](const char* phase, float detail) {
+    renderer.draw(make_camera(view, tree), detail, frame);
+    records.push_back({phase, view.azimuth_deg, detail, frame.stats});
     if (!o.frames_out.empty()) {
       write_png_rgb8(frame_path(o.frames_out, records.size() - 1), frame.width, frame.height,
                      frame.color);
@@ -112,14 +159,12 @@ std::vector<FrameRecord> render_sequence(const RenderOptions& o, const SphereTre
   for (unsigned i = 0; i < o.orbit_frames; ++i) {
     view.azimuth_deg = o.view.azimuth_deg + 360.0f * static_cast<float>(i) /
                                                 static_cast<float>(o.orbit_frames);
-    draw("path", control ? control->parameter() : o.settings.threshold_px);
+    draw("path", control ? control->parameter() : start);
     if (control) control->report(frame.stats.ms_total);
   }
   if (o.refine_frames > 0) {
-    const float start = control ? control->parameter() : o.settings.threshold_px;
-    for (float threshold : refinement_sequence(start, finest, o.refine_frames)) {
-      draw("refine", threshold);
-    }
+    const float from = control ? control->parameter() : start;
+    for (float detail : refinement_sequence(from, finest, o.refine_frames)) draw("refine", detail);
   }
   return records;
 }
@@ -130,24 +175,27 @@ int run_render(const RenderOptions& o) {
   ThreadPool pool(o.threads);
   TerminalProgress progress(!o.quiet && TerminalProgress::stderr_is_terminal());
   const LoadedModel model = LoadedModel::open(o.input, o.prepare, pool, progress);
+  FrameRenderer renderer(o, model.tree(), pool, progress);
   Frame frame;
   const bool sequence =
       o.orbit_frames > 0 || o.refine_frames > 0 || o.frame_ms > 0 || !o.frames_out.empty();
   std::vector<FrameRecord> records;
   if (sequence) {
-    records = render_sequence(o, model.tree(), pool, frame);
+    records = render_sequence(o, model.tree(), renderer, frame);
   } else {
-    render(model.tree(), make_camera(o.view, model.tree()), o.settings, pool, frame);
+    renderer.draw(make_camera(o.view, model.tree()), renderer.initial_detail(), frame);
   }
   write_png_rgb8(o.output, frame.width, frame.height, frame.color);
   if (!o.depth_output.empty()) {
     const auto depth16 = depth_to_gray16(frame);
     write_png_gray16(o.depth_output, frame.width, frame.height, depth16);
   }
-  const float finest = std::min(1.0f, o.settings.threshold_px);
+  const float finest = std::min(1.0f, renderer.initial_detail());
   if (!o.stats_output.empty()) {
-    write_text(o.stats_output, sequence ? sequence_to_json(records, o.frame_ms, kSettleFrames, finest)
-                                        : stats_to_json(frame.stats));
+    const std::string extra = renderer.extra_json();
+    write_text(o.stats_output,
+               sequence ? sequence_to_json(records, o.frame_ms, kSettleFrames, finest, extra)
+                        : stats_to_json(frame.stats, extra));
   }
   if (o.quiet || o.stats_output == "-") return 0;
   if (sequence) {

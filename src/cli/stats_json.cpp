@@ -4,8 +4,8 @@
 
 namespace pointillist::cli {
 
-std::string stats_to_json(const RenderStats& s) {
-  char buf[1024];
+std::string stats_to_json(const RenderStats& s, const std::string& extra) {
+  char buf[2048];
   std::snprintf(buf, sizeof buf,
                 "{\n"
                 "  \"splats\": %llu,\n"
@@ -15,13 +15,14 @@ std::string stats_to_json(const RenderStats& s) {
                 "  \"width\": %d,\n"
                 "  \"height\": %d,\n"
                 "  \"threads\": %u,\n"
+                "%s"
                 "  \"ms\": {\"select\": %.3f, \"raster\": %.3f, \"total\": %.3f}\n"
                 "}\n",
                 static_cast<unsigned long long>(s.splats),
                 static_cast<unsigned long long>(s.nodes_visited),
                 static_cast<unsigned long long>(s.culled_frustum),
                 static_cast<unsigned long long>(s.culled_backface), s.width, s.height, s.threads,
-                s.ms_select, s.ms_raster, s.ms_total);
+                extra.c_str(), s.ms_select, s.ms_raster, s.ms_total);
   return buf;
 }
 
@@ -40,8 +41,9 @@ double hit_rate(const std::vector<FrameRecord>& frames, double target_ms, std::s
 }
 
 std::string sequence_to_json(const std::vector<FrameRecord>& frames, double target_ms,
-                             std::size_t settle, float finest) {
-  std::string json = frames.empty() ? std::string("{\n}\n") : stats_to_json(frames.back().stats);
+                             std::size_t settle, float finest, const std::string& extra) {
+  std::string json =
+      frames.empty() ? std::string("{\n}\n") : stats_to_json(frames.back().stats, extra);
   json.erase(json.rfind('}'));  // reopen the object
   while (!json.empty() && (json.back() == '\n' || json.back() == ' ')) json.pop_back();
   char buf[512];

@@ -9,13 +9,14 @@
 namespace pointillist::cli {
 
 // {"splats": ..., "nodes_visited": ..., ..., "ms": {"select": .., "raster": .., "total": ..}}
-std::string stats_to_json(const RenderStats& stats);
+// `extra` (zero or more `  "key": value,\n` lines) goes before "ms".
+std::string stats_to_json(const RenderStats& stats, const std::string& extra = "");
 
 // One frame of a sequence (render --path / --refine / --frame-ms).
 struct FrameRecord {
   const char* phase;    // "path" or "refine"
   float azimuth_deg;
-  float threshold_px;   // level of detail the frame was rendered with
+  float threshold_px;   // level of detail the frame was rendered with (threshold, or SPT ε)
   RenderStats stats;
 };
 
@@ -26,6 +27,6 @@ struct FrameRecord {
 double hit_rate(const std::vector<FrameRecord>& frames, double target_ms, std::size_t settle,
                 float finest);
 std::string sequence_to_json(const std::vector<FrameRecord>& frames, double target_ms,
-                             std::size_t settle, float finest);
+                             std::size_t settle, float finest, const std::string& extra = "");
 
 }  // namespace pointillist::cli

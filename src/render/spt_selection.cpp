@@ -32,13 +32,15 @@ struct Block {
 struct ViewConstants {
   Vec3f eye, right, up, forward;
   float focal_px, half_w, half_h, width, height;
-  float epsilon2;  // (epsilon_px / f)²: compared with error² / r²
-  bool backface;
+  float epsilon2;      // (epsilon_px / f)²: compared with error² / r²
+  float facing_limit;  // 0 with backface culling (drop (c − eye)·n > 0), else +infinity
 };
 
-// Entry i of [begin, end) is selected (mask 1) iff error² ≤ r²ε² < parent_error² and, with
-// backface culling, (c − eye)·n ≤ 0 (mask 2: in its interval but facing away). Written without branches over the structure-of-arrays so
-// that GCC vectorizes it (-O2 and -O3 both: see the -fopt-info-vec note in the README).
+// Entry i of [begin, end) is selected (mask 1) iff error² ≤ r²ε² < parent_error² and it faces the
+// eye, (c − eye)·n ≤ facing_limit (mask 2: in its interval but facing away). Written without
+// branches over the structure-of-arrays so that GCC vectorizes it (at -O3, which the release build
+// uses: check with -fopt-info-vec). Testing the facing here, on every scanned entry, is cheaper
+// than projecting and shading the backfacing half of the selection only to drop it.
 void select_mask(const SequentialPointTree& t, std::uint32_t begin, std::uint32_t end,
                  const ViewConstants& v, std::uint8_t* __restrict mask) {
   const float* __restrict cx = t.center_x.data() + begin;
@@ -50,14 +52,13 @@ void select_mask(const SequentialPointTree& t, std::uint32_t begin, std::uint32_
   const float* __restrict err = t.error.data() + begin;
   const float* __restrict perr = t.parent_error.data() + begin;
   const float ex = v.eye.x, ey = v.eye.y, ez = v.eye.z, eps2 = v.epsilon2;
-  const float facing_limit = v.backface ? 0.0f : std::numeric_limits<float>::infinity();
+  const float facing_limit = v.facing_limit;
   const std::uint32_t n = end - begin;
   for (std::uint32_t i = 0; i < n; ++i) {
     const float dx = cx[i] - ex, dy = cy[i] - ey, dz = cz[i] - ez;
     const float re2 = (dx * dx + dy * dy + dz * dz) * eps2;
     const float facing = dx * nx[i] + dy * ny[i] + dz * nz[i];
     const int in = (err[i] * err[i] <= re2) & (re2 < perr[i] * perr[i]);
-    // 1: draw; 2: in its interval but facing away; 0: not in its interval.
     mask[i] = static_cast<std::uint8_t>(in + (in & (facing > facing_limit)));
   }
 }
@@ -84,95 +85,98 @@ struct BlockCounters {
   std::uint64_t scanned = 0, backface = 0, frustum = 0;
 };
 
-// Selects, projects and shades the entries of one block into `out`.
+// Selects, projects and shades the entries of one block into `out`. Per tile: the vectorized
+// mask pass, a compaction of the selected indices, then projection and shading four splats at a
+// time, keeping the lanes in front of the eye and on the image.
 void run_block(const SequentialPointTree& t, Block b, const ViewConstants& v,
                const render_detail::Shader& shader, bool with_colors, SplatChunk& out,
                BlockCounters& counters) {
   using render_detail::Float4;
   using render_detail::Int4;
+  using render_detail::kLanes;
+  using render_detail::splat4;
   out.count = 0;
   std::uint8_t mask[kTile];
-  std::uint32_t selected[kTile];
+  std::uint32_t selected[kTile + kLanes];
   counters.scanned += b.end - b.begin;
+  const Vec3f base_color = shader.base_color();
+  const float* cx = t.center_x.data();
+  const float* cy = t.center_y.data();
+  const float* cz = t.center_z.data();
   for (std::uint32_t tile = b.begin; tile < b.end; tile += kTile) {
     const std::uint32_t tile_end = std::min(b.end, tile + kTile);
     select_mask(t, tile, tile_end, v, mask);
     std::uint32_t k = 0;
+    std::uint64_t backface = 0;
     for (std::uint32_t i = 0; i < tile_end - tile; ++i) {
       selected[k] = tile + i;
       k += mask[i] == 1;
-      counters.backface += mask[i] == 2;
+      backface += mask[i] == 2;
     }
+    counters.backface += backface;
     if (k == 0) continue;
-    out.reserve(out.count + k, with_colors);
-    for (std::uint32_t s = 0; s < k; ++s) {
-      const std::uint32_t i = selected[s];
-      const Vec3f d{t.center_x[i] - v.eye.x, t.center_y[i] - v.eye.y, t.center_z[i] - v.eye.z};
-      const float z = dot(d, v.forward);
-      if (!(z > 0)) {
-        ++counters.frustum;
-        continue;
+    // Pad to whole groups with the last selected entry (its lanes are dropped below).
+    for (std::uint32_t p = k; p % kLanes; ++p) selected[p] = selected[k - 1];
+    out.reserve(out.count + k + kLanes, with_colors);
+    for (std::uint32_t g = 0; g < k; g += kLanes) {
+      const std::uint32_t* idx = selected + g;
+      const Float4 dx = Float4{cx[idx[0]], cx[idx[1]], cx[idx[2]], cx[idx[3]]} - v.eye.x;
+      const Float4 dy = Float4{cy[idx[0]], cy[idx[1]], cy[idx[2]], cy[idx[3]]} - v.eye.y;
+      const Float4 dz = Float4{cz[idx[0]], cz[idx[1]], cz[idx[2]], cz[idx[3]]} - v.eye.z;
+      const Float4 z = dx * v.forward.x + dy * v.forward.y + dz * v.forward.z;
+      const Float4 inv_z = 1.0f / render_detail::max4(splat4(1e-30f), z);
+      const Float4 x = v.half_w + v.focal_px * (dx * v.right.x + dy * v.right.y + dz * v.right.z) * inv_z;
+      const Float4 y = v.half_h - v.focal_px * (dx * v.up.x + dy * v.up.y + dz * v.up.z) * inv_z;
+      const Float4 diameter{t.diameter[idx[0]], t.diameter[idx[1]], t.diameter[idx[2]],
+                            t.diameter[idx[3]]};
+      const Float4 size = diameter * v.focal_px * inv_z;
+      // Kept: in front of the eye, not a hair in front of it, and touching the image (with a
+      // pixel of margin: a splat below a pixel still draws the pixel holding its centre).
+      const Float4 half = 0.5f * size + 1.0f;
+      const Int4 visible = (z > 0.0f) & (size < kMaxCoordinate) & (x + half >= 0.0f) &
+                           (x - half <= v.width) & (y + half >= 0.0f) & (y - half <= v.height);
+      Float4 normal[3], to_eye[3], base[3];
+      normal[0] = Float4{t.normal_x[idx[0]], t.normal_x[idx[1]], t.normal_x[idx[2]], t.normal_x[idx[3]]};
+      normal[1] = Float4{t.normal_y[idx[0]], t.normal_y[idx[1]], t.normal_y[idx[2]], t.normal_y[idx[3]]};
+      normal[2] = Float4{t.normal_z[idx[0]], t.normal_z[idx[1]], t.normal_z[idx[2]], t.normal_z[idx[3]]};
+      // Shading (as the QSplat traversal's finish_chunk): normal, unit vector to the eye, base.
+      const Float4 inv_len = 1.0f / render_detail::sqrt4(
+          render_detail::max4(splat4(1e-30f), dx * dx + dy * dy + dz * dz));
+      to_eye[0] = -dx * inv_len;
+      to_eye[1] = -dy * inv_len;
+      to_eye[2] = -dz * inv_len;
+      if (with_colors) {
+        constexpr float kScale = 1.0f / 255.0f;
+        const Rgb8* col = t.colors.data();
+        base[0] = Float4{float(col[idx[0]].r), float(col[idx[1]].r), float(col[idx[2]].r),
+                         float(col[idx[3]].r)} * kScale;
+        base[1] = Float4{float(col[idx[0]].g), float(col[idx[1]].g), float(col[idx[2]].g),
+                         float(col[idx[3]].g)} * kScale;
+        base[2] = Float4{float(col[idx[0]].b), float(col[idx[1]].b), float(col[idx[2]].b),
+                         float(col[idx[3]].b)} * kScale;
+      } else {
+        for (int c = 0; c < 3; ++c) base[c] = splat4(base_color[c]);
       }
-      const float inv_z = 1.0f / z;
-      const float x = v.half_w + v.focal_px * dot(d, v.right) * inv_z;
-      const float y = v.half_h - v.focal_px * dot(d, v.up) * inv_z;
-      const float size = t.diameter[i] * v.focal_px * inv_z;
-      const float half = 0.5f * size + 1.0f;
-      // Outside the image (with a pixel of margin: a tiny splat still draws its pixel) or a
-      // hair in front of the eye.
-      if (!(x + half >= 0 && x - half <= v.width && y + half >= 0 && y - half <= v.height &&
-            size < kMaxCoordinate)) {
-        ++counters.frustum;
-        continue;
+      Int4 rgb[3];
+      shader.shade4(normal, to_eye, base, rgb);
+      const Int4 packed = rgb[0] | rgb[1] << 8 | rgb[2] << 16;
+      const std::uint32_t lanes = std::min<std::uint32_t>(kLanes, k - g);
+      for (std::uint32_t l = 0; l < lanes; ++l) {
+        // Written unconditionally, kept by advancing the count (no branch on the lane).
+        const std::size_t o = out.count;
+        out.x_px[o] = x[l];
+        out.y_px[o] = y[l];
+        out.depth[o] = z[l];
+        out.size_px[o] = size[l];
+        out.shaded[o] = static_cast<std::uint32_t>(packed[l]);
+        out.node[o] = idx[l];
+        out.normal[o] = Vec3f{normal[0][l], normal[1][l], normal[2][l]};
+        if (with_colors) out.color[o] = t.colors[idx[l]];
+        const bool kept = visible[l] != 0;
+        out.count += kept;
+        counters.frustum += !kept;
       }
-      const std::size_t o = out.count++;
-      out.x_px[o] = x;
-      out.y_px[o] = y;
-      out.depth[o] = z;
-      out.size_px[o] = size;
-      out.node[o] = i;
-      out.normal[o] = Vec3f{t.normal_x[i], t.normal_y[i], t.normal_z[i]};
-      if (with_colors) out.color[o] = t.colors[i];
     }
-  }
-  // Shading, four splats at a time (as the QSplat traversal's finish_chunk).
-  const Vec3f base_color = shader.base_color();
-  for (std::size_t i = 0; i < out.count; i += render_detail::kLanes) {
-    const std::size_t lanes = std::min<std::size_t>(render_detail::kLanes, out.count - i);
-    std::size_t idx[render_detail::kLanes];
-    for (std::size_t l = 0; l < render_detail::kLanes; ++l) idx[l] = i + std::min(l, lanes - 1);
-    Float4 normal[3], to_eye[3], base[3];
-    for (int c = 0; c < 3; ++c) {
-      normal[c] = Float4{out.normal[idx[0]][c], out.normal[idx[1]][c], out.normal[idx[2]][c],
-                         out.normal[idx[3]][c]};
-    }
-    const std::uint32_t* node = out.node.data();
-    to_eye[0] = v.eye.x - Float4{t.center_x[node[idx[0]]], t.center_x[node[idx[1]]],
-                                 t.center_x[node[idx[2]]], t.center_x[node[idx[3]]]};
-    to_eye[1] = v.eye.y - Float4{t.center_y[node[idx[0]]], t.center_y[node[idx[1]]],
-                                 t.center_y[node[idx[2]]], t.center_y[node[idx[3]]]};
-    to_eye[2] = v.eye.z - Float4{t.center_z[node[idx[0]]], t.center_z[node[idx[1]]],
-                                 t.center_z[node[idx[2]]], t.center_z[node[idx[3]]]};
-    const Float4 inv_len = 1.0f / render_detail::sqrt4(to_eye[0] * to_eye[0] +
-                                                       to_eye[1] * to_eye[1] +
-                                                       to_eye[2] * to_eye[2]);
-    for (Float4& e : to_eye) e *= inv_len;
-    if (with_colors) {
-      constexpr float kScale = 1.0f / 255.0f;
-      const Rgb8* col = out.color.data();
-      base[0] = Float4{float(col[idx[0]].r), float(col[idx[1]].r), float(col[idx[2]].r),
-                       float(col[idx[3]].r)} * kScale;
-      base[1] = Float4{float(col[idx[0]].g), float(col[idx[1]].g), float(col[idx[2]].g),
-                       float(col[idx[3]].g)} * kScale;
-      base[2] = Float4{float(col[idx[0]].b), float(col[idx[1]].b), float(col[idx[2]].b),
-                       float(col[idx[3]].b)} * kScale;
-    } else {
-      for (int c = 0; c < 3; ++c) base[c] = render_detail::splat4(base_color[c]);
-    }
-    Int4 rgb[3];
-    shader.shade4(normal, to_eye, base, rgb);
-    const Int4 packed = rgb[0] | rgb[1] << 8 | rgb[2] << 16;
-    for (std::size_t l = 0; l < lanes; ++l) out.shaded[i + l] = static_cast<std::uint32_t>(packed[l]);
   }
 }
 
@@ -206,7 +210,7 @@ void select_splats_spt(const SequentialPointTree& tree, const CameraFrame& camer
   v.height = static_cast<float>(camera.height);
   const float epsilon = options.epsilon_px / camera.focal_px;  // world error per unit distance
   v.epsilon2 = epsilon * epsilon;
-  v.backface = settings.backface_culling;
+  v.facing_limit = settings.backface_culling ? 0.0f : std::numeric_limits<float>::infinity();
 
   // The ranges to scan and their prefixes, cut into blocks.
   std::vector<Block> blocks;

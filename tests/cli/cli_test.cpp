@@ -218,3 +218,23 @@ TEST(Cli, BadSequenceOptionsAreExplained) {
   EXPECT_NE(r.exit_code, 0);
   EXPECT_THAT(r.output, HasSubstr("--eye"));
 }
+
+TEST(Cli, SequentialPointTreeRenderAndInfo) {
+  pointillist::testing::TempDir dir;
+  const auto ply = dir.file("scene.ply");
+  ASSERT_EQ(run("generate --scene torus --points 20000 -o " + ply).exit_code, 0);
+  const Result r = run("render " + ply + " -o " + dir.file("spt.png") +
+                       " --size 160x120 --lod spt --epsilon 2 --stats -");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("\"lod\": \"spt\""));
+  EXPECT_THAT(r.output, HasSubstr("\"fraction_scanned\""));
+  EXPECT_THAT(r.output, HasSubstr("\"list_length\""));
+  const ImageRgb8 img = read_png_rgb8(dir.file("spt.png"));
+  const Rgb8 centre_left = img.pixels[60 * 160 + 40];  // on the torus ring
+  EXPECT_GT(int(centre_left.r) + centre_left.g + centre_left.b, 60);
+  const Result i = run("info " + ply + " --spt --view 30,20 --epsilon 1");
+  ASSERT_EQ(i.exit_code, 0) << i.output;
+  EXPECT_THAT(i.output, HasSubstr("sequential point tree"));
+  EXPECT_THAT(i.output, HasSubstr("% of the list"));
+  EXPECT_NE(run("render " + ply + " -o " + dir.file("x.png") + " --lod octree").exit_code, 0);
+}

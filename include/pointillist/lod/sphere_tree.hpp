@@ -79,4 +79,9 @@ SphereTree build_sphere_tree(const PointSet& points, ThreadPool& pool,
                              Progress& progress = Progress::none(),
                              const SphereTreeOptions& options = {});
 
+// The leaves of a hierarchy as splats: positions = leaf centres, normals, radii and (when the
+// tree has them) colors, in node order. Lets another level-of-detail structure (e.g. a Sequential
+// Point Tree) be built from a model file that stores a sphere tree.
+PointSet sphere_tree_leaves(const SphereTreeView& tree);
+
 }  // namespace pointillist
