@@ -80,7 +80,7 @@ TEST(Dragon, SequentialPointTreeImageMatchesTheQsplatTraversal) {
   const SequentialPointTree spt = build_sequential_point_tree(splats, pool);
   for (float az : {0.0f, 150.0f}) {
     const Camera cam = orbit_camera(tree.view_sphere,
-                                    {.azimuth_deg = az, .elevation_deg = 10, .width = 640, .height = 360});
+                                    {.azimuth_deg = az, .elevation_deg = 10, .width = 1280, .height = 720});
     Frame q, s;
     render(tree.view(), cam, RenderSettings{}, pool, q);
     SptSelectionStats tiny;
