@@ -1,0 +1,102 @@
+// read_point_file: the reader is chosen by the file name's extension alone, so a file is never
+// half-parsed as the wrong format.
+#include "pointillist/io/point_file.hpp"
+
+#include <cctype>
+#include <charconv>
+#include <string_view>
+
+#include "pointillist/core/error.hpp"
+#include "pointillist/io/las.hpp"
+#include "pointillist/io/obj.hpp"
+#include "pointillist/io/ply.hpp"
+#include "pointillist/io/xyz.hpp"
+
+namespace pointillist {
+namespace {
+
+enum class Kind { Unknown, Ply, Text, Obj, Las, Laz };
+
+struct Extension {
+  const char* suffix;
+  Kind kind;
+};
+
+// Longer suffixes first, so ".ply.gz" wins over ".gz".
+constexpr Extension kExtensions[] = {
+    {".ply.gz", Kind::Ply}, {".xyz.gz", Kind::Text}, {".pts.gz", Kind::Text},
+    {".csv.gz", Kind::Text}, {".txt.gz", Kind::Text}, {".obj.gz", Kind::Obj},
+    {".las.gz", Kind::Las}, {".ply", Kind::Ply},      {".xyz", Kind::Text},
+    {".pts", Kind::Text},    {".csv", Kind::Text},    {".txt", Kind::Text},
+    {".obj", Kind::Obj},     {".las", Kind::Las},     {".laz", Kind::Laz}};
+
+Kind kind_of(const std::string& path) {
+  // Only the file name counts, not a folder called "scans.ply".
+  const std::size_t slash = path.find_last_of('/');
+  std::string name = path.substr(slash == std::string::npos ? 0 : slash + 1);
+  for (char& c : name) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  for (const Extension& e : kExtensions) {
+    const std::string_view suffix(e.suffix);
+    if (name.size() > suffix.size() && name.ends_with(suffix)) return e.kind;
+  }
+  return Kind::Unknown;
+}
+
+}  // namespace
+
+std::string supported_point_file_extensions() {
+  return ".ply, .ply.gz, .xyz, .pts, .csv, .txt (each also .gz), .obj, .obj.gz, .las, .las.gz";
+}
+
+bool is_point_file_extension(const std::string& path) {
+  const Kind kind = kind_of(path);
+  return kind != Kind::Unknown && kind != Kind::Laz;
+}
+
+PointSet read_point_file(const std::string& path, Progress& progress,
+                         const PointReadOptions& options) {
+  switch (kind_of(path)) {
+    case Kind::Ply:
+      return read_ply(path, progress, {.read_colors = options.read_colors, .pool = options.pool});
+    case Kind::Text:
+      return read_xyz(path, progress,
+                      {.read_colors = options.read_colors,
+                       .pool = options.pool,
+                       .columns = options.columns});
+    case Kind::Obj:
+      return read_obj(path, progress, {.read_colors = options.read_colors});
+    case Kind::Las:
+      return read_las(path, progress, {.read_colors = options.read_colors, .pool = options.pool});
+    case Kind::Laz:
+      throw FormatError(path +
+                        ": compressed LAS (LAZ) is not supported yet; decompress it with laszip or "
+                        "pdal first, e.g. 'laszip -i in.laz -o out.las' or "
+                        "'pdal translate in.laz out.las'");
+    case Kind::Unknown:
+      break;
+  }
+  throw FormatError(path + ": unknown point file type (supported: " +
+                    supported_point_file_extensions() +
+                    "); rename the file if its extension is wrong, or convert it to PLY");
+}
+
+std::optional<std::array<double, 3>> point_set_origin(const PointSet& points) {
+  constexpr std::string_view kPrefix = "origin: ";
+  for (const std::string& comment : points.comments) {
+    if (!comment.starts_with(kPrefix)) continue;
+    std::array<double, 3> origin{};
+    const char* p = comment.data() + kPrefix.size();
+    const char* end = comment.data() + comment.size();
+    bool ok = true;
+    for (double& v : origin) {
+      while (p < end && *p == ' ') ++p;
+      const auto r = std::from_chars(p, end, v);
+      ok = ok && r.ec == std::errc();
+      p = r.ptr;
+    }
+    if (ok) return origin;
+  }
+  return std::nullopt;
+}
+
+}  // namespace pointillist

@@ -1,0 +1,604 @@
+// Text point cloud reader (XYZ, PTS, CSV, TXT). The lines before the first point line are read
+// on the calling thread: they fix the delimiter, the column layout and the origin. The body is
+// then parsed like an ascii PLY body: with a pool, cut into pieces at line starts, a first
+// parallel pass counts each piece's point lines so every piece knows the index of its first
+// point, and a second pass parses the pieces into the shared arrays.
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstring>
+#include <functional>
+#include <limits>
+#include <optional>
+
+#include "io/file_bytes.hpp"
+#include "io/ply_body.hpp"
+#include "io/text_numbers.hpp"
+#include "pointillist/core/error.hpp"
+#include "pointillist/core/thread_pool.hpp"
+#include "pointillist/io/xyz.hpp"
+
+namespace pointillist {
+namespace {
+
+using namespace io_detail;
+
+// Where a column's value goes: a coordinate, or one of the two groups of three (A, B) that hold
+// normals or colors.
+enum Slot : std::int8_t { kSkip = -1, kX, kY, kZ, kA0, kA1, kA2, kB0, kB1, kB2 };
+
+enum class Group { None, Normals, Colors, Detect };
+
+struct Layout {
+  std::vector<Slot> slots;  // one per column read; later columns are ignored
+  Group a = Group::None, b = Group::None;
+  bool exact = false;  // every point line has exactly slots.size() values
+};
+
+enum class Delimiter : char { Blank = ' ', Comma = ',', Semicolon = ';' };
+
+std::string lowercase(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+std::vector<std::string> split_names(std::string_view text) {
+  std::vector<std::string> names;
+  std::string current;
+  for (char c : text) {
+    if (c == ',' || c == ';' || c == ' ' || c == '\t' || c == '\r' || c == '"' || c == '\'') {
+      if (!current.empty()) names.push_back(lowercase(current));
+      current.clear();
+    } else {
+      current += c;
+    }
+  }
+  if (!current.empty()) names.push_back(lowercase(current));
+  return names;
+}
+
+Slot slot_for_name(const std::string& name) {
+  static const std::pair<const char*, Slot> kNames[] = {
+      {"x", kX},         {"y", kY},          {"z", kZ},         {"nx", kA0},
+      {"ny", kA1},       {"nz", kA2},        {"normal_x", kA0}, {"normal_y", kA1},
+      {"normal_z", kA2}, {"r", kB0},         {"g", kB1},        {"b", kB2},
+      {"red", kB0},      {"green", kB1},     {"blue", kB2}};
+  for (const auto& [text, slot] : kNames)
+    if (name == text) return slot;
+  return kSkip;
+}
+
+// A layout from column names. `strict` (the columns option): unknown names, repeated names
+// and partial groups throw OptionError. Not strict (a header line): unknown names are skipped,
+// and a layout without x, y and z, or with repeats, is no layout.
+std::optional<Layout> layout_from_names(const std::vector<std::string>& names, bool strict,
+                                        const std::string& spec) {
+  const auto fail = [&](const std::string& what) -> std::optional<Layout> {
+    if (!strict) return std::nullopt;
+    throw OptionError("columns '" + spec + "': " + what +
+                      " (expected names from x, y, z, nx, ny, nz, r, g, b, skip, separated by "
+                      "commas or blanks, e.g. \"x,y,z,skip,r,g,b\")");
+  };
+  Layout layout;
+  int seen[9] = {};
+  for (const std::string& name : names) {
+    Slot slot = slot_for_name(name);
+    if (slot == kSkip && strict && name != "skip" && name != "_")
+      return fail("unknown column name '" + name + "'");
+    if (slot != kSkip && seen[slot]++) return fail("column '" + name + "' given twice");
+    layout.slots.push_back(slot);
+  }
+  if (!seen[kX] || !seen[kY] || !seen[kZ]) return fail("x, y and z are all required");
+  const auto group = [&](int first, const char* what) {
+    const int count = seen[first] + seen[first + 1] + seen[first + 2];
+    if (count == 3) return true;
+    if (count != 0 && strict) fail(std::string(what) + " need all three columns");
+    // A header naming only part of a group: those columns are not read.
+    for (Slot& s : layout.slots)
+      if (s >= first && s < first + 3) s = kSkip;
+    return false;
+  };
+  layout.a = group(kA0, "normals (nx ny nz)") ? Group::Normals : Group::None;
+  layout.b = group(kB0, "colors (r g b)") ? Group::Colors : Group::None;
+  return layout;
+}
+
+// The layout for a first point line of `count` values when nothing names the columns.
+Layout layout_from_count(std::size_t count) {
+  Layout layout;
+  layout.exact = true;
+  layout.slots.assign(count, kSkip);
+  for (int a = 0; a < 3; ++a) layout.slots[static_cast<std::size_t>(a)] = Slot(kX + a);
+  const auto put_group = [&](std::size_t first, Slot slot) {
+    for (int k = 0; k < 3; ++k) layout.slots[first + static_cast<std::size_t>(k)] = Slot(slot + k);
+  };
+  switch (count) {
+    case 6:
+      put_group(3, kA0);
+      layout.a = Group::Detect;
+      break;
+    case 7:
+      put_group(4, kB0);
+      layout.b = Group::Detect;
+      break;
+    case 9:
+      put_group(3, kA0);
+      put_group(6, kB0);
+      layout.a = layout.b = Group::Detect;
+      break;
+    case 10:
+      put_group(4, kA0);
+      put_group(7, kB0);
+      layout.a = layout.b = Group::Detect;
+      break;
+    default:
+      break;
+  }
+  return layout;
+}
+
+// What a group's values looked like over the file, to tell normals from colors and a color
+// scale from another.
+struct GroupStats {
+  float min = std::numeric_limits<float>::infinity();
+  float max = -std::numeric_limits<float>::infinity();
+  bool has_point = false;  // some token has a decimal point or an exponent
+  bool all_unit = true;    // every row has length 1 (within 10%)
+
+  void merge(const GroupStats& o) {
+    min = std::min(min, o.min);
+    max = std::max(max, o.max);
+    has_point = has_point || o.has_point;
+    all_unit = all_unit && o.all_unit;
+  }
+};
+
+Group classify(const GroupStats& s) {
+  if (s.min < 0.0f) return Group::Normals;
+  if (s.all_unit && s.has_point) return Group::Normals;
+  return Group::Colors;
+}
+
+ply::ColorScale color_scale(const GroupStats& s) {
+  if (s.max > 255.0f) return ply::ColorScale::Word;
+  if (s.max <= 1.0f && s.has_point) return ply::ColorScale::Unit;
+  return ply::ColorScale::Byte;
+}
+
+struct LineValues {
+  double xyz[3] = {};
+  float group[2][3] = {};
+};
+
+struct Outputs {
+  Vec3f* positions = nullptr;
+  Vec3f* group[2] = {nullptr, nullptr};
+};
+
+bool is_comment_start(const char* t, const char* le) {
+  return *t == '#' || (*t == '/' && t + 1 < le && t[1] == '/');
+}
+
+// A line that holds a point: anything but blanks and comments.
+bool is_point_line(const char* t, const char* le) { return t < le && !is_comment_start(t, le); }
+
+std::uint64_t count_point_lines(const char* begin, const char* end) {
+  std::uint64_t count = 0;
+  for (const char* p = begin; p < end;) {
+    const char* le = line_end(p, end);
+    count += is_point_line(skip_blanks(p, le), le);
+    p = le + 1;
+  }
+  return count;
+}
+
+class LineParser {
+ public:
+  LineParser(const std::string& path, std::string_view data, const Layout& layout,
+             Delimiter delimiter, std::size_t first_line, std::size_t first_count)
+      : path_(path),
+        data_(data),
+        layout_(layout),
+        delimiter_(delimiter),
+        first_line_(first_line),
+        first_count_(first_count) {}
+
+  // Parses the point line whose first non-blank character is `t` and which ends at `le`.
+  void parse(const char* t, const char* le, LineValues& v, GroupStats stats[2]) const {
+    const std::size_t n = layout_.slots.size();
+    const char* p = t;
+    for (std::size_t c = 0; c < n; ++c) {
+      if (c > 0) p = next_field(p, le, c);
+      const Slot slot = layout_.slots[c];
+      if (slot == kSkip) {
+        p = skip_field(p, le);
+        continue;
+      }
+      if (slot <= kZ) {
+        double d = 0;
+        const char* q = parse_real(p, le, d);
+        if (!q) fail_number(p, le, c);
+        if (!std::isfinite(d)) fail_not_finite(p, le, c);
+        v.xyz[slot] = d;
+        p = q;
+        continue;
+      }
+      const int g = slot >= kB0;
+      float f = 0;
+      const char* q = parse_real(p, le, f);
+      if (!q) fail_number(p, le, c);
+      for (const char* s = p; s < q; ++s)
+        if (*s == '.' || *s == 'e' || *s == 'E') stats[g].has_point = true;
+      v.group[g][slot - (g ? kB0 : kA0)] = f;
+      p = q;
+    }
+    for (int g = 0; g < 2; ++g) {
+      if ((g ? layout_.b : layout_.a) == Group::None) continue;
+      const float* values = v.group[g];
+      for (int k = 0; k < 3; ++k) {
+        stats[g].min = std::min(stats[g].min, values[k]);
+        stats[g].max = std::max(stats[g].max, values[k]);
+      }
+      const float length2 = values[0] * values[0] + values[1] * values[1] + values[2] * values[2];
+      if (!(length2 >= 0.81f && length2 <= 1.21f)) stats[g].all_unit = false;
+    }
+    p = skip_blanks(p, le);
+    if (p < le && delimiter_ != Delimiter::Blank && *p == char(delimiter_)) {
+      // A delimiter at the end of the line (some CSV writers add one) or before more fields.
+      const char* after = skip_blanks(p + 1, le);
+      if (after == le) return;
+      p = after;
+    }
+    if (p < le && layout_.exact) fail_extra(p, le);
+  }
+
+  std::size_t column_count() const { return layout_.slots.size(); }
+
+ private:
+  // Moves from the end of field c-1 to the start of field c.
+  const char* next_field(const char* p, const char* le, std::size_t c) const {
+    if (delimiter_ == Delimiter::Blank) {
+      const char* q = skip_blanks(p, le);
+      if (q == le) fail_short(q, c);
+      if (q == p) fail_expected_delimiter(p, le);
+      return q;
+    }
+    p = skip_blanks(p, le);
+    if (p == le) fail_short(p, c);
+    if (*p != char(delimiter_)) fail_expected_delimiter(p, le);
+    const char* q = skip_blanks(p + 1, le);
+    if (q == le) fail_short(q, c);
+    if (*q == char(delimiter_))
+      fail(q, "column " + std::to_string(c + 1) + " is empty (found '" +
+                  std::string(1, char(delimiter_)) + "' right after the previous one)");
+    return q;
+  }
+
+  const char* skip_field(const char* p, const char* le) const {
+    if (delimiter_ == Delimiter::Blank) {
+      while (p < le && !is_blank(*p)) ++p;
+      return p;
+    }
+    while (p < le && *p != char(delimiter_)) ++p;
+    return p;
+  }
+
+  std::string column_name(std::size_t c) const {
+    static const char* kNames[] = {"x", "y", "z"};
+    const Slot slot = layout_.slots[c];
+    std::string name = "column " + std::to_string(c + 1);
+    if (slot >= kX && slot <= kZ) name += std::string(" (") + kNames[slot] + ")";
+    return name;
+  }
+
+  std::string layout_text() const {
+    return std::to_string(column_count()) + (layout_.exact ? "" : " or more") + " values";
+  }
+
+  [[noreturn, gnu::cold]] void fail(const char* pos, const std::string& what) const {
+    throw FormatError(path_ + ": line " + std::to_string(line_number(data_, pos)) + ": " + what);
+  }
+  [[noreturn, gnu::cold]] void fail_number(const char* p, const char* le, std::size_t c) const {
+    fail(p, column_name(c) + ": expected a number, found " + quote_token(p, le) +
+                (c < 3 ? "" : " (give the columns option and name this column 'skip' to ignore it)"));
+  }
+  [[noreturn, gnu::cold]] void fail_not_finite(const char* p, const char* le,
+                                               std::size_t c) const {
+    fail(p, column_name(c) + " is not a finite number (found " + quote_token(p, le) + ")");
+  }
+  [[noreturn, gnu::cold]] void fail_short(const char* p, std::size_t found) const {
+    fail(p, "line ends early: expected " + layout_text() + ", found " + std::to_string(found) +
+                (layout_.exact ? " (the first point line, line " + std::to_string(first_line_) +
+                                     ", has " + std::to_string(first_count_) + ")"
+                               : ""));
+  }
+  [[noreturn, gnu::cold]] void fail_extra(const char* p, const char* le) const {
+    fail(p, "extra value " + quote_token(p, le) + ": expected " + layout_text() +
+                " as on the first point line (line " + std::to_string(first_line_) +
+                "); fix the line, or give the columns option to read a fixed set of columns");
+  }
+  [[noreturn, gnu::cold]] void fail_expected_delimiter(const char* p, const char* le) const {
+    const std::string expected = delimiter_ == Delimiter::Blank
+                                     ? "a blank"
+                                     : "'" + std::string(1, char(delimiter_)) + "'";
+    fail(p, "expected " + expected + " between values (the delimiter of the first point line), found " +
+                quote_token(p, le));
+  }
+
+  const std::string& path_;
+  std::string_view data_;
+  const Layout& layout_;
+  Delimiter delimiter_;
+  std::size_t first_line_, first_count_;
+};
+
+// Values on the first point line [t, le) (a trailing delimiter is not a value).
+std::size_t count_fields(const char* t, const char* le, Delimiter delimiter) {
+  std::size_t count = 0;
+  if (delimiter == Delimiter::Blank) {
+    for (const char* p = t; p < le;) {
+      p = skip_blanks(p, le);
+      if (p == le) break;
+      ++count;
+      while (p < le && !is_blank(*p)) ++p;
+    }
+    return count;
+  }
+  count = 1 + static_cast<std::size_t>(std::count(t, le, char(delimiter)));
+  const char* last = le;
+  while (last > t && is_blank(last[-1])) --last;
+  if (last > t && last[-1] == char(delimiter)) --count;
+  return count;
+}
+
+struct Preamble {
+  const char* body = nullptr;  // start of the first point line
+  std::size_t first_line = 0;  // its line number
+  std::size_t first_count = 0;  // values on it
+  Delimiter delimiter = Delimiter::Blank;
+  Layout layout;
+  std::string layout_source;
+};
+
+// Reads the lines before the first point line: header names, the PTS count line, comments.
+Preamble read_preamble(const std::string& path, std::string_view data,
+                       const XyzReadOptions& options) {
+  const char* end = data.data() + data.size();
+  std::optional<Layout> header_layout;
+  std::size_t header_line = 0;
+  bool count_line_seen = false;
+  std::size_t line = 0;
+  constexpr std::size_t kMaxPreambleLines = 1000;
+  for (const char* p = data.data(); p < end; p = line_end(p, end) + 1) {
+    ++line;
+    const char* le = line_end(p, end);
+    const char* t = skip_blanks(p, le);
+    if (t == le) continue;
+    if (line > kMaxPreambleLines)
+      throw FormatError(path + ": line " + std::to_string(line) + ": no point line in the first " +
+                        std::to_string(kMaxPreambleLines) +
+                        " lines (expected lines of numbers x y z ...); is this a point text file?");
+    const bool comment = is_comment_start(t, le);
+    double first = 0;
+    const char* q = comment ? nullptr : parse_real(t, le, first);
+    if (!q) {
+      // A header (or a comment) line; column names in it are used when they include x, y, z.
+      std::string_view text(t, static_cast<std::size_t>(le - t));
+      while (!text.empty() && (text.front() == '#' || text.front() == '/')) text.remove_prefix(1);
+      if (auto layout = layout_from_names(split_names(text), false, std::string(text))) {
+        header_layout = std::move(layout);
+        header_line = line;
+      }
+      continue;
+    }
+    std::int64_t count = 0;
+    if (!count_line_seen && parse_index(t, le, count) && skip_blanks(q, le) == le) {
+      count_line_seen = true;  // a PTS point count: not checked, the lines are what counts
+      continue;
+    }
+    Preamble pre;
+    pre.body = p;
+    pre.first_line = line;
+    pre.delimiter = std::find(t, le, ';') != le   ? Delimiter::Semicolon
+                    : std::find(t, le, ',') != le ? Delimiter::Comma
+                                                  : Delimiter::Blank;
+    pre.first_count = count_fields(t, le, pre.delimiter);
+    if (!options.columns.empty()) {
+      pre.layout = *layout_from_names(split_names(options.columns), true, options.columns);
+      pre.layout_source = "the columns option";
+    } else if (header_layout) {
+      pre.layout = *header_layout;
+      pre.layout_source = "the header on line " + std::to_string(header_line);
+    } else {
+      if (pre.first_count < 3)
+        throw FormatError(path + ": line " + std::to_string(line) +
+                          ": a point line needs at least 3 values (x y z), found " +
+                          std::to_string(pre.first_count));
+      pre.layout = layout_from_count(pre.first_count);
+      pre.layout_source = "the " + std::to_string(pre.first_count) + " values on line " +
+                          std::to_string(line);
+    }
+    if (!options.read_colors) {
+      for (Slot& s : pre.layout.slots)
+        if (s >= kB0) s = kSkip;
+      pre.layout.b = Group::None;
+    }
+    return pre;
+  }
+  throw FormatError(path + ": line " + std::to_string(std::max<std::size_t>(line, 1)) +
+                    ": no point lines (expected lines of numbers: x y z, optionally followed by "
+                    "normals and colors)");
+}
+
+std::string columns_text(const Layout& layout, std::size_t first_count) {
+  std::string text;
+  static const char* kGroupNames[2][3] = {{"nx", "ny", "nz"}, {"r", "g", "b"}};
+  for (const Slot s : layout.slots) {
+    if (!text.empty()) text += ' ';
+    if (s == kSkip) {
+      text += "skip";
+    } else if (s <= kZ) {
+      text += "xyz"[s];
+    } else {
+      const int g = s >= kB0;
+      const Group kind = g ? layout.b : layout.a;
+      text += kGroupNames[kind == Group::Colors][s - (g ? kB0 : kA0)];
+    }
+  }
+  if (first_count > layout.slots.size())
+    text += " (" + std::to_string(first_count - layout.slots.size()) + " more ignored)";
+  return text;
+}
+
+// Turns a parsed group into normals or colors in `points`.
+void store_group(Group kind, const GroupStats& stats, std::vector<Vec3f>& values,
+                 PointSet& points, bool read_colors) {
+  if (kind == Group::Normals) {
+    points.normals = std::move(values);
+    finish_normals(points.normals);
+  } else if (kind == Group::Colors && read_colors) {
+    const ply::ColorScale scale = color_scale(stats);
+    points.colors.resize(values.size());
+    for (std::size_t i = 0; i < values.size(); ++i)
+      points.colors[i] = {ply::to_color(values[i].x, scale), ply::to_color(values[i].y, scale),
+                          ply::to_color(values[i].z, scale)};
+  }
+  values.clear();
+  values.shrink_to_fit();
+}
+
+}  // namespace
+
+PointSet read_xyz(const std::string& path, Progress& progress, const XyzReadOptions& options) {
+  // Check the option before touching the file, so a typo is reported as such.
+  if (!options.columns.empty())
+    layout_from_names(split_names(options.columns), true, options.columns);
+  FileBytes raw = FileBytes::map(path);
+  const std::uint64_t file_size = raw.file_size();
+  ReadProgress read_progress(progress, file_size);
+  const bool gzip = has_gzip_magic(raw.view());
+  FileBytes bytes;
+  if (gzip) {
+    read_progress.begin_part(file_size / 2, file_size);
+    bytes = FileBytes::inflate(raw, path, [&](std::uint64_t n) { read_progress.advance(n); });
+  } else {
+    bytes = std::move(raw);
+  }
+  const std::string_view data = bytes.view();
+  if (data.empty()) throw FormatError(path + ": line 1: file is empty (expected lines x y z ...)");
+
+  Preamble pre = read_preamble(path, data, options);
+  const char* begin = pre.body;
+  const char* end = data.data() + data.size();
+  read_progress.begin_part(file_size - (gzip ? file_size / 2 : 0),
+                           static_cast<std::uint64_t>(end - data.data()));
+  read_progress.advance(static_cast<std::uint64_t>(begin - data.data()));
+  const LineParser parser(path, data, pre.layout, pre.delimiter, pre.first_line,
+                          pre.first_count);
+
+  // The origin comes from the first point.
+  LineValues first;
+  GroupStats unused[2];
+  {
+    const char* le = line_end(begin, end);
+    parser.parse(skip_blanks(begin, le), le, first, unused);
+  }
+  const std::array<double, 3> origin = text_origin(first.xyz);
+
+  // Pieces start at line starts, so each holds whole lines.
+  constexpr std::size_t kMinPieceBytes = 1 << 20;
+  const auto bytes_left = static_cast<std::size_t>(end - begin);
+  std::size_t piece_count = 1;
+  if (options.pool && options.pool->thread_count() >= 2 && bytes_left >= 2 * kMinPieceBytes)
+    piece_count = std::min<std::size_t>(options.pool->thread_count() * 4,
+                                        bytes_left / kMinPieceBytes);
+  std::vector<const char*> cuts{begin};
+  for (std::size_t k = 1; k < piece_count; ++k) {
+    const char* guess = std::max(begin + bytes_left * k / piece_count, cuts.back());
+    const char* nl = line_end(guess, end);
+    cuts.push_back(nl < end ? nl + 1 : end);
+  }
+  cuts.push_back(end);
+  const auto run = [&](const std::function<void(std::size_t)>& fn) {
+    if (piece_count == 1)
+      fn(0);
+    else
+      options.pool->run(piece_count, fn);
+  };
+
+  std::vector<std::uint64_t> firsts(piece_count + 1, 0);
+  run([&](std::size_t k) { firsts[k + 1] = count_point_lines(cuts[k], cuts[k + 1]); });
+  for (std::size_t k = 0; k < piece_count; ++k) firsts[k + 1] += firsts[k];
+  const auto n = static_cast<std::size_t>(firsts[piece_count]);
+
+  PointSet points;
+  std::vector<Vec3f> group_values[2];
+  const Group kinds[2] = {pre.layout.a, pre.layout.b};
+  points.positions.resize(n);
+  Outputs out;
+  out.positions = points.positions.data();
+  for (int g = 0; g < 2; ++g) {
+    if (kinds[g] == Group::None) continue;
+    group_values[g].resize(n);
+    out.group[g] = group_values[g].data();
+  }
+
+  std::vector<std::array<GroupStats, 2>> piece_stats(piece_count);
+  run([&](std::size_t k) {
+    std::size_t i = static_cast<std::size_t>(firsts[k]);
+    GroupStats* stats = piece_stats[k].data();
+    const char* reported = cuts[k];
+    for (const char* p = cuts[k]; p < cuts[k + 1];) {
+      const char* le = line_end(p, cuts[k + 1]);
+      const char* t = skip_blanks(p, le);
+      p = le + 1;
+      if (!is_point_line(t, le)) continue;
+      LineValues v;
+      parser.parse(t, le, v, stats);
+      out.positions[i] = {static_cast<float>(v.xyz[0] - origin[0]),
+                          static_cast<float>(v.xyz[1] - origin[1]),
+                          static_cast<float>(v.xyz[2] - origin[2])};
+      for (int g = 0; g < 2; ++g)
+        if (out.group[g]) out.group[g][i] = {v.group[g][0], v.group[g][1], v.group[g][2]};
+      if ((++i & 0xffff) == 0) {
+        read_progress.advance(static_cast<std::uint64_t>(std::min(p, cuts[k + 1]) - reported));
+        reported = std::min(p, cuts[k + 1]);
+      }
+    }
+    read_progress.advance(static_cast<std::uint64_t>(cuts[k + 1] - reported));
+  });
+
+  GroupStats stats[2];
+  for (const auto& s : piece_stats) {
+    stats[0].merge(s[0]);
+    stats[1].merge(s[1]);
+  }
+  Layout& layout = pre.layout;
+  if (layout.a == Group::Detect && layout.b == Group::Detect) {
+    layout.a = classify(stats[0]);
+    layout.b = classify(stats[1]);
+    if (layout.a == layout.b) {  // both look alike: the usual order
+      layout.a = Group::Normals;
+      layout.b = Group::Colors;
+    }
+  } else {
+    if (layout.a == Group::Detect) layout.a = classify(stats[0]);
+    if (layout.b == Group::Detect) layout.b = classify(stats[1]);
+  }
+  for (int g = 0; g < 2; ++g) {
+    const Group kind = g ? layout.b : layout.a;
+    store_group(kind, stats[g], group_values[g], points, options.read_colors);
+    if (kind == Group::Colors && !options.read_colors) {
+      for (Slot& s : layout.slots)
+        if (s >= (g ? kB0 : kA0) && s < (g ? kB0 + 3 : kA0 + 3)) s = kSkip;
+    }
+  }
+  points.comments.push_back("columns: " + columns_text(layout, pre.first_count) + " (from " +
+                            pre.layout_source + ")");
+  if (origin[0] != 0 || origin[1] != 0 || origin[2] != 0)
+    points.comments.push_back(origin_comment(origin));
+  read_progress.finish();
+  return points;
+}
+
+}  // namespace pointillist
