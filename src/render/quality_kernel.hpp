@@ -1,0 +1,92 @@
+// Pieces shared by the quality rasterizer and reconstruct_pixel: the reconstruction rule, the
+// kernel's exponential and the layout of the per-splat setup.
+#pragma once
+
+#include <cstdint>
+#include <cstring>
+
+#include <vector>
+
+#include "pointillist/core/camera.hpp"
+#include "pointillist/lod/sphere_tree.hpp"
+#include "pointillist/render/quality.hpp"
+#include "pointillist/render/splat_stream.hpp"
+#include "render/simd.hpp"
+
+namespace pointillist::quality_detail {
+
+using render_detail::Float4;
+using render_detail::Int4;
+
+// The rule of Reconstruction: a fragment's interval [key, bound]. ZThreshold: key = depth,
+// bound = depth + ε·r; ZRange: [depth_min − m·r, depth_max + m·r].
+struct RuleConstants {
+  bool z_range = true;
+  float z_threshold = 1, z_range_margin = 0.5f;
+};
+inline RuleConstants rule_constants(const QualitySettings& q) {
+  return {q.reconstruction == Reconstruction::ZRange, q.z_threshold, q.z_range_margin};
+}
+inline float fragment_key(const RuleConstants& k, float depth, float depth_min, float radius) {
+  return k.z_range ? depth_min - k.z_range_margin * radius : depth;
+}
+inline float fragment_bound(const RuleConstants& k, float depth, float depth_max, float radius) {
+  return k.z_range ? depth_max + k.z_range_margin * radius : depth + k.z_threshold * radius;
+}
+
+// e^(−x) lane by lane for x in [0, 80] (clamped; NaN gives 1): 2^y with y = −x·log2(e) split
+// into an integer n and f in [−½, ½], 2^f by its Taylor polynomial of degree 6 (relative error
+// below 1e-7 plus rounding), and n added to the exponent bits.
+inline Float4 exp_neg4(Float4 x) {
+  x = render_detail::min4(render_detail::splat4(80.0f),
+                          render_detail::max4(render_detail::splat4(0.0f), x));
+  const Float4 y = x * -1.44269504088896341f;
+  const Int4 n = render_detail::to_int4(y - 0.5f);  // y − ½ < 0: truncation rounds toward y
+  const Float4 f = y - render_detail::to_float4(n);
+  Float4 p = f * 1.5403530393381609e-4f + 1.3333558146428443e-3f;
+  p = p * f + 9.6181291076284772e-3f;
+  p = p * f + 5.5504108664821580e-2f;
+  p = p * f + 2.4022650695910071e-1f;
+  p = p * f + 6.9314718055994531e-1f;
+  p = p * f + 1.0f;
+  Int4 bits;
+  std::memcpy(&bits, &p, sizeof bits);
+  bits += n << 23;
+  Float4 out;
+  std::memcpy(&out, &bits, sizeof out);
+  return out;
+}
+
+// Per-splat setup, kStride floats per splat (quality_setup.cpp writes it).
+enum SplatField : int {
+  kI0, kI1, kJ0, kJ1,     // pixel box (inclusive, clipped to the image; i1 < i0 when empty)
+  kCx, kCy, kCz,          // centre in eye coordinates (x right, y up, z = depth)
+  kNx, kNy, kNz,          // unit normal in eye coordinates
+  kNc,                    // n·c
+  kInvR2,                 // 1 / r²
+  kSx, kSy,               // projected centre in pixels (for the low-pass)
+  kDepthLo, kDepthHi,     // the disc's depth interval c_z ± r·√(1 − n_z²)
+  kKey, kBound,           // ZRange: the widened interval; ZThreshold: unused, ε·r
+  kBaseR, kBaseG, kBaseB, // base color, linear 0..1
+  kWx, kWy, kWz,          // unit normal in world space (blended for shading)
+  kStride = 24,
+};
+
+// What the per-splat setup needs to know about the view.
+struct SetupConstants {
+  CameraFrame camera;
+  RuleConstants rule;
+  float lowpass_radius_px = 1;
+  float radius_scale = 1;  // disc radius / node radius
+  bool has_colors = false;
+  Vec3f base_color;
+  int band_rows = 1, band_count = 1;  // rows of the image drawn by one band, bands
+};
+
+// Writes the setup of every splat of `chunk` into `splats` (kStride floats each) and bins the
+// splats by band: bins[b] .. bins[b + 1] − 1 (offsets counted from bins[band_count + 1]) are
+// the indices, in stream order, of the chunk's splats whose pixel box meets band b.
+void prepare_chunk(const SplatChunk& chunk, const SphereTreeView& tree, const SetupConstants& k,
+                   std::vector<float>& splats, std::vector<std::uint32_t>& bins);
+
+}  // namespace pointillist::quality_detail
