@@ -8,6 +8,7 @@
 
 #include "pointillist/core/camera.hpp"
 #include "pointillist/prep/prepare.hpp"
+#include "pointillist/render/quality.hpp"
 #include "pointillist/render/render.hpp"
 
 namespace pointillist::cli {
@@ -16,6 +17,7 @@ struct ConvertOptions {
   std::vector<std::string> inputs;
   std::string output;
   PrepareOptions prepare;
+  std::string columns;  // --columns for text inputs (empty = detect)
   bool ascii = false;  // .ply output only
   unsigned threads = 0;
   bool quiet = false;
@@ -31,6 +33,7 @@ struct ViewOptions {
 };
 
 enum class LodScheme { QSplat, Spt };
+enum class RenderMode { Fast, Quality };
 
 struct RenderOptions {
   std::string input;
@@ -39,9 +42,12 @@ struct RenderOptions {
   std::string output;
   ViewOptions view;
   RenderSettings settings;
+  RenderMode mode = RenderMode::Fast;  // --mode fast|quality
+  QualitySettings quality;             // --reconstruction, --opacity (quality mode)
   std::string depth_output;  // empty = no depth image
   std::string stats_output;  // empty = none, "-" = stdout
-  PrepareOptions prepare;    // for .ply inputs
+  PrepareOptions prepare;    // for point/mesh file inputs (built in memory)
+  std::string columns;       // --columns for text inputs
   unsigned threads = 0;
   bool quiet = false;
   // Frame sequences (see README "Frame sequences"): 0 = off.
@@ -58,6 +64,7 @@ Camera make_camera(const ViewOptions& view, const SphereTreeView& tree);
 
 struct InfoOptions {
   std::string input;
+  std::string columns;     // --columns for text inputs
   unsigned threads = 0;
   bool spt = false;        // --spt: build the Sequential Point Tree and report its list
   ViewOptions view;        // for the SPT report: the view whose scanned fraction is given

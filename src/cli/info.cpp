@@ -1,6 +1,8 @@
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cstdio>
+#include <string>
 
 #include "cli/commands.hpp"
 #include "cli/model_loading.hpp"
@@ -9,9 +11,24 @@
 
 namespace pointillist::cli {
 
+namespace {
+
+// "PLY", "LAS", "OBJ" or "text" from the file name (as read_point_file dispatches).
+std::string input_format_name(const std::string& path) {
+  std::string lower = path;
+  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (lower.size() > 3 && lower.ends_with(".gz")) lower.resize(lower.size() - 3);
+  if (lower.ends_with(".ply")) return "PLY";
+  if (lower.ends_with(".las")) return "LAS";
+  if (lower.ends_with(".obj")) return "OBJ";
+  return "text";
+}
+
+}  // namespace
+
 int run_info(const InfoOptions& o) {
   ThreadPool pool(o.threads);
-  const LoadedModel model = LoadedModel::open(o.input, {}, pool, Progress::none());
+  const LoadedModel model = LoadedModel::open(o.input, {}, pool, Progress::none(), o.columns);
   const SphereTreeView& t = model.tree();
   std::array<std::uint64_t, 5> children{};
   for (const SphereNode& n : t.nodes) children[n.child_count <= 4 ? n.child_count : 0]++;
@@ -21,8 +38,11 @@ int run_info(const InfoOptions& o) {
   if (model.memory_mapped()) {
     std::printf("format:      Pointillist model (.ptl) version %u, memory-mapped\n",
                 model.ptl()->version());
+  } else if (model.qsplat()) {
+    std::printf("format:      QSplat model (.qs 1.1), decoded into memory\n");
   } else {
-    std::printf("format:      PLY %s, %zu input points%s (hierarchy built in memory)\n",
+    std::printf("format:      %s %s, %zu input points%s (hierarchy built in memory)\n",
+                input_format_name(o.input).c_str(),
                 model.input_is_mesh ? "mesh" : "point cloud", model.input_points,
                 model.input_is_mesh ? " (vertices used by faces kept)" : "");
   }
@@ -33,7 +53,7 @@ int run_info(const InfoOptions& o) {
               static_cast<unsigned long long>(children[3]),
               static_cast<unsigned long long>(children[4]));
   std::printf("depth:       %u levels below the root\n", t.depth);
-  if (model.memory_mapped()) {
+  if (model.memory_mapped() || model.qsplat()) {
     std::printf("attributes:  position, normal, normal cone, radius%s\n",
                 t.has_colors ? ", color" : "");
   } else {

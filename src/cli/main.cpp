@@ -91,6 +91,12 @@ pointillist::Rgb8 parse_rgb8(const std::string& text, const std::string& option)
           static_cast<std::uint8_t>(c.z)};
 }
 
+void add_columns(CLI::App* app, std::string& columns) {
+  app->add_option("--columns", columns,
+                  "Text inputs (.xyz .pts .csv .txt): what each column holds, e.g. "
+                  "x,y,z,skip,r,g,b (names: x y z nx ny nz r g b skip; default: detect)");
+}
+
 void add_threads(CLI::App* app, unsigned& threads) {
   app->add_option("--threads", threads, "Worker threads (0 = one per core)")->default_val(0);
 }
@@ -122,12 +128,15 @@ int main(int argc, char** argv) {
   // convert
   pc::ConvertOptions convert;
   auto* convert_cmd = app.add_subcommand(
-      "convert", "Convert scans (PLY, .ply.gz) into a splat model (.ptl) or points with normals "
-                 "and radii (.ply)");
+      "convert", "Convert scans (PLY, XYZ/PTS/CSV, OBJ, LAS; .gz too) into a splat model (.ptl, "
+                 ".qs) or points with normals and radii (.ply)");
   convert_cmd->add_option("inputs", convert.inputs, "Input files (several are merged)")
       ->required()
       ->check(CLI::ExistingFile);
-  convert_cmd->add_option("-o,--output", convert.output, "Output file: .ptl or .ply")->required();
+  convert_cmd->add_option("-o,--output", convert.output,
+                          "Output file: .ptl (Pointillist model), .qs (QSplat 1.1 model) or .ply")
+      ->required();
+  add_columns(convert_cmd, convert.columns);
   add_prepare_options(convert_cmd, convert.prepare);
   convert_cmd->add_flag("--ascii", convert.ascii, "Write .ply output as ascii");
   add_threads(convert_cmd, convert.threads);
@@ -137,7 +146,7 @@ int main(int argc, char** argv) {
   pc::RenderOptions render;
   std::string size = "1280x720", view, eye, target, up, background = "0,0,0";
   auto* render_cmd =
-      app.add_subcommand("render", "Render a model (.ptl, or .ply/.ply.gz built in memory) to PNG");
+      app.add_subcommand("render", "Render a model (.ptl, .qs, or a scan built in memory) to PNG");
   render_cmd->add_option("input", render.input, "Model file")->required()->check(CLI::ExistingFile);
   render_cmd->add_option("-o,--output", render.output, "Output PNG")->required();
   render_cmd->add_option("--size", size, "Image size WxH")->default_str("1280x720");
@@ -148,7 +157,10 @@ int main(int argc, char** argv) {
       ->default_val(30.0f);
   render_cmd->add_option("--eye", eye, "Explicit eye X,Y,Z (with --target)");
   render_cmd->add_option("--target", target, "Explicit target X,Y,Z (with --eye)");
-  render_cmd->add_option("--up", up, "Explicit up vector X,Y,Z (default 0,1,0)");
+  render_cmd->add_option("--up", up,
+                         "Up vector X,Y,Z (default 0,1,0): with --eye/--target the camera's; "
+                         "otherwise the model's up axis for --view and --path (0,0,1 for most "
+                         "LAS scans)");
   render_cmd->add_option("--threshold", render.settings.threshold_px,
                          "Stop refining at this projected splat diameter, pixels")
       ->default_val(1.0f)
@@ -188,7 +200,28 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1u, 100000u));
   render_cmd->add_option("--frames-out", render.frames_out,
                          "Write every frame of a sequence to DIR/frame_NNNNN.png");
+  const std::map<std::string, pc::RenderMode> modes{{"fast", pc::RenderMode::Fast},
+                                                    {"quality", pc::RenderMode::Quality}};
+  render_cmd->add_option("--mode", render.mode,
+                         "fast (opaque splats, the default) or quality (perspective-correct "
+                         "Gaussian surface splatting with per-pixel shading)")
+      ->transform(CLI::CheckedTransformer(modes, CLI::ignore_case))
+      ->default_str("fast");
+  const std::map<std::string, pointillist::Reconstruction> reconstructions{
+      {"zthreshold", pointillist::Reconstruction::ZThreshold},
+      {"zrange", pointillist::Reconstruction::ZRange}};
+  render_cmd->add_option("--reconstruction", render.quality.reconstruction,
+                         "With --mode quality: which fragments of a pixel blend, zrange (depth "
+                         "intervals overlap) or zthreshold (within a fixed depth of the front)")
+      ->transform(CLI::CheckedTransformer(reconstructions, CLI::ignore_case))
+      ->default_str("zrange");
+  render_cmd->add_option("--opacity", render.quality.opacity,
+                         "With --mode quality: opacity of every surface, composited front to back "
+                         "(1 = opaque)")
+      ->default_val(1.0f)
+      ->check(CLI::Range(0.001f, 1.0f));
   add_prepare_options(render_cmd, render.prepare);
+  add_columns(render_cmd, render.columns);
   add_threads(render_cmd, render.threads);
   render_cmd->add_flag("-q,--quiet", render.quiet, "No progress bars and no summary");
 
@@ -198,6 +231,7 @@ int main(int argc, char** argv) {
   info_cmd->add_option("input", info.input, "Model or scan file")->required()->check(
       CLI::ExistingFile);
   add_threads(info_cmd, info.threads);
+  add_columns(info_cmd, info.columns);
   std::string info_view, info_size = "1280x720";
   info_cmd->add_flag("--spt", info.spt,
                      "Also build the Sequential Point Tree and report its list and the share of "

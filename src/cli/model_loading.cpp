@@ -1,26 +1,27 @@
 #include "cli/model_loading.hpp"
 
+#include <array>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 
 #include "pointillist/core/error.hpp"
 #include "pointillist/core/thread_pool.hpp"
-#include "pointillist/io/ply.hpp"
+#include "pointillist/format/qs.hpp"
+#include "pointillist/io/point_file.hpp"
 
 namespace pointillist::cli {
 
 namespace {
 
-// Appends `b` to `a`. An attribute survives only when every part has it, so the merged set stays
-// consistent (one entry per position or none).
-void append_points(PointSet& a, PointSet&& b) {
-  const bool first = a.positions.empty() && a.triangles.empty();
-  if (first) {
-    a = std::move(b);
-    return;
-  }
+constexpr Rgb8 kMissingColor{180, 180, 180};
+
+// Appends `b` to `a` (see read_inputs for the rules). `b_origin` is where b's coordinates are
+// relative to, `a_origin` a's.
+void append_points(PointSet& a, PointSet&& b, const std::array<double, 3>& a_origin,
+                   const std::array<double, 3>& b_origin) {
   const auto offset = static_cast<std::uint32_t>(a.positions.size());
+  const std::size_t a_count = a.positions.size(), b_count = b.positions.size();
   const auto merge = [&](auto& dst, auto& src) {
     if (dst.empty() || src.empty()) {
       dst.clear();
@@ -29,33 +30,73 @@ void append_points(PointSet& a, PointSet&& b) {
     dst.insert(dst.end(), src.begin(), src.end());
   };
   merge(a.normals, b.normals);
-  merge(a.colors, b.colors);
   merge(a.radii, b.radii);
-  a.positions.insert(a.positions.end(), b.positions.begin(), b.positions.end());
+  if (!a.colors.empty() || !b.colors.empty()) {
+    if (a.colors.empty()) a.colors.assign(a_count, kMissingColor);
+    if (b.colors.empty()) b.colors.assign(b_count, kMissingColor);
+    a.colors.insert(a.colors.end(), b.colors.begin(), b.colors.end());
+  }
+  const double shift[3] = {b_origin[0] - a_origin[0], b_origin[1] - a_origin[1],
+                           b_origin[2] - a_origin[2]};
+  const bool shifted = shift[0] != 0 || shift[1] != 0 || shift[2] != 0;
+  a.positions.reserve(a_count + b_count);
+  for (const Vec3f& p : b.positions) {
+    a.positions.push_back(shifted ? Vec3f{static_cast<float>(p.x + shift[0]),
+                                          static_cast<float>(p.y + shift[1]),
+                                          static_cast<float>(p.z + shift[2])}
+                                  : p);
+  }
   for (auto t : b.triangles) a.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
-  a.comments.insert(a.comments.end(), b.comments.begin(), b.comments.end());
+  for (auto& c : b.comments) {
+    if (c.rfind("origin: ", 0) != 0) a.comments.push_back(std::move(c));
+  }
 }
 
 }  // namespace
 
-PointSet read_inputs(const std::vector<std::string>& paths, ThreadPool& pool, Progress& progress) {
+PointSet read_inputs(const std::vector<std::string>& paths, ThreadPool& pool, Progress& progress,
+                     const std::string& columns, std::vector<std::string>* warnings) {
   PointSet all;
-  for (const std::string& path : paths) {
+  std::array<double, 3> all_origin{};
+  std::vector<std::string> without_colors;
+  bool any_colors = false;
+  for (std::size_t i = 0; i < paths.size(); ++i) {
+    const std::string& path = paths[i];
     if (!std::filesystem::exists(path)) {
       throw IoError(path + ": no such file; check the path (models fetched by "
                            "scripts/fetch-models.sh are in ~/.cache/pointillist/models)");
     }
-    if (is_ptl_file(path)) {
-      throw Error(path + ": is already a Pointillist model (.ptl); give the source scan (.ply, "
-                         ".ply.gz) to convert, or render the .ptl directly");
+    if (is_ptl_file(path) || is_qs_file(path)) {
+      throw Error(path + ": is already a splat model (" + (is_ptl_file(path) ? ".ptl" : ".qs") +
+                  "); give the source scan (" + supported_point_file_extensions() +
+                  ") to convert, or render the model directly");
     }
-    append_points(all, read_ply(path, progress, {.pool = &pool}));
+    PointSet part = read_point_file(path, progress, {.pool = &pool, .columns = columns});
+    const std::array<double, 3> origin = point_set_origin(part).value_or(std::array<double, 3>{});
+    if (part.colors.empty()) without_colors.push_back(path);
+    any_colors = any_colors || !part.colors.empty();
+    if (i == 0) {
+      all = std::move(part);
+      all_origin = origin;
+    } else {
+      append_points(all, std::move(part), all_origin, origin);
+    }
+  }
+  if (warnings && any_colors && !without_colors.empty()) {
+    std::string list;
+    for (std::size_t i = 0; i < without_colors.size() && i < 5; ++i) {
+      list += (i ? ", " : "") + without_colors[i];
+    }
+    if (without_colors.size() > 5) list += ", ...";
+    warnings->push_back(std::to_string(without_colors.size()) + " of " +
+                        std::to_string(paths.size()) +
+                        " input files have no colors; their points are grey (" + list + ")");
   }
   return all;
 }
 
 LoadedModel LoadedModel::open(const std::string& path, const PrepareOptions& prepare,
-                              ThreadPool& pool, Progress& progress) {
+                              ThreadPool& pool, Progress& progress, const std::string& columns) {
   LoadedModel model;
   if (!std::filesystem::exists(path)) {
     throw IoError(path + ": no such file; check the path");
@@ -67,7 +108,16 @@ LoadedModel LoadedModel::open(const std::string& path, const PrepareOptions& pre
     model.metadata = model.file_->metadata();
     return model;
   }
-  PointSet points = read_inputs({path}, pool, progress);
+  if (is_qs_file(path)) {
+    ProgressPhase phase(progress, "decode", 0);
+    QsModel qs = read_qs(path);
+    model.qsplat_ = true;
+    model.metadata = qs.metadata();
+    model.built_ = std::move(qs.tree);
+    model.view_ = model.built_.view();
+    return model;
+  }
+  PointSet points = read_inputs({path}, pool, progress, columns);
   model.input_points = points.size();
   model.input_has_normals = points.has_normals();
   model.input_has_colors = points.has_colors();

@@ -15,15 +15,24 @@
 
 namespace pointillist::cli {
 
-// Reads and merges one or more input files (PLY for now). Throws Error naming the file.
-PointSet read_inputs(const std::vector<std::string>& paths, ThreadPool& pool, Progress& progress);
+// Reads and merges one or more input files (any extension read_point_file knows: PLY, XYZ/PTS/
+// CSV text, OBJ, LAS). Parts whose readers shifted coordinates to a local origin (LAS, large text
+// coordinates) are moved into the first part's frame, so tiles of one scan line up; the merged
+// set keeps the first part's "origin:" comment. An attribute (normals, radii) survives only
+// when every part has it; colors survive when any part has them (parts without get a neutral
+// grey, and `warnings` says which). `columns` is passed to the text reader.
+PointSet read_inputs(const std::vector<std::string>& paths, ThreadPool& pool, Progress& progress,
+                     const std::string& columns = {},
+                     std::vector<std::string>* warnings = nullptr);
 
-// A hierarchy either mapped from a .ptl file or built in memory.
+// A hierarchy either mapped from a .ptl file, decoded from a QSplat .qs file, or built in memory
+// from a point or mesh file.
 class LoadedModel {
  public:
   const SphereTreeView& tree() const { return view_; }
   bool memory_mapped() const { return file_ != nullptr; }
   const PtlFile* ptl() const { return file_.get(); }
+  bool qsplat() const { return qsplat_; }
   std::uint64_t file_size = 0;
   std::string metadata;
   // Kept for `info` when the input was not a .ptl.
@@ -32,10 +41,11 @@ class LoadedModel {
   bool input_is_mesh = false;
 
   static LoadedModel open(const std::string& path, const PrepareOptions& prepare, ThreadPool& pool,
-                          Progress& progress);
+                          Progress& progress, const std::string& columns = {});
 
  private:
   std::unique_ptr<PtlFile> file_;
+  bool qsplat_ = false;
   SphereTree built_;
   SphereTreeView view_;
 };

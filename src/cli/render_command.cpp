@@ -20,7 +20,7 @@
 namespace pointillist::cli {
 
 Camera make_camera(const ViewOptions& v, const SphereTreeView& tree) {
-  const bool explicit_eye = v.eye || v.target || v.up;
+  const bool explicit_eye = v.eye || v.target;
   if (explicit_eye) {
     if (!v.eye || !v.target) {
       throw OptionError("--eye and --target must be given together (--up is optional, default 0,1,0)");
@@ -39,7 +39,8 @@ Camera make_camera(const ViewOptions& v, const SphereTreeView& tree) {
                                          .distance = v.distance,
                                          .fov_deg = v.fov_deg,
                                          .width = v.width,
-                                         .height = v.height});
+                                         .height = v.height,
+                                         .up = v.up.value_or(Vec3f{0, 1, 0})});
 }
 
 void write_text(const std::string& where, const std::string& json) {
@@ -70,9 +71,9 @@ void check_sequence_options(const RenderOptions& o) {
     throw OptionError("--frame-ms holds a frame time over a sequence of frames; add --path orbit:N "
                       "(N frames around the model)");
   }
-  if (o.orbit_frames > 0 && (o.view.eye || o.view.target || o.view.up)) {
+  if (o.orbit_frames > 0 && (o.view.eye || o.view.target)) {
     throw OptionError("--path orbit:N moves the camera around the orbit; it cannot be combined "
-                      "with --eye/--target/--up (use --view and --distance)");
+                      "with --eye/--target (use --view, --distance and --up)");
   }
   if (!o.frames_out.empty() && o.orbit_frames == 0 && o.refine_frames == 0) {
     throw OptionError("--frames-out writes the frames of a sequence; add --path orbit:N or --refine K");
@@ -94,6 +95,11 @@ class FrameRenderer {
   FrameRenderer(const RenderOptions& o, const SphereTreeView& tree, ThreadPool& pool,
                 Progress& progress)
       : o_(o), tree_(tree), pool_(pool) {
+    if (o.mode == RenderMode::Quality && o.lod == LodScheme::Spt) {
+      throw OptionError("--mode quality draws the QSplat hierarchy's splats; it cannot be combined "
+                        "with --lod spt (drop --lod spt, or use --mode fast)");
+    }
+    if (o.mode == RenderMode::Quality) validate_quality_settings(o.quality);
     if (o.lod == LodScheme::Spt) {
       spt_ = build_sequential_point_tree(sphere_tree_leaves(tree), pool, progress);
     }
@@ -105,6 +111,9 @@ class FrameRenderer {
     RenderSettings settings = o_.settings;
     if (o_.lod == LodScheme::Spt) {
       render_spt(spt_, camera, settings, {.epsilon_px = detail}, pool_, frame, &spt_stats_);
+    } else if (o_.mode == RenderMode::Quality) {
+      settings.threshold_px = detail;
+      render_quality(tree_, camera, settings, o_.quality, pool_, frame, quality_scratch_);
     } else {
       settings.threshold_px = detail;
       render(tree_, camera, settings, pool_, frame);
@@ -112,10 +121,19 @@ class FrameRenderer {
   }
   // Extra --stats lines for the last frame.
   std::string extra_json() const {
-    if (o_.lod != LodScheme::Spt) return "  \"lod\": \"qsplat\",\n";
+    if (o_.mode == RenderMode::Quality) {
+      char buf[256];
+      std::snprintf(buf, sizeof buf,
+                    "  \"lod\": \"qsplat\",\n  \"mode\": \"quality\",\n  \"reconstruction\": \"%s\",\n"
+                    "  \"opacity\": %g,\n",
+                    o_.quality.reconstruction == Reconstruction::ZRange ? "zrange" : "zthreshold",
+                    double(o_.quality.opacity));
+      return buf;
+    }
+    if (o_.lod != LodScheme::Spt) return "  \"lod\": \"qsplat\",\n  \"mode\": \"fast\",\n";
     char buf[512];
     std::snprintf(buf, sizeof buf,
-                  "  \"lod\": \"spt\",\n  \"list_length\": %llu,\n  \"entries_scanned\": %llu,\n"
+                  "  \"lod\": \"spt\",\n  \"mode\": \"fast\",\n  \"list_length\": %llu,\n  \"entries_scanned\": %llu,\n"
                   "  \"fraction_scanned\": %.4f,\n  \"chunks\": %llu,\n  \"chunks_culled\": %llu,\n",
                   static_cast<unsigned long long>(spt_stats_.entries_total),
                   static_cast<unsigned long long>(spt_stats_.entries_scanned),
@@ -133,6 +151,7 @@ class FrameRenderer {
   ThreadPool& pool_;
   SequentialPointTree spt_;
   SptSelectionStats spt_stats_;
+  QualityScratch quality_scratch_;
 };
 
 // Renders the path (and/or the idle refinement) a viewer would show; returns every frame's record
@@ -174,7 +193,7 @@ std::vector<FrameRecord> render_sequence(const RenderOptions& o, const SphereTre
 int run_render(const RenderOptions& o) {
   ThreadPool pool(o.threads);
   TerminalProgress progress(!o.quiet && TerminalProgress::stderr_is_terminal());
-  const LoadedModel model = LoadedModel::open(o.input, o.prepare, pool, progress);
+  const LoadedModel model = LoadedModel::open(o.input, o.prepare, pool, progress, o.columns);
   FrameRenderer renderer(o, model.tree(), pool, progress);
   Frame frame;
   const bool sequence =

@@ -26,11 +26,24 @@ Camera orbit_camera(const Sphere& view_sphere, const OrbitOptions& o) {
   const float az = deg_to_rad(o.azimuth_deg);
   const float el = deg_to_rad(o.elevation_deg);
   const float radius = view_sphere.radius > 0.0f ? view_sphere.radius : 1.0f;
-  const Vec3f dir{std::cos(el) * std::sin(az), std::sin(el), std::cos(el) * std::cos(az)};
+  const float up_length = length(o.up);
+  if (!(up_length > 0.0f) || !std::isfinite(up_length)) {
+    throw OptionError("orbit up axis (" + std::to_string(o.up.x) + ", " + std::to_string(o.up.y) +
+                      ", " + std::to_string(o.up.z) + ") is not a direction; give a non-zero vector "
+                      "such as 0,0,1");
+  }
+  const Vec3f up = o.up / up_length;
+  // X' = +X made perpendicular to up (+Z when up is along X), Z' = X' × up.
+  Vec3f x_axis = Vec3f{1, 0, 0} - up * up.x;
+  if (length(x_axis) < 1e-3f) x_axis = Vec3f{0, 0, 1} - up * up.z;
+  x_axis = x_axis / length(x_axis);
+  const Vec3f z_axis = cross(x_axis, up);
+  const Vec3f dir = x_axis * (std::cos(el) * std::sin(az)) + up * std::sin(el) +
+                    z_axis * (std::cos(el) * std::cos(az));
   Camera cam;
   cam.eye = view_sphere.center + dir * (d * radius);
   cam.target = view_sphere.center;
-  cam.up = {0, 1, 0};
+  cam.up = up;
   cam.fov_deg = o.fov_deg;
   cam.width = o.width;
   cam.height = o.height;

@@ -51,8 +51,10 @@ std::vector<Vec3f> pca_normals_ordered(const OrderedCloud& cloud, std::uint32_t 
 void orient_normals_ordered(const OrderedCloud& cloud, std::uint32_t graph_k,
                             std::span<Vec3f> normals, ThreadPool& pool, Progress& progress);
 
-// Mean distance to the first `neighbours` entries of each row times `factor`, Morton order.
+// Mean distance to the first `neighbours` entries of each row, capped at outlier_ratio × the
+// median of the same for those entries (0 = no cap), times `factor`, Morton order.
 std::vector<float> cloud_radii_ordered(const OrderedCloud& cloud, std::uint32_t neighbours,
-                                       float factor, ThreadPool& pool, Progress& progress);
+                                       float factor, float outlier_ratio, ThreadPool& pool,
+                                       Progress& progress);
 
 }  // namespace pointillist::prep_detail

@@ -155,7 +155,8 @@ void prepare_splats(PointSet& points, ThreadPool& pool, Progress& progress,
 
   if (want_cloud_radii) {
     const std::vector<float> radii = prep_detail::cloud_radii_ordered(
-        cloud, kRadiusNeighbours, options.coverage * options.radius_scale, pool, progress);
+        cloud, kRadiusNeighbours, options.coverage * options.radius_scale, options.outlier_ratio,
+        pool, progress);
     points.radii = prep_detail::to_caller_order<float>(cloud, radii, pool);
     return;
   }

@@ -2,6 +2,7 @@
 // for large meshes", SIGGRAPH 2000, section 3.1, with the rule its preprocessor applies (the
 // smallest circle enclosing each incident triangle, ../shared/specs/qsplat-qs-format.md §8.2). Clouds: the
 // mean distance to the nearest neighbours, widened by a coverage factor (see radii.hpp).
+#include <array>
 #include "pointillist/prep/radii.hpp"
 
 #include <algorithm>
@@ -67,19 +68,36 @@ std::vector<float> mesh_radii(std::span<const Vec3f> positions,
 namespace prep_detail {
 
 std::vector<float> cloud_radii_ordered(const OrderedCloud& cloud, std::uint32_t neighbours,
-                                       float factor, ThreadPool& pool, Progress& progress) {
+                                       float factor, float outlier_ratio, ThreadPool& pool,
+                                       Progress& progress) {
   const std::size_t n = cloud.size();
   const std::size_t used = std::min(neighbours, cloud.k);
   ProgressPhase phase(progress, "radii", n);
-  std::vector<float> radii(n, 0.0f);
-  if (used == 0) return radii;
+  std::vector<float> raw(n, 0.0f);
+  if (used == 0) return raw;
   parallel_for(pool, n, kGrain, [&](std::size_t begin, std::size_t end) {
     for (std::size_t j = begin; j < end; ++j) {
       float sum = 0.0f;
       for (const std::uint32_t i : cloud.row(j).first(used)) {
         sum += distance(cloud.positions[i], cloud.positions[j]);
       }
-      radii[j] = sum / float(used) * factor;
+      raw[j] = sum / float(used);
+    }
+  });
+  std::vector<float> radii(n, 0.0f);
+  parallel_for(pool, n, kGrain, [&](std::size_t begin, std::size_t end) {
+    std::array<float, 64> theirs{};
+    for (std::size_t j = begin; j < end; ++j) {
+      float r = raw[j];
+      if (outlier_ratio > 0.0f) {
+        const std::size_t m = std::min<std::size_t>(used, theirs.size());
+        const auto row = cloud.row(j);
+        for (std::size_t q = 0; q < m; ++q) theirs[q] = raw[row[q]];
+        std::nth_element(theirs.begin(), theirs.begin() + m / 2, theirs.begin() + m);
+        const float median = theirs[m / 2];
+        if (median > 0.0f) r = std::min(r, outlier_ratio * median);
+      }
+      radii[j] = r * factor;
     }
     phase.advance(end - begin);
   });
@@ -98,7 +116,8 @@ std::vector<float> cloud_radii(std::span<const Vec3f> positions, ThreadPool& poo
   const prep_detail::OrderedCloud cloud =
       prep_detail::order_cloud(positions, options.neighbours, pool, progress);
   const std::vector<float> radii = prep_detail::cloud_radii_ordered(
-      cloud, options.neighbours, options.coverage * options.scale, pool, progress);
+      cloud, options.neighbours, options.coverage * options.scale, options.outlier_ratio, pool,
+      progress);
   return prep_detail::to_caller_order<float>(cloud, radii, pool);
 }
 

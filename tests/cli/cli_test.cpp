@@ -10,6 +10,7 @@
 
 #include "pointillist/io/ply.hpp"
 #include "pointillist/io/png.hpp"
+#include "cli/cli_run.hpp"
 #include "testing/testing.hpp"
 
 using namespace pointillist;
@@ -18,25 +19,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Result {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr together
-};
-
-Result run(const std::string& args) {
-  const std::string cmd = std::string(POINTILLIST_CLI_PATH) + " " + args + " 2>&1";
-  Result r;
-  FILE* pipe = ::popen(cmd.c_str(), "r");
-  if (!pipe) return r;
-  char buf[4096];
-  while (std::size_t n = std::fread(buf, 1, sizeof buf, pipe)) r.output.append(buf, n);
-  const int status = ::pclose(pipe);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+using Result = pointillist::testing::CliResult;
+Result run(const std::string& args) { return pointillist::testing::run_cli(args); }
 
 void write_text(const std::string& path, const std::string& text) {
-  std::ofstream(path, std::ios::binary) << text;
+  pointillist::testing::write_text_file(path, text);
 }
 
 }  // namespace
@@ -148,7 +135,7 @@ TEST(Cli, RenderingAPtlIsNotConvertedAgain) {
   ASSERT_EQ(run("convert -q " + in + " -o " + ptl).exit_code, 0);
   const Result r = run("convert " + ptl + " -o " + dir.file("again.ptl"));
   EXPECT_NE(r.exit_code, 0);
-  EXPECT_THAT(r.output, HasSubstr("already a Pointillist model"));
+  EXPECT_THAT(r.output, HasSubstr("already a splat model (.ptl)"));
 }
 
 TEST(Cli, OrbitPathWithRefinementWritesEveryFrameAndEndsAtFullDetail) {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "pointillist/io/png.hpp"
+#include "cli/cli_run.hpp"
 #include "testing/testing.hpp"
 
 using namespace pointillist;
@@ -17,22 +18,8 @@ using ::testing::HasSubstr;
 
 namespace {
 
-struct Result {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr together
-};
-
-Result run(const std::string& args) {
-  const std::string cmd = std::string(POINTILLIST_CLI_PATH) + " " + args + " 2>&1";
-  Result r;
-  FILE* pipe = ::popen(cmd.c_str(), "r");
-  if (!pipe) return r;
-  char buf[4096];
-  while (std::size_t n = std::fread(buf, 1, sizeof buf, pipe)) r.output.append(buf, n);
-  const int status = ::pclose(pipe);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+using Result = pointillist::testing::CliResult;
+Result run(const std::string& args) { return pointillist::testing::run_cli(args); }
 
 // A black w×h image with a white w/2 × h/2 rectangle whose top-left corner is (x0, y0).
 void write_rect_png(const std::string& path, int w, int h, int x0, int y0) {

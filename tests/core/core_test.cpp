@@ -58,6 +58,27 @@ TEST(Camera, OrbitPlacesTheEyeAsTheArchitectureSays) {
   EXPECT_THROW(orbit_camera(vs, {.elevation_deg = 90}), OptionError);
 }
 
+TEST(Camera, OrbitAroundAZUpAxisKeepsZUpAndMeasuresElevationFromTheXYPlane) {
+  const Sphere vs{{1, 2, 3}, 2.0f};
+  // Azimuth 0, elevation 30°, distance 3 radii, +Z up: the eye is 6 units away, in front along
+  // −Y (Z' = X × up = −Y), 6·sin 30° = 3 above the centre.
+  const Camera c = orbit_camera(
+      vs, {.azimuth_deg = 0, .elevation_deg = 30, .distance = 3, .up = {0, 0, 2}});
+  EXPECT_NEAR(c.eye.x, 1, 1e-5f);
+  EXPECT_NEAR(c.eye.y, 2 - 6 * std::cos(deg_to_rad(30)), 1e-5f);
+  EXPECT_NEAR(c.eye.z, 3 + 3, 1e-5f);
+  EXPECT_NEAR(c.up.z, 1, 1e-6f);
+  // Azimuth 90°: along +X, as with +Y up.
+  const Camera d = orbit_camera(vs, {.azimuth_deg = 90, .distance = 3, .up = {0, 0, 1}});
+  EXPECT_NEAR(d.eye.x, 7, 1e-5f);
+  EXPECT_NEAR(d.eye.z, 3, 1e-5f);
+  // The default equals an explicit +Y.
+  const Camera e = orbit_camera(vs, {.azimuth_deg = 40, .elevation_deg = 20});
+  const Camera f = orbit_camera(vs, {.azimuth_deg = 40, .elevation_deg = 20, .up = {0, 1, 0}});
+  EXPECT_EQ(e.eye, f.eye);
+  EXPECT_THROW(orbit_camera(vs, {.up = {0, 0, 0}}), OptionError);
+}
+
 TEST(Camera, FrameProjectsWithTheStatedFocalLengthAndFrustum) {
   const Camera c{.eye = {0, 0, 10}, .target = {0, 0, 0}, .fov_deg = 90, .width = 200, .height = 100};
   const CameraFrame f = make_camera_frame(c);

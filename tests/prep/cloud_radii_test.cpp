@@ -39,7 +39,7 @@ TEST(CloudRadii, MatchBruteForceOnRandomPoints) {
   const std::vector<Vec3f>& p = s.points.positions;
   ThreadPool pool(2);
   const std::vector<float> r =
-      cloud_radii(p, pool, Progress::none(), {.neighbours = 3, .coverage = 1.0f});
+      cloud_radii(p, pool, Progress::none(), {.neighbours = 3, .coverage = 1.0f, .outlier_ratio = 0});
   for (std::size_t i = 0; i < p.size(); ++i) {
     std::vector<float> d;
     for (std::size_t j = 0; j < p.size(); ++j) {
@@ -159,4 +159,56 @@ TEST(CloudRadii, DefaultCoverageLeavesNoHolesOnRandomlySampledSurfaces) {
 TEST(CloudRadii, CoverageOfOneLeavesHoles) {
   // The check above can fail: at coverage 1 about 1% of such a surface is uncovered.
   EXPECT_GT(uncovered_fraction(sphere_scene(), 5'000, 25, 100'000, 1.0f), 0.003);
+}
+
+TEST(CloudRadii, IsolatedPointsAreCappedAtTheirNeighboursRadiusTimesTheOutlierRatio) {
+  // A 20 × 20 grid of spacing h and two stray points 40 h above its centre, h apart (a pair, so
+  // that neither is the other's only neighbour). Uncapped, a stray point's mean 5-NN distance
+  // is about (h + 4·40h)/5 ≈ 32 h. Its neighbours' median is a grid point's mean distance
+  // ((4 + √2)/5 h) or at most a few h more; with the cap the stray radius stays
+  // within kDefaultOutlierRatio (4) × that.
+  const float h = 0.1f;
+  std::vector<Vec3f> p;
+  for (int y = 0; y < 20; ++y) {
+    for (int x = 0; x < 20; ++x) p.push_back({x * h, y * h, 0.0f});
+  }
+  p.push_back({1.0f, 1.0f, 40 * h});
+  p.push_back({1.0f + h, 1.0f, 40 * h});
+  ThreadPool pool(2);
+  const std::vector<float> capped = cloud_radii(p, pool, Progress::none(), {.coverage = 1.0f});
+  const std::vector<float> uncapped =
+      cloud_radii(p, pool, Progress::none(), {.coverage = 1.0f, .outlier_ratio = 0.0f});
+  const float grid_mean = (4.0f + std::sqrt(2.0f)) * h / 5.0f;
+  for (std::size_t s : {std::size_t{400}, std::size_t{401}}) {
+    EXPECT_GT(uncapped[s], 25 * h) << "stray point " << s;
+    EXPECT_LE(capped[s], kDefaultOutlierRatio * 1.5f * grid_mean) << "stray point " << s;
+  }
+  // Grid points keep the defining formula (their neighbours are as dense as they are).
+  for (int y = 1; y < 19; ++y) {
+    for (int x = 1; x < 19; ++x) {
+      EXPECT_NEAR(capped[std::size_t(y * 20 + x)], grid_mean, 1e-6f) << x << "," << y;
+    }
+  }
+}
+
+TEST(CloudRadii, UniformlySparseRegionsAreNotCapped) {
+  // Two grids side by side, one 4× sparser than the other: interior points of the sparse grid
+  // (away from the border) keep their full mean distance although it is 4× the dense grid's.
+  std::vector<Vec3f> p;
+  const float h = 0.1f, H = 0.4f;
+  for (int y = 0; y < 40; ++y) {
+    for (int x = 0; x < 40; ++x) p.push_back({x * h, y * h, 0.0f});
+  }
+  const std::size_t sparse_start = p.size();
+  for (int y = 0; y < 10; ++y) {
+    for (int x = 0; x < 10; ++x) p.push_back({10.0f + x * H, y * H, 0.0f});
+  }
+  ThreadPool pool(2);
+  const std::vector<float> r = cloud_radii(p, pool, Progress::none(), {.coverage = 1.0f});
+  const float sparse_mean = (4.0f + std::sqrt(2.0f)) * H / 5.0f;
+  for (int y = 1; y < 9; ++y) {
+    for (int x = 1; x < 9; ++x) {
+      EXPECT_NEAR(r[sparse_start + std::size_t(y * 10 + x)], sparse_mean, 1e-6f) << x << "," << y;
+    }
+  }
 }

@@ -27,10 +27,15 @@ struct OrbitOptions {
   float fov_deg = 30.0f;
   int width = 1024;
   int height = 768;
+  // The model's up axis: elevation is measured from the plane perpendicular to it and the camera
+  // keeps it pointing up in the image. +Y by default (the world convention); scans that use +Z
+  // up (most LAS files) pass {0, 0, 1}. Azimuth 0 looks along −Z' where X' is +X made
+  // perpendicular to `up` (+Z for up along ±X) and Z' = X' × up: (+Z for +Y up, −Y for +Z up).
+  Vec3f up = {0.0f, 1.0f, 0.0f};
 };
 
-// Throws OptionError when the elevation is ±90° (the up vector is then undefined) or the
-// size/fov/distance is out of range.
+// Throws OptionError when the elevation is ±90° (the up vector is then undefined), `up` is zero
+// or not finite, or the size/fov/distance is out of range.
 Camera orbit_camera(const Sphere& view_sphere, const OrbitOptions& options);
 
 // A plane n·p + d = 0 with unit normal n; signed distance n·p + d, positive inside.

@@ -27,6 +27,8 @@ struct PrepareOptions {
   // Point clouds without radii: radius = mean 5-NN distance × coverage × radius_scale; > 0.
   // See kDefaultCloudCoverage for how the default was chosen.
   float coverage = kDefaultCloudCoverage;
+  // Cap on an isolated point's radius relative to its neighbours' (CloudRadiusOptions); 0 = off.
+  float outlier_ratio = kDefaultOutlierRatio;
   // Names the input in error messages (e.g. the file path).
   std::string input_name = "the input";
 };

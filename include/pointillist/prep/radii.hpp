@@ -34,6 +34,11 @@ std::vector<float> mesh_radii(std::span<const Vec3f> positions,
 // projected disc.
 inline constexpr float kDefaultCloudCoverage = 2.5f;
 
+// Default cap on a cloud radius relative to its neighbours' (see CloudRadiusOptions).
+// 4 leaves randomly (Poisson) sampled surfaces covered as measured above (the coverage tests
+// run with the cap on); 3 already caps some points of a random sample when few neighbours are used.
+inline constexpr float kDefaultOutlierRatio = 4.0f;
+
 struct CloudRadiusOptions {
   std::uint32_t neighbours = 5;  // the mean distance to this many nearest neighbours is measured
   // Radius = mean distance × coverage × scale. The default closes the holes between the discs of
@@ -41,10 +46,17 @@ struct CloudRadiusOptions {
   // uneven scans, lower it for samples on a regular grid (0.75 covers a square grid).
   float coverage = kDefaultCloudCoverage;
   float scale = 1.0f;  // the user's --radius-scale
+  // Isolated points (stray returns, a leaf far from the rest) would get discs as large as the
+  // gap to the main cloud. Each point's mean distance is capped at outlier_ratio × the median
+  // of its neighbours' mean distances before the coverage factor is applied. A point in a
+  // uniformly sparse region is not affected (its neighbours are as sparse); only a point much
+  // sparser than its own neighbours is. 0 = no cap.
+  float outlier_ratio = kDefaultOutlierRatio;
 };
 
 // Radius of each point of a cloud (world units): the mean distance to its `neighbours` nearest
-// other points × coverage × scale. Points whose neighbours all coincide with them get 0.
+// other points (capped at outlier_ratio × the median of the same for those neighbours) ×
+// coverage × scale. Points whose neighbours all coincide with them get 0.
 // Throws OptionError when neighbours == 0, Error when a position is not finite. Progress phases
 // "neighbours", "radii". Deterministic for any thread count.
 std::vector<float> cloud_radii(std::span<const Vec3f> positions, ThreadPool& pool,

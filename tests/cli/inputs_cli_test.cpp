@@ -1,0 +1,324 @@
+// End-to-end tests of the inputs and model formats added to the command line: QSplat .qs files
+// (rendered, described, written byte for byte as qsplat_make does), XYZ/LAS/OBJ inputs merged
+// by `convert`, the model's up axis, and the quality mode.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cli/cli_run.hpp"
+#include "io/las_builder.hpp"
+#include "pointillist/io/png.hpp"
+#include "testing/testing.hpp"
+
+using namespace pointillist;
+using pointillist::testing::CliResult;
+using pointillist::testing::run_cli;
+using pointillist::testing::TempDir;
+using pointillist::testing::write_text_file;
+using ::testing::HasSubstr;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string qsplat_sample(const std::string& name) {
+  return (pointillist::testing::shared_testdata_dir() / "qsplat" / name).string();
+}
+
+std::string file_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// Pixels that differ from the background (black).
+std::size_t drawn_pixels(const ImageRgb8& img) {
+  std::size_t n = 0;
+  for (const Rgb8& p : img.pixels) n += (p.r | p.g | p.b) != 0;
+  return n;
+}
+
+// Values after "label" in `info` output: "bounds:      min (a, b, c)  max (d, e, f)".
+std::vector<double> info_bounds(const std::string& info) {
+  const auto at = info.find("bounds:");
+  std::vector<double> v(6, NAN);
+  if (at == std::string::npos) return v;
+  std::sscanf(info.c_str() + at, "bounds: min (%lf, %lf, %lf) max (%lf, %lf, %lf)", &v[0], &v[1],
+              &v[2], &v[3], &v[4], &v[5]);
+  return v;
+}
+
+}  // namespace
+
+TEST(QsCli, InfoAndRenderOpenTheFilesQsplatMakeWrote) {
+  TempDir dir;
+  const CliResult info = run_cli("info " + qsplat_sample("dragon_vrip_res4_color.strict.qs"));
+  ASSERT_EQ(info.exit_code, 0) << info.output;
+  // Leaf count and structure from the sample folder's README (made by QSplat 1.0's tool).
+  EXPECT_THAT(info.output, HasSubstr("QSplat model (.qs 1.1)"));
+  EXPECT_THAT(info.output, HasSubstr("points:      5203 (leaves)"));
+  EXPECT_THAT(info.output, HasSubstr("nodes:       7753"));  // 7752 records + the root
+  EXPECT_THAT(info.output, HasSubstr("depth:       9 levels"));
+  EXPECT_THAT(info.output, HasSubstr("color"));
+
+  const std::string png = dir.file("qs.png");
+  const CliResult ren = run_cli("render " + qsplat_sample("dragon_vrip_res4_color.strict.qs") +
+                                " -o " + png + " --size 320x240 --view 20,10");
+  ASSERT_EQ(ren.exit_code, 0) << ren.output;
+  const ImageRgb8 img = read_png_rgb8(png);
+  EXPECT_GT(drawn_pixels(img), 320u * 240u / 10) << "the dragon should fill part of the frame";
+  // The synthetic colours run red with x, green with y, blue with z: the picture is not grey.
+  std::size_t coloured = 0;
+  for (const Rgb8& p : img.pixels) coloured += std::abs(int(p.r) - int(p.b)) > 40;
+  EXPECT_GT(coloured, 500u);
+}
+
+TEST(QsCli, ConvertToQsWritesTheBytesQsplatMakeWrote) {
+  TempDir dir;
+  for (const std::string base : {"dragon_vrip_res4", "dragon_vrip_res4_color"}) {
+    const std::string out = dir.file(base + ".qs");
+    const CliResult conv = run_cli("convert " + qsplat_sample(base + ".bbe.ply") + " -o " + out);
+    ASSERT_EQ(conv.exit_code, 0) << conv.output;
+    EXPECT_EQ(file_bytes(out), file_bytes(qsplat_sample(base + ".strict.qs"))) << base;
+  }
+}
+
+TEST(QsCli, AQsModelIsNotAnInputToConvert) {
+  TempDir dir;
+  const CliResult r =
+      run_cli("convert " + qsplat_sample("dragon_vrip_res4.qs") + " -o " + dir.file("x.ptl"));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_THAT(r.output, HasSubstr("already a splat model (.qs)"));
+  EXPECT_FALSE(fs::exists(dir.file("x.ptl")));
+}
+
+TEST(InputsCli, ConvertMergesSeveralTextFiles) {
+  TempDir dir;
+  // Two halves of a 40 × 40 grid in the plane z = 0, one with a header and commas.
+  std::string a = "x y z\n", b;
+  for (int j = 0; j < 40; ++j) {
+    for (int i = 0; i < 40; ++i) {
+      std::string& out = i < 20 ? a : b;
+      char line[64];
+      std::snprintf(line, sizeof line, i < 20 ? "%g %g 0\n" : "%g,%g,0\n", i * 0.1, j * 0.1);
+      out += line;
+    }
+  }
+  write_text_file(dir.file("a.xyz"), a);
+  write_text_file(dir.file("b.csv"), b);
+  const std::string ptl = dir.file("grid.ptl");
+  const CliResult conv =
+      run_cli("convert " + dir.file("a.xyz") + " " + dir.file("b.csv") + " -o " + ptl);
+  ASSERT_EQ(conv.exit_code, 0) << conv.output;
+  EXPECT_THAT(conv.output, HasSubstr("converted 1600 points"));
+  const CliResult info = run_cli("info " + ptl);
+  ASSERT_EQ(info.exit_code, 0) << info.output;
+  EXPECT_THAT(info.output, HasSubstr("points:      1600"));
+  const std::vector<double> box = info_bounds(info.output);
+  EXPECT_NEAR(box[0], 0.0, 1e-5);
+  EXPECT_NEAR(box[3], 3.9, 1e-5);
+  EXPECT_NEAR(box[4], 3.9, 1e-5);
+}
+
+TEST(InputsCli, GeoreferencedLasTilesLineUpWhenMerged) {
+  // Two tiles of one survey at UTM-like coordinates (x ≈ 500 km, y ≈ 4000 km), 1 mm steps: each
+  // tile is shifted to its own local origin by the reader (the coordinates are too large for
+  // float steps of 1 mm), so merging must bring the second into the first one's frame. Tile A
+  // covers x = 0..9.5 m, tile B x = 10..19.5 m of the same 0.5 m grid: merged, the model spans
+  // 19.5 m; overlaid in the wrong frame it would span 9.5 m.
+  TempDir dir;
+  using pointillist::testing::LasPoint;
+  using pointillist::testing::LasSpec;
+  LasSpec spec;
+  spec.format = 0;
+  spec.scale[0] = spec.scale[1] = spec.scale[2] = 0.001;
+  spec.offset[0] = 500000.0;
+  spec.offset[1] = 4000000.0;
+  spec.offset[2] = 0.0;
+  for (int tile = 0; tile < 2; ++tile) {
+    std::vector<LasPoint> points;
+    for (int j = 0; j < 20; ++j) {
+      for (int i = 0; i < 20; ++i) {
+        points.push_back({(tile * 20 + i) * 500, j * 500, 100000});
+      }
+    }
+    pointillist::testing::write_file(dir.file("tile" + std::to_string(tile) + ".las"),
+                                     pointillist::testing::build_las(spec, points));
+  }
+  const std::string ptl = dir.file("survey.ptl");
+  const CliResult conv = run_cli("convert " + dir.file("tile0.las") + " " + dir.file("tile1.las") +
+                                 " -o " + ptl + " --normals pca");
+  ASSERT_EQ(conv.exit_code, 0) << conv.output;
+  const CliResult info = run_cli("info " + ptl);
+  ASSERT_EQ(info.exit_code, 0) << info.output;
+  EXPECT_THAT(info.output, HasSubstr("points:      800"));
+  const std::vector<double> box = info_bounds(info.output);
+  EXPECT_NEAR(box[3] - box[0], 19.5, 1e-3) << info.output;
+  EXPECT_NEAR(box[4] - box[1], 9.5, 1e-3) << info.output;
+  EXPECT_NEAR(box[5] - box[2], 0.0, 1e-3) << info.output;
+}
+
+TEST(InputsCli, CompressedLasIsRefusedWithAdviceAndNoOutput) {
+  TempDir dir;
+  write_text_file(dir.file("scan.laz"), "LASF not really compressed");
+  const CliResult r = run_cli("convert " + dir.file("scan.laz") + " -o " + dir.file("scan.ptl"));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_THAT(r.output, HasSubstr("scan.laz"));
+  EXPECT_THAT(r.output, HasSubstr("compressed LAS (LAZ) is not supported yet"));
+  EXPECT_FALSE(fs::exists(dir.file("scan.ptl")));
+}
+
+TEST(InputsCli, BadTextLineIsNamedAndNothingIsWritten) {
+  TempDir dir;
+  write_text_file(dir.file("bad.xyz"), "1 2 3\n4 5 6\n7 eight 9\n");
+  const CliResult r = run_cli("convert " + dir.file("bad.xyz") + " -o " + dir.file("bad.ptl"));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_THAT(r.output, HasSubstr("bad.xyz"));
+  EXPECT_THAT(r.output, HasSubstr("line 3"));
+  EXPECT_FALSE(fs::exists(dir.file("bad.ptl")));
+}
+
+TEST(InputsCli, ObjMeshRendersDirectly) {
+  // A unit square as two triangles facing +z, seen from the front: the middle of the image is
+  // drawn, the corners are not.
+  TempDir dir;
+  std::string obj = "# square\n";
+  const int n = 30;
+  for (int j = 0; j <= n; ++j) {
+    for (int i = 0; i <= n; ++i) obj += "v " + std::to_string(double(i) / n) + " " +
+                                          std::to_string(double(j) / n) + " 0\n";
+  }
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) {
+      const int a = j * (n + 1) + i + 1, b = a + 1, c = a + n + 1, d = c + 1;
+      obj += "f " + std::to_string(a) + " " + std::to_string(b) + " " + std::to_string(d) + "\n";
+      obj += "f " + std::to_string(a) + " " + std::to_string(d) + " " + std::to_string(c) + "\n";
+    }
+  }
+  write_text_file(dir.file("square.obj"), obj);
+  const std::string png = dir.file("square.png");
+  const CliResult r = run_cli("render " + dir.file("square.obj") + " -o " + png + " --size 100x100");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const ImageRgb8 img = read_png_rgb8(png);
+  const Rgb8 centre = img.pixels[50 * 100 + 50];
+  EXPECT_GT(int(centre.r) + centre.g + centre.b, 150);
+  EXPECT_EQ(img.pixels[0], (Rgb8{0, 0, 0}));
+}
+
+TEST(ViewCli, UpAxisOrbitsAZUpModelUpright) {
+  // A tall thin column along +z (a z-up scan): with --up 0,0,1 it stands upright in the image
+  // (taller than wide); with the default +y up it lies across it.
+  TempDir dir;
+  std::string xyz;
+  for (int k = 0; k < 200; ++k) {
+    for (int a = 0; a < 24; ++a) {
+      const double t = 2 * M_PI * a / 24;
+      char line[96];
+      std::snprintf(line, sizeof line, "%g %g %g\n", 0.1 * std::cos(t), 0.1 * std::sin(t),
+                    k * 0.01);
+      xyz += line;
+    }
+  }
+  write_text_file(dir.file("column.xyz"), xyz);
+  const auto extent = [&](const std::string& extra) {
+    const std::string png = dir.file("column.png");
+    const CliResult r =
+        run_cli("render " + dir.file("column.xyz") + " -o " + png + " --size 200x200 " + extra);
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    const ImageRgb8 img = read_png_rgb8(png);
+    int x0 = 200, x1 = -1, y0 = 200, y1 = -1;
+    for (int y = 0; y < 200; ++y) {
+      for (int x = 0; x < 200; ++x) {
+        const Rgb8 p = img.pixels[std::size_t(y) * 200 + x];
+        if ((p.r | p.g | p.b) == 0) continue;
+        x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+      }
+    }
+    return std::pair{x1 - x0, y1 - y0};
+  };
+  const auto [w_up, h_up] = extent("--view 0,10 --up 0,0,1");
+  EXPECT_GT(h_up, 3 * w_up) << "upright with --up 0,0,1";
+  const auto [w_y, h_y] = extent("--view 90,10");
+  EXPECT_GT(w_y, 3 * h_y) << "lying across with the default +y up";
+  const CliResult bad = run_cli("render " + dir.file("column.xyz") + " -o " +
+                                dir.file("x.png") + " --up 0,0,0");
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_THAT(bad.output, HasSubstr("not a direction"));
+}
+
+TEST(QualityCli, QualityModeRendersAndReportsItsSettings) {
+  TempDir dir;
+  const std::string ply = dir.file("sphere.ply"), ptl = dir.file("sphere.ptl");
+  ASSERT_EQ(run_cli("generate --scene sphere --points 20000 -o " + ply).exit_code, 0);
+  ASSERT_EQ(run_cli("convert -q " + ply + " -o " + ptl).exit_code, 0);
+  for (const std::string rule : {"zrange", "zthreshold"}) {
+    const std::string png = dir.file(rule + ".png");
+    const CliResult r = run_cli("render " + ptl + " -o " + png +
+                                " --size 160x120 --mode quality --reconstruction " + rule +
+                                " --stats -");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_THAT(r.output, HasSubstr("\"mode\": \"quality\""));
+    EXPECT_THAT(r.output, HasSubstr("\"reconstruction\": \"" + rule + "\""));
+    EXPECT_THAT(r.output, HasSubstr("\"splats\""));
+    const ImageRgb8 img = read_png_rgb8(png);
+    const Rgb8 centre = img.pixels[60 * 160 + 80];
+    EXPECT_GT(int(centre.r) + centre.g + centre.b, 100) << rule;
+    EXPECT_EQ(img.pixels[0], (Rgb8{0, 0, 0})) << rule;
+  }
+  const CliResult spt = run_cli("render " + ptl + " -o " + dir.file("x.png") +
+                                " --mode quality --lod spt");
+  EXPECT_NE(spt.exit_code, 0);
+  EXPECT_THAT(spt.output, HasSubstr("cannot be combined with --lod spt"));
+  const CliResult opacity = run_cli("render " + ptl + " -o " + dir.file("x.png") +
+                                    " --mode quality --opacity 0");
+  EXPECT_NE(opacity.exit_code, 0);
+  EXPECT_THAT(opacity.output, HasSubstr("--opacity"));
+}
+
+TEST(InputsCliData, LionLasTilesConvertTogetherAndRenderInColour) {
+  const fs::path dir_in = pointillist::testing::model_cache_dir() / "lion_takanawa_las";
+  if (!fs::is_directory(dir_in)) GTEST_SKIP() << "run scripts/fetch-models.sh for the lion scan";
+  std::vector<std::string> tiles;
+  for (const auto& e : fs::directory_iterator(dir_in)) {
+    if (e.path().extension() == ".las") tiles.push_back(e.path().string());
+  }
+  ASSERT_GT(tiles.size(), 10u);
+  // The expected count from the headers (legacy point count, byte 107 of a LAS header).
+  std::uint64_t expected = 0;
+  std::string args;
+  for (const std::string& t : tiles) {
+    const std::string bytes = file_bytes(t);
+    ASSERT_GE(bytes.size(), 111u) << t;
+    std::uint32_t count = 0;
+    std::memcpy(&count, bytes.data() + 107, 4);
+    expected += count;
+    args += " " + t;
+  }
+  TempDir dir;
+  const std::string ptl = dir.file("lion.ptl"), png = dir.file("lion.png");
+  const CliResult conv = run_cli("convert -q" + args + " -o " + ptl);
+  ASSERT_EQ(conv.exit_code, 0) << conv.output;
+  const CliResult info = run_cli("info " + ptl);
+  EXPECT_THAT(info.output, HasSubstr("points:      " + std::to_string(expected) + " (leaves)"));
+  EXPECT_THAT(info.output, HasSubstr("color"));
+  const CliResult ren =
+      run_cli("render " + ptl + " -o " + png + " --size 400x300 --view 30,15 --up 0,0,1");
+  ASSERT_EQ(ren.exit_code, 0) << ren.output;
+  const ImageRgb8 img = read_png_rgb8(png);
+  // The stone lion is grey; the foliage around it is green.
+  std::size_t green = 0, grey = 0;
+  for (const Rgb8& p : img.pixels) {
+    if ((p.r | p.g | p.b) == 0) continue;
+    if (p.g > p.r + 15 && p.g > p.b + 15) ++green;
+    if (std::abs(int(p.r) - int(p.g)) < 12 && std::abs(int(p.g) - int(p.b)) < 12 && p.r > 40) ++grey;
+  }
+  EXPECT_GT(green, 200u);
+  EXPECT_GT(grey, 5000u);
+}
