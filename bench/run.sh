@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs every benchmark and prints the figures as ratios against baselines measured in the same run.
 #   bash bench/run.sh            all benchmarks (several minutes: includes a 10-million-point cloud)
-#   BENCH_QUICK=1 bash bench/run.sh   skip the 10-million-point end-to-end conversion
+#   BENCH_QUICK=1 bash bench/run.sh   skip the 10-million-point model (conversion and level of detail)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bin=build/release
@@ -105,3 +105,6 @@ if [ -z "${BENCH_QUICK:-}" ]; then
 fi
 
 summary
+
+echo
+bash bench/lod.sh "$work"

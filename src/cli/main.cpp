@@ -238,6 +238,8 @@ int main(int argc, char** argv) {
                      "it one view scans");
   info_cmd->add_option("--view", info_view, "With --spt: orbit view AZ,EL (default 0,0)");
   info_cmd->add_option("--size", info_size, "With --spt: image size WxH")->default_str("1280x720");
+  info_cmd->add_option("--distance", info.view.distance,
+                       "With --spt: eye distance in model radii (default: whole model in view)");
   info_cmd->add_option("--epsilon", info.epsilon_px, "With --spt: error bound, pixels")
       ->default_val(1.0f)
       ->check(CLI::Range(0.001f, 1000.0f));
