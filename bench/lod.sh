@@ -29,6 +29,14 @@ model_rows() {  # model_rows NAME MODEL.ptl FRAME_MS
   local q="$work/q.json" s="$work/s.json"
   "$cli" render "$model" -o "$work/q.png" --path orbit:$frames --stats "$q" -q
   "$cli" render "$model" -o "$work/s.png" --path orbit:$frames --stats "$s" -q --lod spt
+  local u="$work/u.json" c="$work/c.json" cu="$work/cu.json"
+  "$cli" render "$model" -o "$work/u.png" --path orbit:$frames --stats "$u" -q --lod spt \
+    --no-chunk-culling
+  # A close-up orbit (0.4 model radii), where chunks leave the frustum, with and without culling.
+  "$cli" render "$model" -o "$work/c.png" --path orbit:$frames --stats "$c" -q --lod spt \
+    --distance 0.4
+  "$cli" render "$model" -o "$work/c.png" --path orbit:$frames --stats "$cu" -q --lod spt \
+    --distance 0.4 --no-chunk-culling
   # The last frame of both orbits is the same view: compare the two images.
   local psnr
   psnr=$("$cli" compare "$work/q.png" "$work/s.png" --json - | sed -n 's/.*"psnr_db": \([0-9.a-z]*\).*/\1/p')
@@ -40,6 +48,12 @@ model_rows() {  # model_rows NAME MODEL.ptl FRAME_MS
   printf '%-12s %-16s %9s %11s %10s %12s %10s\n' "" "spt (chunked)" "$st" "$ssel" "$ss" \
     "$(awk -v n="$ss" -v t="$ssel" 'BEGIN { printf "%.1f", (t > 0 ? n / t / 1e3 : 0) }')" \
     "$(awk -v a="$qsel" -v b="$ssel" -v n="$qs" -v m="$ss" 'BEGIN { if (b > 0 && n > 0) { printf "%.2f", (a / n) / (b / m) } else { print "nan" } }')"
+  printf '%-12s %-16s %9s %11s %10s\n' "" "spt, no culling" "$(median ms "$u")" \
+    "$(median ms_select "$u")" "$(median splats "$u")"
+  printf '%-12s %-16s %9s %11s %10s\n' "" "close-up spt" "$(median ms "$c")" \
+    "$(median ms_select "$c")" "$(median splats "$c")"
+  printf '%-12s %-16s %9s %11s %10s\n' "" " no culling" "$(median ms "$cu")" \
+    "$(median ms_select "$cu")" "$(median splats "$cu")"
   echo "             PSNR qsplat vs spt (same view): $psnr dB"
   # The share of the list scanned, whole model in view and in a close-up (distance 0.4 model
   # radii, where whole chunks leave the frustum): chunk culling's savings.

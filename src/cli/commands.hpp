@@ -39,6 +39,7 @@ struct RenderOptions {
   std::string input;
   LodScheme lod = LodScheme::QSplat;  // --lod qsplat|spt
   float epsilon_px = 1.0f;            // --epsilon (spt)
+  bool no_chunk_culling = false;      // --no-chunk-culling (spt; to measure what culling saves)
   std::string output;
   ViewOptions view;
   RenderSettings settings;

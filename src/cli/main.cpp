@@ -187,6 +187,9 @@ int main(int argc, char** argv) {
                          "With --lod spt: allowed geometric error in pixels (1 = full detail)")
       ->default_val(1.0f)
       ->check(CLI::Range(0.001f, 1000.0f));
+  render_cmd->add_flag("--no-chunk-culling", render.no_chunk_culling,
+                       "With --lod spt: scan every chunk's list even when the chunk is outside "
+                       "the view (to measure what chunk culling saves)");
   std::string path;
   render_cmd->add_option("--path", path,
                          "Render a sequence of frames along a camera path: orbit:N = N frames "

@@ -110,7 +110,9 @@ class FrameRenderer {
   void draw(const Camera& camera, float detail, Frame& frame) {
     RenderSettings settings = o_.settings;
     if (o_.lod == LodScheme::Spt) {
-      render_spt(spt_, camera, settings, {.epsilon_px = detail}, pool_, frame, &spt_stats_);
+      render_spt(spt_, camera, settings,
+                 {.epsilon_px = detail, .chunk_culling = !o_.no_chunk_culling}, pool_, frame,
+                 &spt_stats_);
     } else if (o_.mode == RenderMode::Quality) {
       settings.threshold_px = detail;
       render_quality(tree_, camera, settings, o_.quality, pool_, frame, quality_scratch_);

@@ -225,3 +225,22 @@ TEST(Cli, SequentialPointTreeRenderAndInfo) {
   EXPECT_THAT(i.output, HasSubstr("% of the list"));
   EXPECT_NE(run("render " + ply + " -o " + dir.file("x.png") + " --lod octree").exit_code, 0);
 }
+
+TEST(Cli, ChunkCullingSkipsChunksInACloseUpWithoutChangingTheImage) {
+  // A close-up of the torus: part of it is outside the view. With chunk culling some chunks
+  // are culled; without, none are, and the image is the same (culling only skips chunks no
+  // entry of which could be drawn).
+  pointillist::testing::TempDir dir;
+  const auto ply = dir.file("scene.ply"), ptl = dir.file("scene.ptl");
+  ASSERT_EQ(run("generate --scene torus --points 40000 -o " + ply).exit_code, 0);
+  ASSERT_EQ(run("convert -q " + ply + " -o " + ptl).exit_code, 0);
+  const std::string common = " --size 200x150 --lod spt --distance 0.5 --view 20,10 --stats -";
+  const Result on = run("render " + ptl + " -o " + dir.file("on.png") + common);
+  const Result off =
+      run("render " + ptl + " -o " + dir.file("off.png") + common + " --no-chunk-culling");
+  ASSERT_EQ(on.exit_code, 0) << on.output;
+  ASSERT_EQ(off.exit_code, 0) << off.output;
+  EXPECT_THAT(off.output, HasSubstr("\"chunks_culled\": 0,"));
+  EXPECT_THAT(on.output, ::testing::Not(HasSubstr("\"chunks_culled\": 0,")));
+  EXPECT_EQ(read_png_rgb8(dir.file("on.png")).pixels, read_png_rgb8(dir.file("off.png")).pixels);
+}
