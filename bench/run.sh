@@ -13,7 +13,7 @@ trap 'rm -rf "$work"' EXIT
 
 csv="$work/results.csv"
 : > "$csv"
-for b in io prep lod render; do
+for b in io prep lod format render; do
   if [ -x "$bin/bench/${b}_bench" ]; then
     echo "== ${b}_bench"
     # Human-readable output on the terminal, CSV (one header line per program) for the summary.
@@ -34,6 +34,7 @@ summary() {
       t[name] = $col["real_time"]; items[name] = $col["items_per_second"]
       bytes[name] = $col["bytes_per_second"]
       if ("splats" in col) splats[name] = $col["splats"]
+      if ("bytes_per_point" in col) bpp[name] = $col["bytes_per_point"]
       if ("ms_select" in col) { sel[name] = $col["ms_select"]; ras[name] = $col["ms_raster"] }
     }
     function row(what, value, unit, base, base_unit, ratio) {
@@ -58,6 +59,15 @@ summary() {
       rate("kNN k=16, 1M points (points/s)", "BM_Knn16/1000000", "BM_BaselineBoundingBox/1000000", 1e6, "M/s", "items")
       rate("PCA normals, 1M points (points/s)", "BM_PcaNormals/1000000", "BM_BaselineBoundingBox/1000000", 1e6, "M/s", "items")
       rate("cloud radii, 1M points (points/s)", "BM_CloudRadii/1000000", "BM_BaselineBoundingBox/1000000", 1e6, "M/s", "items")
+      rate("LAS read, lion's 200 tiles (MB/s)", "BM_LasReadLion", "BM_BaselineReadLionBytes", 1e6, "MB/s", "bytes")
+      if (items["BM_LasReadLion"] != "")
+        row("  points/s", sprintf("%.1f", items["BM_LasReadLion"] / 1e6), "M/s", "", "", "")
+      if (bpp["BM_WriteQsDragon"] != "" && bpp["BM_BaselineWritePtlDragon"] != "")
+        row(".qs bytes/point, dragon (baseline .ptl v1)", sprintf("%.2f", bpp["BM_WriteQsDragon"]), "B",
+            sprintf("%.2f", bpp["BM_BaselineWritePtlDragon"]), "B",
+            sprintf("%.3f", bpp["BM_WriteQsDragon"] / bpp["BM_BaselineWritePtlDragon"]))
+      time(".qs write dragon (vs writing .ptl v1)", "BM_WriteQsDragon", "BM_BaselineWritePtlDragon")
+      time(".qs decode dragon (vs writing .ptl v1)", "BM_ReadQsDragon", "BM_BaselineWritePtlDragon")
       time("prepare dragon mesh (normals+radii)", "BM_PrepareDragonMesh", "BM_BaselineGunzipDragon")
       rate("hierarchy build, 437k points (points/s)", "BM_BuildSphereTree/437645", "BM_BaselineSortFloats/437645", 1e6, "M/s", "items")
       rate("hierarchy build, 10M points (points/s)", "BM_BuildSphereTree/10000000", "BM_BaselineSortFloats/10000000", 1e6, "M/s", "items")
