@@ -33,7 +33,7 @@ struct ViewOptions {
 };
 
 enum class LodScheme { QSplat, Spt };
-enum class RenderMode { Fast, Quality };
+enum class RenderMode { Fast, Quality, Reference };
 
 struct RenderOptions {
   std::string input;
@@ -43,7 +43,7 @@ struct RenderOptions {
   std::string output;
   ViewOptions view;
   RenderSettings settings;
-  RenderMode mode = RenderMode::Fast;  // --mode fast|quality
+  RenderMode mode = RenderMode::Fast;  // --mode fast|quality|reference
   QualitySettings quality;             // --reconstruction, --opacity (quality mode)
   std::string depth_output;  // empty = no depth image
   std::string stats_output;  // empty = none, "-" = stdout

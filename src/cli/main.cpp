@@ -204,10 +204,12 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--frames-out", render.frames_out,
                          "Write every frame of a sequence to DIR/frame_NNNNN.png");
   const std::map<std::string, pc::RenderMode> modes{{"fast", pc::RenderMode::Fast},
-                                                    {"quality", pc::RenderMode::Quality}};
+                                                    {"quality", pc::RenderMode::Quality},
+                                                    {"reference", pc::RenderMode::Reference}};
   render_cmd->add_option("--mode", render.mode,
-                         "fast (opaque splats, the default) or quality (perspective-correct "
-                         "Gaussian surface splatting with per-pixel shading)")
+                         "fast (opaque splats, the default), quality (perspective-correct "
+                         "Gaussian surface splatting with per-pixel shading), or reference (a "
+                         "mesh input's triangles, z-buffered, same camera and shading)")
       ->transform(CLI::CheckedTransformer(modes, CLI::ignore_case))
       ->default_str("fast");
   const std::map<std::string, pointillist::Reconstruction> reconstructions{

@@ -96,7 +96,8 @@ PointSet read_inputs(const std::vector<std::string>& paths, ThreadPool& pool, Pr
 }
 
 LoadedModel LoadedModel::open(const std::string& path, const PrepareOptions& prepare,
-                              ThreadPool& pool, Progress& progress, const std::string& columns) {
+                              ThreadPool& pool, Progress& progress, const std::string& columns,
+                              bool keep_source) {
   LoadedModel model;
   if (!std::filesystem::exists(path)) {
     throw IoError(path + ": no such file; check the path");
@@ -126,6 +127,7 @@ LoadedModel LoadedModel::open(const std::string& path, const PrepareOptions& pre
   prepare_splats(points, pool, progress, prepare);
   model.built_ = build_sphere_tree(points, pool, progress);
   model.view_ = model.built_.view();
+  if (keep_source) model.source = std::move(points);
   return model;
 }
 

@@ -40,8 +40,12 @@ class LoadedModel {
   bool input_has_normals = false, input_has_colors = false, input_has_radii = false;
   bool input_is_mesh = false;
 
+  // With keep_source, a scan's prepared points (normals and radii computed, faces kept) stay in
+  // `source` (for the triangle reference renderer); models (.ptl, .qs) leave it empty.
   static LoadedModel open(const std::string& path, const PrepareOptions& prepare, ThreadPool& pool,
-                          Progress& progress, const std::string& columns = {});
+                          Progress& progress, const std::string& columns = {},
+                          bool keep_source = false);
+  PointSet source;
 
  private:
   std::unique_ptr<PtlFile> file_;

@@ -15,6 +15,7 @@
 #include "pointillist/io/png.hpp"
 #include "pointillist/render/depth_image.hpp"
 #include "pointillist/render/frame_control.hpp"
+#include "pointillist/render/mesh_reference.hpp"
 #include "pointillist/render/spt_render.hpp"
 
 namespace pointillist::cli {
@@ -92,16 +93,29 @@ void check_sequence_options(const RenderOptions& o) {
 // SPT error bound (pixels).
 class FrameRenderer {
  public:
-  FrameRenderer(const RenderOptions& o, const SphereTreeView& tree, ThreadPool& pool,
+  FrameRenderer(const RenderOptions& o, const LoadedModel& model, ThreadPool& pool,
                 Progress& progress)
-      : o_(o), tree_(tree), pool_(pool) {
+      : o_(o), tree_(model.tree()), mesh_(model.source), pool_(pool) {
+    if (o.mode == RenderMode::Reference) {
+      if (o.lod == LodScheme::Spt) {
+        throw OptionError("--mode reference draws the mesh's triangles; it cannot be combined with "
+                          "--lod spt");
+      }
+      if (!mesh_.is_mesh()) {
+        throw OptionError(o.input + ": --mode reference draws a mesh's triangles, and this input " +
+                          (model.memory_mapped() || model.qsplat()
+                               ? std::string("is a splat model")
+                               : std::string("has no faces")) +
+                          "; give the source mesh (.ply, .obj)");
+      }
+    }
     if (o.mode == RenderMode::Quality && o.lod == LodScheme::Spt) {
       throw OptionError("--mode quality draws the QSplat hierarchy's splats; it cannot be combined "
                         "with --lod spt (drop --lod spt, or use --mode fast)");
     }
     if (o.mode == RenderMode::Quality) validate_quality_settings(o.quality);
     if (o.lod == LodScheme::Spt) {
-      spt_ = build_sequential_point_tree(sphere_tree_leaves(tree), pool, progress);
+      spt_ = build_sequential_point_tree(sphere_tree_leaves(tree_), pool, progress);
     }
   }
   float initial_detail() const {
@@ -113,6 +127,8 @@ class FrameRenderer {
       render_spt(spt_, camera, settings,
                  {.epsilon_px = detail, .chunk_culling = !o_.no_chunk_culling}, pool_, frame,
                  &spt_stats_);
+    } else if (o_.mode == RenderMode::Reference) {
+      render_mesh_reference(mesh_, camera, settings, frame);
     } else if (o_.mode == RenderMode::Quality) {
       settings.threshold_px = detail;
       render_quality(tree_, camera, settings, o_.quality, pool_, frame, quality_scratch_);
@@ -132,6 +148,7 @@ class FrameRenderer {
                     double(o_.quality.opacity));
       return buf;
     }
+    if (o_.mode == RenderMode::Reference) return "  \"mode\": \"reference\",\n";
     if (o_.lod != LodScheme::Spt) return "  \"lod\": \"qsplat\",\n  \"mode\": \"fast\",\n";
     char buf[512];
     std::snprintf(buf, sizeof buf,
@@ -150,6 +167,7 @@ class FrameRenderer {
  private:
   const RenderOptions& o_;
   const SphereTreeView& tree_;
+  const PointSet& mesh_;
   ThreadPool& pool_;
   SequentialPointTree spt_;
   SptSelectionStats spt_stats_;
@@ -195,8 +213,9 @@ std::vector<FrameRecord> render_sequence(const RenderOptions& o, const SphereTre
 int run_render(const RenderOptions& o) {
   ThreadPool pool(o.threads);
   TerminalProgress progress(!o.quiet && TerminalProgress::stderr_is_terminal());
-  const LoadedModel model = LoadedModel::open(o.input, o.prepare, pool, progress, o.columns);
-  FrameRenderer renderer(o, model.tree(), pool, progress);
+  const LoadedModel model = LoadedModel::open(o.input, o.prepare, pool, progress, o.columns,
+                                              o.mode == RenderMode::Reference);
+  FrameRenderer renderer(o, model, pool, progress);
   Frame frame;
   const bool sequence =
       o.orbit_frames > 0 || o.refine_frames > 0 || o.frame_ms > 0 || !o.frames_out.empty();

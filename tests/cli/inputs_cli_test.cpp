@@ -185,10 +185,10 @@ TEST(InputsCli, BadTextLineIsNamedAndNothingIsWritten) {
   EXPECT_FALSE(fs::exists(dir.file("bad.ptl")));
 }
 
-TEST(InputsCli, ObjMeshRendersDirectly) {
-  // A unit square as two triangles facing +z, seen from the front: the middle of the image is
-  // drawn, the corners are not.
-  TempDir dir;
+namespace {
+
+// A unit square in the plane z = 0 as a 30 × 30 grid of triangle pairs, facing +z.
+void write_square_obj(const std::string& path) {
   std::string obj = "# square\n";
   const int n = 30;
   for (int j = 0; j <= n; ++j) {
@@ -202,7 +202,15 @@ TEST(InputsCli, ObjMeshRendersDirectly) {
       obj += "f " + std::to_string(a) + " " + std::to_string(d) + " " + std::to_string(c) + "\n";
     }
   }
-  write_text_file(dir.file("square.obj"), obj);
+  write_text_file(path, obj);
+}
+
+}  // namespace
+
+TEST(InputsCli, ObjMeshRendersDirectly) {
+  // The square seen from the front: the middle of the image is drawn, the corners are not.
+  TempDir dir;
+  write_square_obj(dir.file("square.obj"));
   const std::string png = dir.file("square.png");
   const CliResult r = run_cli("render " + dir.file("square.obj") + " -o " + png + " --size 100x100");
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -321,4 +329,43 @@ TEST(InputsCliData, LionLasTilesConvertTogetherAndRenderInColour) {
   }
   EXPECT_GT(green, 200u);
   EXPECT_GT(grey, 5000u);
+}
+
+TEST(QualityCli, ReferenceModeDrawsTheTrianglesAndCompareMeasuresSplatsAgainstThem) {
+  // The square seen at an angle: the triangles drawn by --mode reference cover exactly the
+  // projected square; the quality-mode splats of the same mesh must cover it without holes and
+  // with nearly the same silhouette.
+  TempDir dir;
+  write_square_obj(dir.file("square.obj"));
+  const std::string view = " --size 200x150 --view 25,15";
+  const CliResult ref = run_cli("render " + dir.file("square.obj") + " -o " + dir.file("ref.png") +
+                                view + " --mode reference --stats -");
+  ASSERT_EQ(ref.exit_code, 0) << ref.output;
+  EXPECT_THAT(ref.output, HasSubstr("\"mode\": \"reference\""));
+  ASSERT_EQ(run_cli("render " + dir.file("square.obj") + " -o " + dir.file("q.png") + view +
+                    " --mode quality").exit_code, 0);
+  const CliResult cmp =
+      run_cli("compare " + dir.file("ref.png") + " " + dir.file("q.png") + " --json -");
+  ASSERT_EQ(cmp.exit_code, 0) << cmp.output;
+  double iou = 0;
+  unsigned long holes = 99;
+  const auto at_iou = cmp.output.find("\"silhouette_iou\":");
+  const auto at_holes = cmp.output.find("\"hole_pixels\":");
+  ASSERT_NE(at_iou, std::string::npos) << cmp.output;
+  ASSERT_NE(at_holes, std::string::npos) << cmp.output;
+  std::sscanf(cmp.output.c_str() + at_iou, "\"silhouette_iou\": %lf", &iou);
+  std::sscanf(cmp.output.c_str() + at_holes, "\"hole_pixels\": %lu", &holes);
+  // Splats on the square's border overhang it by their radius: cells are 1/30 of the square,
+  // about 3.2 px here, and a splat's radius is 1.1 × the circumradius of its right triangles
+  // (0.71 cells), about 2.5 px, along a perimeter of about 340 px: some 850 extra pixels on a
+  // square of 8,500, IoU about 0.91. 0.88 leaves room for rounding, and catches a silhouette
+  // off by a pixel more all around.
+  EXPECT_GE(iou, 0.88) << cmp.output;
+  EXPECT_EQ(holes, 0u) << cmp.output;
+  // A splat model has no triangles to draw.
+  ASSERT_EQ(run_cli("convert -q " + dir.file("square.obj") + " -o " + dir.file("sq.ptl")).exit_code, 0);
+  const CliResult bad = run_cli("render " + dir.file("sq.ptl") + " -o " + dir.file("x.png") +
+                                " --mode reference");
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_THAT(bad.output, HasSubstr("is a splat model"));
 }
