@@ -75,7 +75,7 @@ summary() {
       rate("kNN k=16, 1M points (points/s)", "BM_Knn16/1000000", "BM_BaselineBoundingBox/1000000", 1e6, "M/s", "items")
       rate("PCA normals, 1M points (points/s)", "BM_PcaNormals/1000000", "BM_BaselineBoundingBox/1000000", 1e6, "M/s", "items")
       rate("cloud radii, 1M points (points/s)", "BM_CloudRadii/1000000", "BM_BaselineBoundingBox/1000000", 1e6, "M/s", "items")
-      rate("LAS read, lion's 200 tiles (MB/s)", "BM_LasReadLion", "BM_BaselineReadLionBytes", 1e6, "MB/s", "bytes")
+      rate("LAS read, lion, 200 tiles (MB/s)", "BM_LasReadLion", "BM_BaselineReadLionBytes", 1e6, "MB/s", "bytes")
       if (items["BM_LasReadLion"] != "")
         row("  points/s", sprintf("%.1f", items["BM_LasReadLion"] / 1e6), "M/s", "", "", "")
       if (bpp["BM_WriteQsDragon"] != "" && bpp["BM_BaselineWritePtlDragon"] != "")
