@@ -273,14 +273,8 @@ PointSet read_obj(const std::string& path, Progress& progress, const ObjReadOpti
   FileBytes raw = FileBytes::map(path);
   const std::uint64_t file_size = raw.file_size();
   ReadProgress read_progress(progress, file_size);
-  const bool gzip = has_gzip_magic(raw.view());
-  FileBytes bytes;
-  if (gzip) {
-    read_progress.begin_part(file_size / 2, file_size);
-    bytes = FileBytes::inflate(raw, path, [&](std::uint64_t k) { read_progress.advance(k); });
-  } else {
-    bytes = std::move(raw);
-  }
+  FileBytes bytes = inflate_if_gzipped(std::move(raw), path, read_progress);
+  const bool gzip = bytes.was_compressed();
   read_progress.begin_part(file_size - (gzip ? file_size / 2 : 0), bytes.view().size());
   ObjParser parser(path, bytes.view(), options, read_progress);
   PointSet points = parser.parse();

@@ -9,12 +9,17 @@
 #include <cstring>
 #include <limits>
 
+#include "io/decimal_scan.hpp"
 #include "io/ply_body.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/core/thread_pool.hpp"
 
 namespace pointillist::ply {
 namespace {
+
+using io_detail::Decimal;
+using io_detail::is_digit;
+using io_detail::scan_decimal;
 
 inline bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r'; }
 
@@ -44,7 +49,6 @@ inline Range integer_range(ScalarType type) {
   return kRanges[static_cast<int>(type)];
 }
 
-inline bool is_digit(char c) { return static_cast<unsigned char>(c - '0') < 10; }
 inline bool ends_token_at(const char* q, const char* end) {
   return q == end || is_blank(*q) || *q == '\n';
 }
@@ -53,47 +57,13 @@ inline bool ends_token_at(const char* q, const char* end) {
 // many digits, a large exponent, "nan", a bad character), and the caller then takes the slow,
 // fully checked path, which either parses the token or throws a message naming it.
 
-// "-12.345e-6" as mantissa 12345, exponent -9; null unless the mantissa has at most 19 digits.
-struct Decimal {
-  std::uint64_t mantissa = 0;
-  int exponent = 0;
-  bool negative = false;
-};
-
-inline const char* scan_decimal(const char* p, const char* end, Decimal& d) {
-  if (p < end && (*p == '-' || *p == '+')) d.negative = *p++ == '-';
-  const char* digits = p;
-  std::uint64_t m = 0;
-  while (p < end && is_digit(*p)) m = m * 10 + static_cast<unsigned>(*p++ - '0');
-  std::ptrdiff_t count = p - digits;
-  if (p < end && *p == '.') {
-    const char* fraction = ++p;
-    while (p < end && is_digit(*p)) m = m * 10 + static_cast<unsigned>(*p++ - '0');
-    d.exponent = -static_cast<int>(p - fraction);
-    count += p - fraction;
-  }
-  if (count == 0 || count > 19) return nullptr;
-  if (p < end && (*p == 'e' || *p == 'E')) {
-    ++p;
-    bool negative_exponent = false;
-    if (p < end && (*p == '-' || *p == '+')) negative_exponent = *p++ == '-';
-    const char* exponent_digits = p;
-    int e = 0;
-    while (p < end && is_digit(*p) && p - exponent_digits < 4) e = e * 10 + (*p++ - '0');
-    if (p == exponent_digits) return nullptr;
-    d.exponent += negative_exponent ? -e : e;
-  }
-  if (!ends_token_at(p, end)) return nullptr;
-  d.mantissa = m;
-  return p;
-}
 
 // Exact when the mantissa and the power of ten are exact in the type: one correctly rounded
 // multiplication or division (Clinger's fast path), so the result equals std::from_chars.
 inline const char* fast_float(const char* p, const char* end, float& out) {
   constexpr float kPow10[] = {1e0f, 1e1f, 1e2f, 1e3f, 1e4f, 1e5f, 1e6f, 1e7f, 1e8f, 1e9f, 1e10f};
   Decimal d;
-  p = scan_decimal(p, end, d);
+  p = scan_decimal(p, end, d, ends_token_at);
   if (!p || d.mantissa > (1u << 24) || d.exponent < -10 || d.exponent > 10) return nullptr;
   float v = static_cast<float>(d.mantissa);
   v = d.exponent < 0 ? v / kPow10[-d.exponent] : v * kPow10[d.exponent];
@@ -106,7 +76,7 @@ inline const char* fast_double(const char* p, const char* end, double& out) {
                                1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
                                1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
   Decimal d;
-  p = scan_decimal(p, end, d);
+  p = scan_decimal(p, end, d, ends_token_at);
   if (!p || d.mantissa > (std::uint64_t{1} << 53) || d.exponent < -22 || d.exponent > 22)
     return nullptr;
   double v = static_cast<double>(d.mantissa);

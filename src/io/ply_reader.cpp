@@ -8,6 +8,7 @@
 #include <limits>
 #include <optional>
 
+#include "io/decimal_scan.hpp"
 #include "io/file_bytes.hpp"
 #include "io/ply_body.hpp"
 #include "pointillist/core/error.hpp"
@@ -127,29 +128,6 @@ class ReadProgress {
   std::atomic<std::uint64_t> reported_{0};
 };
 
-// Normalizes in place; zero or non-finite normals become (0, 0, 1). When no normal is usable
-// the file had none in substance, and the array is dropped.
-void finish_normals(std::vector<Vec3f>& normals) {
-  bool any = false;
-  for (Vec3f& n : normals) {
-    const float length2 = dot(n, n);
-    // Already unit (what most writers store): nothing to do, and no square root.
-    if (length2 > 0.99999f && length2 < 1.00001f) {
-      any = true;
-      continue;
-    }
-    if (length2 > 0.0f && std::isfinite(length2)) {
-      n = n / std::sqrt(length2);
-      any = true;
-    } else {
-      n = {0, 0, 1};
-    }
-  }
-  if (!any) {
-    normals.clear();
-    normals.shrink_to_fit();
-  }
-}
 
 // Sizes a large output array. Asking for transparent huge pages before the first touch makes
 // filling hundreds of MB take a few hundred page faults instead of tens of thousands (measured:
@@ -246,7 +224,7 @@ class PlyRead {
   }
 
   PointSet finish() {
-    if (points.has_normals()) finish_normals(points.normals);
+    if (points.has_normals()) io_detail::finish_normals(points.normals);
     points.comments = header.comments;
     progress_.finish();
     return std::move(points);

@@ -20,6 +20,8 @@
 #include <type_traits>
 #include <vector>
 
+#include "io/decimal_scan.hpp"
+#include "io/file_bytes.hpp"
 #include "pointillist/core/math.hpp"
 #include "pointillist/core/progress.hpp"
 
@@ -28,7 +30,6 @@ namespace pointillist::io_detail {
 // Characters -----------------------------------------------------------------------------------
 
 inline bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r'; }
-inline bool is_digit(char c) { return static_cast<unsigned char>(c - '0') < 10; }
 // A number token ends at a blank, the end of the line, or a CSV delimiter.
 inline bool ends_number_at(const char* q, const char* end) {
   return q == end || is_blank(*q) || *q == '\n' || *q == ',' || *q == ';';
@@ -64,41 +65,6 @@ inline std::string quote_token(const char* p, const char* end) {
 
 // Numbers --------------------------------------------------------------------------------------
 
-// "-12.345e-6" as mantissa 12345, exponent -9; null unless the mantissa has at most 19 digits
-// and the token ends right after the number.
-struct Decimal {
-  std::uint64_t mantissa = 0;
-  int exponent = 0;
-  bool negative = false;
-};
-
-inline const char* scan_decimal(const char* p, const char* end, Decimal& d) {
-  if (p < end && (*p == '-' || *p == '+')) d.negative = *p++ == '-';
-  const char* digits = p;
-  std::uint64_t m = 0;
-  while (p < end && is_digit(*p)) m = m * 10 + static_cast<unsigned>(*p++ - '0');
-  std::ptrdiff_t count = p - digits;
-  if (p < end && *p == '.') {
-    const char* fraction = ++p;
-    while (p < end && is_digit(*p)) m = m * 10 + static_cast<unsigned>(*p++ - '0');
-    d.exponent = -static_cast<int>(p - fraction);
-    count += p - fraction;
-  }
-  if (count == 0 || count > 19) return nullptr;
-  if (p < end && (*p == 'e' || *p == 'E')) {
-    ++p;
-    bool negative_exponent = false;
-    if (p < end && (*p == '-' || *p == '+')) negative_exponent = *p++ == '-';
-    const char* exponent_digits = p;
-    int e = 0;
-    while (p < end && is_digit(*p) && p - exponent_digits < 4) e = e * 10 + (*p++ - '0');
-    if (p == exponent_digits) return nullptr;
-    d.exponent += negative_exponent ? -e : e;
-  }
-  if (!ends_number_at(p, end)) return nullptr;
-  d.mantissa = m;
-  return p;
-}
 
 // Parses the number token at `p` (no leading blanks) into `out`. Returns the first character
 // after it, or null when the token is not a number or is out of the type's range. Non-finite
@@ -107,7 +73,7 @@ template <class T>
 const char* parse_real(const char* p, const char* end, T& out) {
   static_assert(std::is_same_v<T, float> || std::is_same_v<T, double>);
   Decimal d;
-  if (const char* q = scan_decimal(p, end, d)) {
+  if (const char* q = scan_decimal(p, end, d, ends_number_at)) {
     constexpr bool is_float = std::is_same_v<T, float>;
     constexpr std::uint64_t kMaxExact = is_float ? (1u << 24) : (std::uint64_t{1} << 53);
     constexpr int kMaxPow = is_float ? 10 : 22;
@@ -202,28 +168,6 @@ inline std::array<double, 3> text_origin(const double first[3]) {
 
 // Normals --------------------------------------------------------------------------------------
 
-// Normalizes in place; a zero or non-finite normal becomes (0, 0, 1). When no normal is usable
-// the file had none in substance, and the array is dropped (as the PLY reader does).
-inline void finish_normals(std::vector<Vec3f>& normals) {
-  bool any = false;
-  for (Vec3f& n : normals) {
-    const float length2 = dot(n, n);
-    if (length2 > 0.99999f && length2 < 1.00001f) {
-      any = true;
-      continue;
-    }
-    if (length2 > 0.0f && std::isfinite(length2)) {
-      n = n / std::sqrt(length2);
-      any = true;
-    } else {
-      n = {0, 0, 1};
-    }
-  }
-  if (!any) {
-    normals.clear();
-    normals.shrink_to_fit();
-  }
-}
 
 // Progress ------------------------------------------------------------------------------------
 
@@ -269,5 +213,15 @@ class ReadProgress {
   std::uint64_t part_units_ = 0, part_bytes_ = 0;
   std::atomic<std::uint64_t> part_done_{0};
 };
+
+// `raw` (a file mapped from `path`) as is, or inflated when it starts with the gzip magic; the
+// inflation earns the first half of `progress` (whose total is the file's size).
+inline FileBytes inflate_if_gzipped(FileBytes raw, const std::string& path,
+                                    ReadProgress& progress) {
+  if (!has_gzip_magic(raw.view())) return raw;
+  const std::uint64_t size = raw.file_size();
+  progress.begin_part(size / 2, size);
+  return FileBytes::inflate(raw, path, [&](std::uint64_t n) { progress.advance(n); });
+}
 
 }  // namespace pointillist::io_detail

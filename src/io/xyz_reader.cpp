@@ -476,14 +476,8 @@ PointSet read_xyz(const std::string& path, Progress& progress, const XyzReadOpti
   FileBytes raw = FileBytes::map(path);
   const std::uint64_t file_size = raw.file_size();
   ReadProgress read_progress(progress, file_size);
-  const bool gzip = has_gzip_magic(raw.view());
-  FileBytes bytes;
-  if (gzip) {
-    read_progress.begin_part(file_size / 2, file_size);
-    bytes = FileBytes::inflate(raw, path, [&](std::uint64_t n) { read_progress.advance(n); });
-  } else {
-    bytes = std::move(raw);
-  }
+  FileBytes bytes = inflate_if_gzipped(std::move(raw), path, read_progress);
+  const bool gzip = bytes.was_compressed();
   const std::string_view data = bytes.view();
   if (data.empty()) throw FormatError(path + ": line 1: file is empty (expected lines x y z ...)");
 
