@@ -1,0 +1,123 @@
+// Out-of-core and progressive rendering: a hierarchy stored as pages that are loaded on demand,
+// as QSplat streams a model in (Rusinkiewicz & Levoy 2000, section 4.3). The traversal draws
+// from the pages that are resident; where a node's children are in a page that is not, it draws
+// the node as a splat and requests the page. Between frames the requested pages are loaded
+// (coarsest first), within a cap on resident memory.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "pointillist/core/camera.hpp"
+#include "pointillist/core/thread_pool.hpp"
+#include "pointillist/lod/sphere_tree.hpp"
+#include "pointillist/render/render.hpp"
+
+namespace pointillist {
+
+inline constexpr std::uint32_t kNoPage = 0xffffffffu;
+
+// One page: a connected part of the hierarchy. Page 0 holds the root (nodes[0]) and the levels
+// below it; any other page holds the children of one node of another page (its anchor) as
+// nodes[0 .. anchor.child_count), then their descendants, breadth-first. A node's children are
+// either in its own page (first_child indexes `nodes`) or they are the first nodes of page
+// child_page[i].
+struct HierarchyPage {
+  std::vector<SphereNode> nodes;
+  std::vector<std::uint32_t> child_page;  // one per node; kNoPage: children (if any) are here
+
+  // What a page of `node_count` nodes costs in memory while it is resident.
+  static std::uint64_t memory_bytes(std::uint64_t node_count) {
+    return node_count * (sizeof(SphereNode) + sizeof(std::uint32_t));
+  }
+};
+
+// Where pages come from: a paged model file, or (tests) an in-memory hierarchy cut into pages.
+class PageSource {
+ public:
+  virtual ~PageSource() = default;
+  virtual std::uint32_t page_count() const = 0;
+  // Bytes read from storage to load the page.
+  virtual std::uint64_t page_storage_bytes(std::uint32_t page) const = 0;
+  // Nodes in the page (what it will cost in memory: HierarchyPage::memory_bytes of that many).
+  virtual std::uint32_t page_node_count(std::uint32_t page) const = 0;
+  // Bytes read to open the model (header, page table), before any page.
+  virtual std::uint64_t open_bytes() const = 0;
+  // Counts and boxes of the whole model (nodes stays empty): leaf_count, depth, bounds,
+  // view_sphere (for the camera) and has_colors.
+  virtual SphereTreeView summary() const = 0;
+  // Loads page `page` into `out`. `anchor` is the page's anchor node as the parent page gave it
+  // (null for page 0); a quantized format decodes the page's spheres relative to it. Safe to
+  // call concurrently for different pages. Throws FormatError or IoError.
+  virtual void load(std::uint32_t page, const SphereNode* anchor, HierarchyPage& out) const = 0;
+};
+
+// `tree` cut into pages: page 0 takes the root and then whole sibling groups breadth-first while
+// it stays within `page_bytes` (at 40 bytes a node, the .ptl v1 node size); each node whose
+// children do not fit starts a new page, filled the same way. The pages are copies; `tree`'s
+// nodes must outlive the result only for summary() (it keeps the bounds and counts).
+// Throws OptionError when page_bytes cannot hold the root and one sibling group (200 bytes).
+std::unique_ptr<PageSource> paginate(const SphereTreeView& tree, std::uint64_t page_bytes);
+
+struct PagedRenderStats {
+  std::uint64_t pages_requested = 0;  // distinct non-resident pages the last frame wanted
+  std::uint64_t bytes_read = 0;       // storage bytes read so far (open_bytes + loaded pages)
+  std::uint64_t resident_bytes = 0;   // memory of the resident pages now
+  std::uint64_t resident_bytes_peak = 0;
+  std::uint64_t resident_pages = 0;
+  std::uint64_t pages_loaded = 0;     // loads so far (a page dropped and loaded again counts twice)
+  std::uint64_t pages_evicted = 0;
+};
+
+// Renders a paged model. Not thread-safe: one frame at a time; the pool parallelises page loads
+// and rasterization.
+class PagedRenderer {
+ public:
+  // Loads page 0. Throws OptionError when page 0 alone needs more than `memory_cap` bytes (the
+  // message gives the size needed), and what the source throws.
+  PagedRenderer(const PageSource& source, std::uint64_t memory_cap, ThreadPool& pool);
+
+  // The QSplat traversal of render() (same tests, threshold and culling, same splats where the
+  // pages are resident) over the resident pages. A node whose children are in a page that is
+  // not resident is drawn as a splat whatever its size, and the page is requested. Selection
+  // is single-threaded; rasterization uses the pool.
+  void render(const Camera& camera, const RenderSettings& settings, ThreadPool& pool,
+              Frame& frame);
+
+  // Loads the pages the last render requested, in request order (so coarser pages first), at
+  // most `max_pages` of them, in parallel on `pool`. A page is loaded only when it fits under
+  // the cap after evicting pages the last frame did not use (least recently used first; only
+  // pages without resident child pages, never page 0). Returns the number of pages loaded.
+  std::size_t load_requested(ThreadPool& pool, std::size_t max_pages = SIZE_MAX);
+
+  // True when the last frame requested nothing: what is resident is all that view needs.
+  bool complete() const { return stats_.pages_requested == 0; }
+  const PagedRenderStats& stats() const { return stats_; }
+  // Counts and boxes of the model (PageSource::summary), for the camera.
+  const SphereTreeView& summary() const { return summary_; }
+
+ private:
+  struct Request {
+    std::uint32_t page;
+    std::uint32_t parent_page;
+    SphereNode anchor;
+    float priority;  // the anchor's projected radius: larger first
+  };
+  bool make_room(std::uint64_t bytes);
+
+  const PageSource& source_;
+  std::uint64_t cap_;
+  SphereTreeView summary_;
+  std::vector<std::unique_ptr<HierarchyPage>> pages_;  // resident pages, null elsewhere
+  std::vector<std::uint32_t> parent_;                  // parent page of each resident page
+  std::vector<std::uint32_t> resident_children_;       // resident child pages of each page
+  std::vector<std::uint64_t> last_used_;               // frame number of the last use
+  std::vector<Request> requests_;
+  std::vector<std::uint8_t> requested_;                // per page: already in requests_
+  std::vector<SphereNode> emitted_;                    // the nodes of the last frame's splats
+  std::uint64_t frame_number_ = 0;
+  PagedRenderStats stats_;
+};
+
+}  // namespace pointillist

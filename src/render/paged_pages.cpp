@@ -1,0 +1,87 @@
+// An in-memory hierarchy cut into pages (paginate): the page layout of paged model files, for
+// tests and for models held in memory.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pointillist/core/error.hpp"
+#include "pointillist/render/paged.hpp"
+
+namespace pointillist {
+namespace {
+
+constexpr std::uint64_t kStorageBytesPerNode = sizeof(SphereNode);  // 40, as in .ptl v1
+
+class InMemoryPages final : public PageSource {
+ public:
+  InMemoryPages(const SphereTreeView& tree, std::uint64_t page_bytes) {
+    summary_ = tree;
+    summary_.nodes = {};
+    if (tree.nodes.empty()) return;
+    // Global indices of each page's nodes, in page order, and of the anchors of new pages.
+    struct Pending {
+      std::uint32_t anchor;  // global index; kNoPage for page 0
+    };
+    std::vector<Pending> starts{{kNoPage}};
+    for (std::size_t p = 0; p < starts.size(); ++p) {
+      std::vector<std::uint32_t> global;
+      HierarchyPage page;
+      if (starts[p].anchor == kNoPage) {
+        global.push_back(0);
+      } else {
+        const SphereNode& a = tree.nodes[starts[p].anchor];
+        for (std::uint32_t c = 0; c < a.child_count; ++c) global.push_back(a.first_child + c);
+      }
+      std::uint64_t bytes = global.size() * kStorageBytesPerNode;
+      for (std::size_t k = 0; k < global.size(); ++k) {
+        SphereNode n = tree.nodes[global[k]];
+        std::uint32_t child_page = kNoPage;
+        if (n.child_count > 0) {
+          const std::uint64_t more = std::uint64_t{n.child_count} * kStorageBytesPerNode;
+          if (bytes + more <= page_bytes) {
+            const std::uint32_t first = static_cast<std::uint32_t>(global.size());
+            for (std::uint32_t c = 0; c < n.child_count; ++c) global.push_back(n.first_child + c);
+            n.first_child = first;
+            bytes += more;
+          } else {
+            child_page = static_cast<std::uint32_t>(starts.size());
+            starts.push_back({global[k]});
+            n.first_child = 0;
+          }
+        }
+        page.nodes.push_back(n);
+        page.child_page.push_back(child_page);
+      }
+      pages_.push_back(std::move(page));
+    }
+  }
+
+  std::uint32_t page_count() const override { return static_cast<std::uint32_t>(pages_.size()); }
+  std::uint64_t page_storage_bytes(std::uint32_t page) const override {
+    return pages_.at(page).nodes.size() * kStorageBytesPerNode;
+  }
+  std::uint32_t page_node_count(std::uint32_t page) const override {
+    return static_cast<std::uint32_t>(pages_.at(page).nodes.size());
+  }
+  std::uint64_t open_bytes() const override { return 0; }
+  SphereTreeView summary() const override { return summary_; }
+  void load(std::uint32_t page, const SphereNode*, HierarchyPage& out) const override {
+    out = pages_.at(page);
+  }
+
+ private:
+  SphereTreeView summary_;
+  std::vector<HierarchyPage> pages_;
+};
+
+}  // namespace
+
+std::unique_ptr<PageSource> paginate(const SphereTreeView& tree, std::uint64_t page_bytes) {
+  if (page_bytes < 5 * kStorageBytesPerNode) {
+    throw OptionError("page size " + std::to_string(page_bytes) +
+                      " bytes is too small; a page must hold a node and 4 children (200 bytes)");
+  }
+  return std::make_unique<InMemoryPages>(tree, page_bytes);
+}
+
+}  // namespace pointillist

@@ -1,0 +1,215 @@
+// The paged QSplat traversal and its page cache (see paged.hpp).
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "pointillist/core/error.hpp"
+#include "pointillist/render/paged.hpp"
+#include "render/shading.hpp"
+#include "render/traversal_common.hpp"
+
+namespace pointillist {
+namespace {
+
+using namespace render_detail;
+
+double ms_between(std::chrono::steady_clock::time_point a, std::chrono::steady_clock::time_point b) {
+  return std::chrono::duration<double, std::milli>(b - a).count();
+}
+
+struct PagedPending {
+  std::uint32_t page, node;
+  std::uint8_t tests;
+};
+
+}  // namespace
+
+PagedRenderer::PagedRenderer(const PageSource& source, std::uint64_t memory_cap, ThreadPool& pool)
+    : source_(source), cap_(memory_cap), summary_(source.summary()) {
+  const std::uint32_t n = source.page_count();
+  pages_.resize(n);
+  parent_.assign(n, kNoPage);
+  resident_children_.assign(n, 0);
+  last_used_.assign(n, 0);
+  requested_.assign(n, 0);
+  stats_.bytes_read = source.open_bytes();
+  if (n == 0) return;
+  const std::uint64_t first = HierarchyPage::memory_bytes(source.page_node_count(0));
+  if (first > cap_) {
+    throw OptionError("memory cap of " + std::to_string(cap_) + " bytes is smaller than the " +
+                      "model's first page (" + std::to_string(first) +
+                      " bytes in memory); give at least that much");
+  }
+  requests_.push_back({0, kNoPage, SphereNode{}, 0.0f});
+  load_requested(pool);
+}
+
+void PagedRenderer::render(const Camera& camera, const RenderSettings& settings, ThreadPool& pool,
+                           Frame& frame) {
+  if (!(settings.threshold_px > 0.0f) || !std::isfinite(settings.threshold_px)) {
+    throw OptionError("splat size threshold " + std::to_string(settings.threshold_px) +
+                      " px is invalid; give a positive number of pixels (1 draws every detail)");
+  }
+  const auto start = std::chrono::steady_clock::now();
+  const CameraFrame cam = make_camera_frame(camera);
+  const std::size_t pixels =
+      static_cast<std::size_t>(cam.width) * static_cast<std::size_t>(cam.height);
+  frame.width = cam.width;
+  frame.height = cam.height;
+  frame.color.resize(pixels);
+  frame.depth.resize(pixels);
+
+  ++frame_number_;
+  for (const Request& r : requests_) requested_[r.page] = 0;
+  requests_.clear();
+  emitted_.clear();
+
+  const bool with_colors = summary_.has_colors;
+  SplatStream& stream = frame.splats;
+  stream.has_colors = with_colors;
+  if (stream.chunks.empty()) stream.chunks.resize(1);
+  stream.chunk_count = 1;
+  SplatChunk& chunk = stream.chunks[0];
+  chunk.count = 0;
+  chunk.reserve(kInitialChunkCapacity, with_colors);
+
+  const Shader shader(settings, cam);
+  const ViewConstants v = make_view_constants(shader, cam, settings);
+  Counters counters;
+  if (pages_.size() > 0 && pages_[0]) {
+    last_used_[0] = frame_number_;
+    Emitter emitter(chunk, with_colors);
+    const auto emit = [&](const SphereNode& n, Vec3f d, float z, bool check_facing = true) {
+      emitter.emit(n, static_cast<std::uint32_t>(emitted_.size()), d, z, v, counters,
+                   check_facing);
+      emitted_.push_back(n);
+    };
+    std::vector<PagedPending> stack;
+    stack.push_back({0, 0,
+                     static_cast<std::uint8_t>((settings.frustum_culling ? kTestFrustum : 0) |
+                                               (settings.backface_culling ? kTestBackface : 0))});
+    while (!stack.empty()) {
+      PagedPending p = stack.back();
+      stack.pop_back();
+      const HierarchyPage& page = *pages_[p.page];
+      const SphereNode& n = page.nodes[p.node];
+      Vec3f d;
+      float z;
+      const Decision decision = visit(n, v, p.tests, counters, d, z);
+      if (decision == Decision::Draw) emit(n, d, z);
+      if (decision != Decision::Refine) continue;
+      std::uint32_t child_page = page.child_page[p.node];
+      std::uint32_t first = n.first_child;
+      if (child_page == kNoPage) {
+        child_page = p.page;
+      } else if (pages_[child_page]) {
+        last_used_[child_page] = frame_number_;
+        first = 0;
+      } else {
+        // Not resident: this node stands in for its subtree, and the page is wanted.
+        emit(n, d, z, false);
+        if (!requested_[child_page]) {
+          requested_[child_page] = 1;
+          requests_.push_back({child_page, p.page, n, z > 0 ? n.radius / z : 0.0f});
+        }
+        continue;
+      }
+      for (std::uint32_t k = n.child_count; k-- > 0;) {
+        stack.push_back({child_page, first + k, p.tests});
+      }
+    }
+  }
+  finish_chunk(emitted_, v, with_colors, chunk);
+  const auto selected = std::chrono::steady_clock::now();
+  rasterize_splats(stream, cam, settings, pool, frame.scratch, frame.color, frame.depth);
+  const auto done = std::chrono::steady_clock::now();
+
+  RenderStats& s = frame.stats;
+  s = {};
+  s.splats = chunk.count;
+  s.nodes_visited = counters.visited;
+  s.culled_frustum = counters.culled_frustum;
+  s.culled_backface = counters.culled_backface;
+  s.width = cam.width;
+  s.height = cam.height;
+  s.threads = pool.thread_count();
+  s.ms_select = ms_between(start, selected);
+  s.ms_raster = ms_between(selected, done);
+  s.ms_total = ms_between(start, done);
+  stats_.pages_requested = requests_.size();
+}
+
+bool PagedRenderer::make_room(std::uint64_t bytes) {
+  while (stats_.resident_bytes + bytes > cap_) {
+    std::uint32_t victim = kNoPage;
+    for (std::uint32_t p = 1; p < pages_.size(); ++p) {
+      if (!pages_[p] || resident_children_[p] != 0 || last_used_[p] >= frame_number_) continue;
+      if (victim == kNoPage || last_used_[p] < last_used_[victim] ||
+          (last_used_[p] == last_used_[victim] && p > victim)) {
+        victim = p;
+      }
+    }
+    if (victim == kNoPage) return false;
+    stats_.resident_bytes -= HierarchyPage::memory_bytes(pages_[victim]->nodes.size());
+    pages_[victim].reset();
+    if (parent_[victim] != kNoPage) --resident_children_[parent_[victim]];
+    parent_[victim] = kNoPage;
+    --stats_.resident_pages;
+    ++stats_.pages_evicted;
+  }
+  return true;
+}
+
+std::size_t PagedRenderer::load_requested(ThreadPool& pool, std::size_t max_pages) {
+  std::stable_sort(requests_.begin(), requests_.end(),
+                   [](const Request& a, const Request& b) { return a.priority > b.priority; });
+  // Choose what fits, reserving its memory (pages chosen now are marked used in this frame, so
+  // they are not evicted for each other).
+  std::vector<const Request*> chosen;
+  for (const Request& r : requests_) {
+    if (chosen.size() >= max_pages) break;
+    if (pages_[r.page]) continue;
+    if (r.parent_page != kNoPage && !pages_[r.parent_page]) continue;
+    const std::uint64_t bytes = HierarchyPage::memory_bytes(source_.page_node_count(r.page));
+    if (!make_room(bytes)) continue;
+    stats_.resident_bytes += bytes;
+    // Keep the parent from being evicted for a later choice of this batch.
+    if (r.parent_page != kNoPage) {
+      ++resident_children_[r.parent_page];
+      last_used_[r.parent_page] = std::max(last_used_[r.parent_page], frame_number_);
+    }
+    last_used_[r.page] = frame_number_;
+    chosen.push_back(&r);
+  }
+  std::vector<std::unique_ptr<HierarchyPage>> loaded(chosen.size());
+  pool.run(chosen.size(), [&](std::size_t i) {
+    auto page = std::make_unique<HierarchyPage>();
+    const Request& r = *chosen[i];
+    source_.load(r.page, r.parent_page == kNoPage ? nullptr : &r.anchor, *page);
+    loaded[i] = std::move(page);
+  });
+  for (std::size_t i = 0; i < chosen.size(); ++i) {
+    const Request& r = *chosen[i];
+    if (loaded[i]->nodes.size() != source_.page_node_count(r.page) ||
+        loaded[i]->child_page.size() != loaded[i]->nodes.size()) {
+      throw FormatError("page " + std::to_string(r.page) + " decoded to " +
+                        std::to_string(loaded[i]->nodes.size()) + " nodes where the page table says " +
+                        std::to_string(source_.page_node_count(r.page)) +
+                        "; the model file is corrupt (convert it again)");
+    }
+    pages_[r.page] = std::move(loaded[i]);
+    parent_[r.page] = r.parent_page;
+    stats_.bytes_read += source_.page_storage_bytes(r.page);
+    ++stats_.pages_loaded;
+    ++stats_.resident_pages;
+  }
+  stats_.resident_bytes_peak = std::max(stats_.resident_bytes_peak, stats_.resident_bytes);
+  const std::size_t count = chosen.size();
+  requests_.clear();
+  std::fill(requested_.begin(), requested_.end(), 0);
+  return count;
+}
+
+}  // namespace pointillist

@@ -1,0 +1,197 @@
+// Paged (out-of-core, progressive) rendering against the in-memory renderer: with every page
+// resident the image is render()'s bit for bit; with fewer pages it has no holes where render()
+// has none; the memory cap holds; progressive frames converge.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <set>
+#include <vector>
+
+#include "pointillist/core/error.hpp"
+#include "pointillist/lod/sphere_tree.hpp"
+#include "pointillist/render/image_compare.hpp"
+#include "pointillist/render/paged.hpp"
+#include "pointillist/render/render.hpp"
+#include "pointillist/scene/analytic.hpp"
+#include "render_test_util.hpp"
+
+using namespace pointillist;
+using namespace pointillist::render_test;
+
+namespace {
+
+const SphereTree& demo_tree() {
+  static const SphereTree tree = [] {
+    ThreadPool pool(2);
+    return build_sphere_tree(splat_samples(demo_scene(), 60000, 3), pool);
+  }();
+  return tree;
+}
+
+Camera view(float azimuth, float distance = 0.0f) {
+  return orbit_camera(demo_tree().view_sphere, {.azimuth_deg = azimuth, .elevation_deg = 20,
+                                                .distance = distance, .width = 240,
+                                                .height = 180});
+}
+
+// Renders, loading what was requested, until nothing more is wanted or can be loaded.
+void render_until_settled(PagedRenderer& r, const Camera& cam, ThreadPool& pool, Frame& frame,
+                          int max_rounds = 200) {
+  for (int i = 0; i < max_rounds; ++i) {
+    r.render(cam, RenderSettings{}, pool, frame);
+    if (r.complete() || r.load_requested(pool) == 0) return;
+  }
+  FAIL() << "did not settle in " << max_rounds << " rounds";
+}
+
+ImageComparison compare(const Frame& reference, const Frame& test) {
+  return compare_images({reference.width, reference.height, reference.color},
+                        {test.width, test.height, test.color},
+                        {.background = RenderSettings{}.background});
+}
+
+}  // namespace
+
+TEST(Paginate, EveryNodeIsInExactlyOnePageAndPagesRespectTheirSize) {
+  const SphereTree& tree = demo_tree();
+  const std::uint64_t page_bytes = 4096;
+  const auto source = paginate(tree.view(), page_bytes);
+  ASSERT_GT(source->page_count(), 10u);
+  // Walk the pages from the root, as the renderer does, matching nodes with the tree's.
+  std::uint64_t nodes = 0;
+  std::set<std::uint32_t> seen_pages;
+  struct Item {
+    std::uint32_t page, local, global;
+  };
+  std::vector<HierarchyPage> pages(source->page_count());
+  for (std::uint32_t p = 0; p < source->page_count(); ++p) {
+    source->load(p, nullptr, pages[p]);
+    EXPECT_LE(pages[p].nodes.size() * sizeof(SphereNode), page_bytes) << "page " << p;
+    EXPECT_EQ(pages[p].nodes.size(), source->page_node_count(p));
+    nodes += pages[p].nodes.size();
+  }
+  EXPECT_EQ(nodes, tree.nodes.size());
+  std::vector<Item> stack{{0, 0, 0}};
+  std::uint64_t visited = 0;
+  while (!stack.empty()) {
+    const Item it = stack.back();
+    stack.pop_back();
+    ++visited;
+    const SphereNode& a = pages[it.page].nodes[it.local];
+    const SphereNode& b = tree.nodes[it.global];
+    ASSERT_EQ(a.center, b.center);
+    ASSERT_EQ(a.radius, b.radius);
+    ASSERT_EQ(a.child_count, b.child_count);
+    const std::uint32_t cp = pages[it.page].child_page[it.local];
+    for (std::uint32_t c = 0; c < a.child_count; ++c) {
+      if (cp == kNoPage) {
+        stack.push_back({it.page, a.first_child + c, b.first_child + c});
+      } else {
+        EXPECT_TRUE(seen_pages.insert(cp).second || c > 0) << "page " << cp << " has two anchors";
+        stack.push_back({cp, c, b.first_child + c});
+      }
+    }
+  }
+  EXPECT_EQ(visited, tree.nodes.size());
+  EXPECT_EQ(seen_pages.size() + 1, source->page_count());
+}
+
+TEST(PagedRender, WithEveryPageResidentTheImageIsRendersBitForBit) {
+  ThreadPool pool(2);
+  const SphereTree& tree = demo_tree();
+  const auto source = paginate(tree.view(), 8192);
+  PagedRenderer paged(*source, UINT64_MAX, pool);
+  for (float az : {0.0f, 130.0f}) {
+    const Camera cam = view(az);
+    Frame expected, frame;
+    render(tree.view(), cam, RenderSettings{}, pool, expected);
+    render_until_settled(paged, cam, pool, frame);
+    EXPECT_TRUE(paged.complete());
+    EXPECT_EQ(frame.stats.splats, expected.stats.splats) << "azimuth " << az;
+    EXPECT_EQ(frame.color, expected.color) << "azimuth " << az;
+    EXPECT_EQ(frame.depth, expected.depth) << "azimuth " << az;
+  }
+}
+
+TEST(PagedRender, FirstFrameFromTheFirstPageAloneHasNoHoles) {
+  // Only page 0 is resident: its deepest nodes stand in for their subtrees as splats of their
+  // bounding spheres, which enclose everything below, so the silhouette can only grow.
+  ThreadPool pool(2);
+  const SphereTree& tree = demo_tree();
+  const auto source = paginate(tree.view(), 16384);
+  PagedRenderer paged(*source, UINT64_MAX, pool);
+  const Camera cam = view(40);
+  Frame full, first;
+  render(tree.view(), cam, RenderSettings{}, pool, full);
+  paged.render(cam, RenderSettings{}, pool, first);
+  EXPECT_FALSE(paged.complete());
+  EXPECT_EQ(paged.stats().pages_loaded, 1u);
+  EXPECT_LT(first.stats.splats, full.stats.splats);
+  const ImageComparison c = compare(full, first);
+  EXPECT_EQ(c.hole_count, 0u);
+  EXPECT_GT(c.interior_count, 2000u);
+}
+
+TEST(PagedRender, ProgressiveFramesReadMoreAndConvergeToTheFullImage) {
+  ThreadPool pool(2);
+  const SphereTree& tree = demo_tree();
+  const auto source = paginate(tree.view(), 4096);
+  PagedRenderer paged(*source, UINT64_MAX, pool);
+  const Camera cam = view(75);
+  Frame full, frame;
+  render(tree.view(), cam, RenderSettings{}, pool, full);
+  std::uint64_t last_bytes = 0;
+  double first_mse = -1, last_mse = -1;
+  for (int i = 0; i < 100 && !(i > 0 && paged.complete()); ++i) {
+    paged.render(cam, RenderSettings{}, pool, frame);
+    const ImageComparison c = compare(full, frame);
+    EXPECT_EQ(c.hole_count, 0u) << "frame " << i;
+    if (first_mse < 0) first_mse = c.mse;
+    last_mse = c.mse;
+    EXPECT_GE(paged.stats().bytes_read, last_bytes);
+    last_bytes = paged.stats().bytes_read;
+    paged.load_requested(pool);
+  }
+  EXPECT_TRUE(paged.complete());
+  EXPECT_GT(first_mse, 0.0);
+  EXPECT_EQ(last_mse, 0.0);
+  EXPECT_EQ(frame.color, full.color);
+}
+
+TEST(PagedRender, MemoryCapHoldsAndTheImageStillHasNoHoles) {
+  ThreadPool pool(2);
+  const SphereTree& tree = demo_tree();
+  const auto source = paginate(tree.view(), 4096);
+  std::uint64_t total = 0;
+  for (std::uint32_t p = 0; p < source->page_count(); ++p) {
+    total += HierarchyPage::memory_bytes(source->page_node_count(p));
+  }
+  const std::uint64_t cap = total / 10;
+  PagedRenderer paged(*source, cap, pool);
+  // Orbit around the model: pages of the far side are dropped for those of the near side.
+  for (float az = 0; az < 360; az += 45) {
+    const Camera cam = view(az, 1.2f);
+    Frame full, frame;
+    render(tree.view(), cam, RenderSettings{}, pool, full);
+    render_until_settled(paged, cam, pool, frame);
+    EXPECT_LE(paged.stats().resident_bytes, cap);
+    EXPECT_EQ(compare(full, frame).hole_count, 0u) << "azimuth " << az;
+  }
+  EXPECT_LE(paged.stats().resident_bytes_peak, cap);
+  EXPECT_GT(paged.stats().pages_evicted, 0u);
+  EXPECT_LT(paged.stats().resident_pages, source->page_count());
+}
+
+TEST(PagedRender, CapBelowTheFirstPageIsRefusedWithTheSizeNeeded) {
+  ThreadPool pool(1);
+  const auto source = paginate(demo_tree().view(), 65536);
+  const std::uint64_t first = HierarchyPage::memory_bytes(source->page_node_count(0));
+  try {
+    PagedRenderer paged(*source, first - 1, pool);
+    FAIL() << "expected OptionError";
+  } catch (const OptionError& e) {
+    EXPECT_NE(std::string(e.what()).find(std::to_string(first)), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(paginate(demo_tree().view(), 100), OptionError);
+}
