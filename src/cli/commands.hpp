@@ -56,6 +56,10 @@ struct RenderOptions {
   double frame_ms = 0;        // --frame-ms T: hold this frame time
   unsigned refine_frames = 0; // --refine K
   std::string frames_out;     // --frames-out DIR: write every frame there
+  // Paged rendering (README "Models larger than memory"): 0 = off / no cap.
+  std::uint64_t memory_cap = 0;     // --memory BYTES
+  unsigned progressive_frames = 0;  // --progressive N
+  std::uint64_t read_per_frame = 1u << 20;  // --read-per-frame BYTES (progressive loading)
 };
 int run_render(const RenderOptions& options);
 

@@ -58,6 +58,24 @@ void parse_size_and_view(const std::string& size, const std::string& view, pc::V
   }
 }
 
+// "500000", "64K", "512M", "1.5G" (powers of 1024) -> bytes.
+std::uint64_t parse_bytes(const std::string& text, const std::string& option) {
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  double scale = 1;
+  const std::string unit = end ? std::string(end) : std::string();
+  if (unit == "K" || unit == "k" || unit == "KB" || unit == "KiB") scale = 1024.0;
+  else if (unit == "M" || unit == "MB" || unit == "MiB") scale = 1024.0 * 1024;
+  else if (unit == "G" || unit == "GB" || unit == "GiB") scale = 1024.0 * 1024 * 1024;
+  else if (!unit.empty()) scale = -1;
+  const double bytes = value * scale;
+  if (text.empty() || end == text.c_str() || scale < 0 || !(bytes >= 1) || bytes > 1e18) {
+    throw OptionError(option + " '" + text +
+                      "': give a size in bytes, optionally with K, M or G (e.g. 512M)");
+  }
+  return static_cast<std::uint64_t>(bytes);
+}
+
 // "orbit:N" (1 <= N <= 100000) -> N.
 unsigned parse_orbit_path(const std::string& text) {
   const std::string prefix = "orbit:";
@@ -201,6 +219,18 @@ int main(int argc, char** argv) {
                          "Then render K frames refining to full detail, as a viewer does when the "
                          "camera stops")
       ->check(CLI::Range(1u, 100000u));
+  std::string memory;
+  render_cmd->add_option("--memory", memory,
+                         "Render page by page keeping at most this much of the model in memory "
+                         "(e.g. 512M); coarser where the cap bites");
+  render_cmd->add_option("--progressive", render.progressive_frames,
+                         "Render N frames at the view while the model's pages load, as a viewer "
+                         "shows a model streaming in")
+      ->check(CLI::Range(1u, 100000u));
+  std::string read_per_frame;
+  render_cmd->add_option("--read-per-frame", read_per_frame,
+                         "With --progressive: bytes of the model read between two frames "
+                         "(default 1M, a disk at 30 MB/s shown at 30 frames/s)");
   render_cmd->add_option("--frames-out", render.frames_out,
                          "Write every frame of a sequence to DIR/frame_NNNNN.png");
   const std::map<std::string, pc::RenderMode> modes{{"fast", pc::RenderMode::Fast},
@@ -308,6 +338,10 @@ int main(int argc, char** argv) {
       if (!up.empty()) render.view.up = parse_vec3(up, "--up");
       render.settings.background = parse_rgb8(background, "--background");
       if (!path.empty()) render.orbit_frames = parse_orbit_path(path);
+      if (!memory.empty()) render.memory_cap = parse_bytes(memory, "--memory");
+      if (!read_per_frame.empty()) {
+        render.read_per_frame = parse_bytes(read_per_frame, "--read-per-frame");
+      }
       return pc::run_render(render);
     }
     if (*info_cmd) {

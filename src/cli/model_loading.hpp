@@ -12,6 +12,7 @@
 #include "pointillist/format/ptl.hpp"
 #include "pointillist/lod/sphere_tree.hpp"
 #include "pointillist/prep/prepare.hpp"
+#include "pointillist/render/paged.hpp"
 
 namespace pointillist::cli {
 
@@ -33,6 +34,9 @@ class LoadedModel {
   bool memory_mapped() const { return file_ != nullptr; }
   const PtlFile* ptl() const { return file_.get(); }
   bool qsplat() const { return qsplat_; }
+  // The pages of a paged model file (rendered out of core), or null: the whole hierarchy is in
+  // tree().
+  const PageSource* pages() const { return pages_.get(); }
   std::uint64_t file_size = 0;
   std::string metadata;
   // Kept for `info` when the input was not a .ptl.
@@ -49,6 +53,7 @@ class LoadedModel {
 
  private:
   std::unique_ptr<PtlFile> file_;
+  std::unique_ptr<PageSource> pages_;
   bool qsplat_ = false;
   SphereTree built_;
   SphereTreeView view_;

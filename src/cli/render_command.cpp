@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <optional>
 #include <sstream>
 #include <vector>
@@ -16,6 +17,7 @@
 #include "pointillist/render/depth_image.hpp"
 #include "pointillist/render/frame_control.hpp"
 #include "pointillist/render/mesh_reference.hpp"
+#include "pointillist/render/paged.hpp"
 #include "pointillist/render/spt_render.hpp"
 
 namespace pointillist::cli {
@@ -60,6 +62,11 @@ namespace {
 
 // Frames a sequence renders before the frame-time controller is judged (the hit rate).
 constexpr std::size_t kSettleFrames = 5;
+// Page size when a model held whole is cut into pages for --memory / --progressive.
+constexpr std::uint64_t kInMemoryPageBytes = 64 * 1024;
+constexpr std::uint32_t kInMemoryPageLevels = 4;
+// A single image of a paged model: at most this many load rounds (each loads one more level).
+constexpr int kMaxSettleRounds = 1000;
 
 std::string frame_path(const std::string& dir, std::size_t index) {
   char name[32];
@@ -76,8 +83,14 @@ void check_sequence_options(const RenderOptions& o) {
     throw OptionError("--path orbit:N moves the camera around the orbit; it cannot be combined "
                       "with --eye/--target (use --view, --distance and --up)");
   }
-  if (!o.frames_out.empty() && o.orbit_frames == 0 && o.refine_frames == 0) {
-    throw OptionError("--frames-out writes the frames of a sequence; add --path orbit:N or --refine K");
+  if (!o.frames_out.empty() && o.orbit_frames == 0 && o.refine_frames == 0 &&
+      o.progressive_frames == 0) {
+    throw OptionError("--frames-out writes the frames of a sequence; add --path orbit:N, "
+                      "--refine K or --progressive N");
+  }
+  if (o.progressive_frames > 0 && (o.orbit_frames > 0 || o.frame_ms > 0)) {
+    throw OptionError("--progressive N renders N frames at one view while pages load; it cannot "
+                      "be combined with --path or --frame-ms (use --refine K to refine after it)");
   }
   if (!o.frames_out.empty()) {
     std::error_code ec;
@@ -114,6 +127,21 @@ class FrameRenderer {
                         "with --lod spt (drop --lod spt, or use --mode fast)");
     }
     if (o.mode == RenderMode::Quality) validate_quality_settings(o.quality);
+    if (model.pages() || o.memory_cap > 0 || o.progressive_frames > 0) {
+      if (o.lod == LodScheme::Spt || o.mode != RenderMode::Fast) {
+        throw OptionError("--memory and --progressive render the QSplat hierarchy page by page in "
+                          "the fast mode; drop --lod spt and --mode");
+      }
+      const PageSource* source = model.pages();
+      if (!source) {
+        // A model held whole (a .ptl v1 file, a scan): cut into pages in memory, so that the
+        // behaviour can be seen; the cap bounds the pages the renderer keeps, not the mapping.
+        owned_pages_ = paginate(tree_, kInMemoryPageBytes, kInMemoryPageLevels);
+        source = owned_pages_.get();
+      }
+      paged_.emplace(*source, o.memory_cap > 0 ? o.memory_cap : UINT64_MAX, pool);
+      page_source_ = source;
+    }
     if (o.lod == LodScheme::Spt) {
       spt_ = build_sequential_point_tree(sphere_tree_leaves(tree_), pool, progress);
     }
@@ -127,6 +155,9 @@ class FrameRenderer {
       render_spt(spt_, camera, settings,
                  {.epsilon_px = detail, .chunk_culling = !o_.no_chunk_culling}, pool_, frame,
                  &spt_stats_);
+    } else if (paged_) {
+      settings.threshold_px = detail;
+      paged_->render(camera, settings, pool_, frame);
     } else if (o_.mode == RenderMode::Reference) {
       render_mesh_reference(mesh_, camera, settings, frame);
     } else if (o_.mode == RenderMode::Quality) {
@@ -137,8 +168,54 @@ class FrameRenderer {
       render(tree_, camera, settings, pool_, frame);
     }
   }
+  // After a frame has been recorded: loads the pages it asked for (paged models). Returns the
+  // number of pages loaded.
+  std::size_t after_frame() {
+    if (!paged_) return 0;
+    return o_.progressive_frames > 0
+               ? paged_->load_requested(pool_, SIZE_MAX, o_.read_per_frame)
+               : paged_->load_requested(pool_);
+  }
+  // Draws the view until a paged model has loaded all it needs (or all the cap allows).
+  void draw_settled(const Camera& camera, float detail, Frame& frame) {
+    for (int round = 0; round < kMaxSettleRounds; ++round) {
+      draw(camera, detail, frame);
+      if (!paged_ || paged_->complete() || after_frame() == 0) return;
+    }
+  }
+  bool paged() const { return paged_.has_value(); }
+  // Fills the paged-model fields of a frame record.
+  void annotate(FrameRecord& r) const {
+    if (!paged_) return;
+    r.bytes_read = static_cast<std::int64_t>(paged_->stats().bytes_read);
+    r.resident_bytes = static_cast<std::int64_t>(paged_->stats().resident_bytes);
+  }
+
   // Extra --stats lines for the last frame.
   std::string extra_json() const {
+    if (paged_) {
+      const PagedRenderStats& p = paged_->stats();
+      std::uint64_t file_bytes = page_source_->open_bytes();
+      for (std::uint32_t i = 0; i < page_source_->page_count(); ++i) {
+        file_bytes += page_source_->page_storage_bytes(i);
+      }
+      char buf[768];
+      std::snprintf(buf, sizeof buf,
+                    "  \"lod\": \"qsplat\",\n  \"mode\": \"fast\",\n  \"paged\": true,\n"
+                    "  \"pages\": %u,\n  \"model_bytes\": %llu,\n  \"memory_cap\": %llu,\n"
+                    "  \"bytes_read\": %llu,\n  \"resident_bytes\": %llu,\n"
+                    "  \"resident_bytes_peak\": %llu,\n  \"pages_loaded\": %llu,\n"
+                    "  \"pages_evicted\": %llu,\n  \"complete\": %s,\n",
+                    page_source_->page_count(), static_cast<unsigned long long>(file_bytes),
+                    static_cast<unsigned long long>(o_.memory_cap),
+                    static_cast<unsigned long long>(p.bytes_read),
+                    static_cast<unsigned long long>(p.resident_bytes),
+                    static_cast<unsigned long long>(p.resident_bytes_peak),
+                    static_cast<unsigned long long>(p.pages_loaded),
+                    static_cast<unsigned long long>(p.pages_evicted),
+                    paged_->complete() ? "true" : "false");
+      return buf;
+    }
     if (o_.mode == RenderMode::Quality) {
       char buf[256];
       std::snprintf(buf, sizeof buf,
@@ -172,6 +249,9 @@ class FrameRenderer {
   SequentialPointTree spt_;
   SptSelectionStats spt_stats_;
   QualityScratch quality_scratch_;
+  std::unique_ptr<PageSource> owned_pages_;
+  const PageSource* page_source_ = nullptr;
+  std::optional<PagedRenderer> paged_;
 };
 
 // Renders the path (and/or the idle refinement) a viewer would show; returns every frame's record
@@ -190,11 +270,14 @@ std::vector<FrameRecord> render_sequence(const RenderOptions& o, const SphereTre
   auto draw = [&](const char* phase, float detail) {
     renderer.draw(make_camera(view, tree), detail, frame);
     records.push_back({phase, view.azimuth_deg, detail, frame.stats});
+    renderer.annotate(records.back());
     if (!o.frames_out.empty()) {
       write_png_rgb8(frame_path(o.frames_out, records.size() - 1), frame.width, frame.height,
                      frame.color);
     }
+    renderer.after_frame();
   };
+  for (unsigned i = 0; i < o.progressive_frames; ++i) draw("progressive", start);
   for (unsigned i = 0; i < o.orbit_frames; ++i) {
     view.azimuth_deg = o.view.azimuth_deg + 360.0f * static_cast<float>(i) /
                                                 static_cast<float>(o.orbit_frames);
@@ -217,13 +300,13 @@ int run_render(const RenderOptions& o) {
                                               o.mode == RenderMode::Reference);
   FrameRenderer renderer(o, model, pool, progress);
   Frame frame;
-  const bool sequence =
-      o.orbit_frames > 0 || o.refine_frames > 0 || o.frame_ms > 0 || !o.frames_out.empty();
+  const bool sequence = o.orbit_frames > 0 || o.refine_frames > 0 || o.frame_ms > 0 ||
+                        o.progressive_frames > 0 || !o.frames_out.empty();
   std::vector<FrameRecord> records;
   if (sequence) {
     records = render_sequence(o, model.tree(), renderer, frame);
   } else {
-    renderer.draw(make_camera(o.view, model.tree()), renderer.initial_detail(), frame);
+    renderer.draw_settled(make_camera(o.view, model.tree()), renderer.initial_detail(), frame);
   }
   write_png_rgb8(o.output, frame.width, frame.height, frame.color);
   if (!o.depth_output.empty()) {

@@ -62,6 +62,12 @@ std::string sequence_to_json(const std::vector<FrameRecord>& frames, double targ
                   static_cast<unsigned long long>(f.stats.splats), f.stats.ms_total,
                   f.stats.ms_select, f.stats.ms_raster);
     json += buf;
+    if (f.bytes_read >= 0) {
+      json.pop_back();  // '}'
+      std::snprintf(buf, sizeof buf, ", \"bytes_read\": %lld, \"resident_bytes\": %lld}",
+                    static_cast<long long>(f.bytes_read), static_cast<long long>(f.resident_bytes));
+      json += buf;
+    }
   }
   json += "\n  ]\n}\n";
   return json;

@@ -1,6 +1,7 @@
 // Render statistics as JSON (for --stats).
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,10 @@ struct FrameRecord {
   float azimuth_deg;
   float threshold_px;   // level of detail the frame was rendered with (threshold, or SPT ε)
   RenderStats stats;
+  // Paged models only (else negative): storage bytes read so far and resident page memory,
+  // both when the frame was drawn.
+  std::int64_t bytes_read = -1;
+  std::int64_t resident_bytes = -1;
 };
 
 // The statistics of the last frame as stats_to_json writes them, plus "frames": [...] with each

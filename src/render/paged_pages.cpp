@@ -14,7 +14,7 @@ constexpr std::uint64_t kStorageBytesPerNode = sizeof(SphereNode);  // 40, as in
 
 class InMemoryPages final : public PageSource {
  public:
-  InMemoryPages(const SphereTreeView& tree, std::uint64_t page_bytes) {
+  InMemoryPages(const SphereTreeView& tree, std::uint64_t page_bytes, std::uint32_t max_levels) {
     summary_ = tree;
     summary_.nodes = {};
     if (tree.nodes.empty()) return;
@@ -33,14 +33,18 @@ class InMemoryPages final : public PageSource {
         for (std::uint32_t c = 0; c < a.child_count; ++c) global.push_back(a.first_child + c);
       }
       std::uint64_t bytes = global.size() * kStorageBytesPerNode;
+      std::vector<std::uint32_t> level(global.size(), 1);  // levels of the page, 1-based
       for (std::size_t k = 0; k < global.size(); ++k) {
         SphereNode n = tree.nodes[global[k]];
         std::uint32_t child_page = kNoPage;
         if (n.child_count > 0) {
           const std::uint64_t more = std::uint64_t{n.child_count} * kStorageBytesPerNode;
-          if (bytes + more <= page_bytes) {
+          if (bytes + more <= page_bytes && (p == 0 || level[k] < max_levels)) {
             const std::uint32_t first = static_cast<std::uint32_t>(global.size());
-            for (std::uint32_t c = 0; c < n.child_count; ++c) global.push_back(n.first_child + c);
+            for (std::uint32_t c = 0; c < n.child_count; ++c) {
+              global.push_back(n.first_child + c);
+              level.push_back(level[k] + 1);
+            }
             n.first_child = first;
             bytes += more;
           } else {
@@ -76,12 +80,14 @@ class InMemoryPages final : public PageSource {
 
 }  // namespace
 
-std::unique_ptr<PageSource> paginate(const SphereTreeView& tree, std::uint64_t page_bytes) {
+std::unique_ptr<PageSource> paginate(const SphereTreeView& tree, std::uint64_t page_bytes,
+                                     std::uint32_t max_levels) {
   if (page_bytes < 5 * kStorageBytesPerNode) {
     throw OptionError("page size " + std::to_string(page_bytes) +
                       " bytes is too small; a page must hold a node and 4 children (200 bytes)");
   }
-  return std::make_unique<InMemoryPages>(tree, page_bytes);
+  if (max_levels < 1) throw OptionError("pages must hold at least 1 level of the hierarchy");
+  return std::make_unique<InMemoryPages>(tree, page_bytes, max_levels);
 }
 
 }  // namespace pointillist

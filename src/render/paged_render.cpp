@@ -81,10 +81,12 @@ void PagedRenderer::render(const Camera& camera, const RenderSettings& settings,
   if (pages_.size() > 0 && pages_[0]) {
     last_used_[0] = frame_number_;
     Emitter emitter(chunk, with_colors);
-    const auto emit = [&](const SphereNode& n, Vec3f d, float z, bool check_facing = true) {
-      emitter.emit(n, static_cast<std::uint32_t>(emitted_.size()), d, z, v, counters,
-                   check_facing);
+    const auto emit = [&](const SphereNode& n, Vec3f d, float z, bool stand_in = false) {
+      emitter.emit(n, static_cast<std::uint32_t>(emitted_.size()), d, z, v, counters, !stand_in);
       emitted_.push_back(n);
+      // A stand-in is drawn even when its mean normal faces away (its subtree may hold surfaces
+      // facing the eye); it is then lit from the front, not drawn black.
+      if (stand_in && dot(d, n.normal) > 0) emitted_.back().normal = -n.normal;
     };
     std::vector<PagedPending> stack;
     stack.push_back({0, 0,
@@ -109,7 +111,7 @@ void PagedRenderer::render(const Camera& camera, const RenderSettings& settings,
         first = 0;
       } else {
         // Not resident: this node stands in for its subtree, and the page is wanted.
-        emit(n, d, z, false);
+        emit(n, d, z, true);
         if (!requested_[child_page]) {
           requested_[child_page] = 1;
           requests_.push_back({child_page, p.page, n, z > 0 ? n.radius / z : 0.0f});
@@ -162,15 +164,19 @@ bool PagedRenderer::make_room(std::uint64_t bytes) {
   return true;
 }
 
-std::size_t PagedRenderer::load_requested(ThreadPool& pool, std::size_t max_pages) {
+std::size_t PagedRenderer::load_requested(ThreadPool& pool, std::size_t max_pages,
+                                          std::uint64_t max_storage_bytes) {
   std::stable_sort(requests_.begin(), requests_.end(),
                    [](const Request& a, const Request& b) { return a.priority > b.priority; });
   // Choose what fits, reserving its memory (pages chosen now are marked used in this frame, so
   // they are not evicted for each other).
   std::vector<const Request*> chosen;
+  std::uint64_t storage = 0;
   for (const Request& r : requests_) {
     if (chosen.size() >= max_pages) break;
     if (pages_[r.page]) continue;
+    const std::uint64_t read = source_.page_storage_bytes(r.page);
+    if (!chosen.empty() && storage + read > max_storage_bytes) break;
     if (r.parent_page != kNoPage && !pages_[r.parent_page]) continue;
     const std::uint64_t bytes = HierarchyPage::memory_bytes(source_.page_node_count(r.page));
     if (!make_room(bytes)) continue;
@@ -181,6 +187,7 @@ std::size_t PagedRenderer::load_requested(ThreadPool& pool, std::size_t max_page
       last_used_[r.parent_page] = std::max(last_used_[r.parent_page], frame_number_);
     }
     last_used_[r.page] = frame_number_;
+    storage += read;
     chosen.push_back(&r);
   }
   std::vector<std::unique_ptr<HierarchyPage>> loaded(chosen.size());

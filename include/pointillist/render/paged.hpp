@@ -55,10 +55,13 @@ class PageSource {
 
 // `tree` cut into pages: page 0 takes the root and then whole sibling groups breadth-first while
 // it stays within `page_bytes` (at 40 bytes a node, the .ptl v1 node size); each node whose
-// children do not fit starts a new page, filled the same way. The pages are copies; `tree`'s
-// nodes must outlive the result only for summary() (it keeps the bounds and counts).
-// Throws OptionError when page_bytes cannot hold the root and one sibling group (200 bytes).
-std::unique_ptr<PageSource> paginate(const SphereTreeView& tree, std::uint64_t page_bytes);
+// children do not fit starts a new page, filled the same way but with at most `max_levels`
+// levels. Shallow pages make a model stream in coarse to fine everywhere rather than region by
+// region; a full first page makes the first frame a good one. The
+// pages are copies; summary() keeps `tree`'s bounds and counts. Throws OptionError when
+// page_bytes cannot hold a node and 4 children (200 bytes) or max_levels is 0.
+std::unique_ptr<PageSource> paginate(const SphereTreeView& tree, std::uint64_t page_bytes,
+                                     std::uint32_t max_levels = 64);
 
 struct PagedRenderStats {
   std::uint64_t pages_requested = 0;  // distinct non-resident pages the last frame wanted
@@ -85,11 +88,13 @@ class PagedRenderer {
   void render(const Camera& camera, const RenderSettings& settings, ThreadPool& pool,
               Frame& frame);
 
-  // Loads the pages the last render requested, in request order (so coarser pages first), at
-  // most `max_pages` of them, in parallel on `pool`. A page is loaded only when it fits under
+  // Loads the pages the last render requested, largest on screen first, at most `max_pages` of
+  // them and at most `max_storage_bytes` read (at least one page is always loaded when one
+  // fits in memory, however large), in parallel on `pool`. A page is loaded only when it fits under
   // the cap after evicting pages the last frame did not use (least recently used first; only
   // pages without resident child pages, never page 0). Returns the number of pages loaded.
-  std::size_t load_requested(ThreadPool& pool, std::size_t max_pages = SIZE_MAX);
+  std::size_t load_requested(ThreadPool& pool, std::size_t max_pages = SIZE_MAX,
+                             std::uint64_t max_storage_bytes = UINT64_MAX);
 
   // True when the last frame requested nothing: what is resident is all that view needs.
   bool complete() const { return stats_.pages_requested == 0; }
