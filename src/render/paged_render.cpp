@@ -108,7 +108,6 @@ void PagedRenderer::render(const Camera& camera, const RenderSettings& settings,
         child_page = p.page;
       } else if (pages_[child_page]) {
         last_used_[child_page] = frame_number_;
-        first = 0;
       } else {
         // Not resident: this node stands in for its subtree, and the page is wanted.
         emit(n, d, z, true);

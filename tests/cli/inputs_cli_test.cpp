@@ -369,3 +369,58 @@ TEST(QualityCli, ReferenceModeDrawsTheTrianglesAndCompareMeasuresSplatsAgainstTh
   EXPECT_NE(bad.exit_code, 0);
   EXPECT_THAT(bad.output, HasSubstr("is a splat model"));
 }
+
+TEST(PagedCli, ProgressiveFramesReadMoreEachFrameAndEndAtTheFullImage) {
+  TempDir dir;
+  const std::string ply = dir.file("scene.ply"), ptl = dir.file("scene.ptl");
+  ASSERT_EQ(run_cli("generate --points 100000 -o " + ply).exit_code, 0);
+  ASSERT_EQ(run_cli("convert -q " + ply + " -o " + ptl).exit_code, 0);
+  const std::string common = " --size 200x150 --view 30,20";
+  ASSERT_EQ(run_cli("render " + ptl + " -o " + dir.file("full.png") + common).exit_code, 0);
+  const CliResult r = run_cli("render " + ptl + " -o " + dir.file("last.png") + common +
+                              " --progressive 40 --read-per-frame 200K --frames-out " +
+                              dir.file("frames") + " --stats -");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("\"paged\": true"));
+  EXPECT_THAT(r.output, HasSubstr("\"complete\": true"));
+  // bytes_read of each frame: non-decreasing, the first a small part of the model.
+  std::vector<long long> read;
+  const std::size_t frames_at = r.output.find("\"frames\"");
+  ASSERT_NE(frames_at, std::string::npos);
+  for (std::size_t at = frames_at;
+       (at = r.output.find("\"bytes_read\": ", at)) != std::string::npos;) {
+    at += 14;
+    read.push_back(std::atoll(r.output.c_str() + at));
+  }
+  ASSERT_EQ(read.size(), 40u);
+  for (std::size_t i = 1; i < 40; ++i) EXPECT_GE(read[i], read[i - 1]) << "frame " << i;
+  const auto model_at = r.output.find("\"model_bytes\": ");
+  ASSERT_NE(model_at, std::string::npos);
+  const long long model_bytes = std::atoll(r.output.c_str() + model_at + 15);
+  EXPECT_LT(read[0] * 100, model_bytes * 2) << "the first frame should need under 2% of the model";
+  EXPECT_LT(read[1], read[39]);
+  // The last frame is the image rendered from the whole model.
+  EXPECT_EQ(read_png_rgb8(dir.file("last.png")).pixels, read_png_rgb8(dir.file("full.png")).pixels);
+  EXPECT_TRUE(fs::exists(dir.file("frames") + "/frame_00039.png"));
+}
+
+TEST(PagedCli, MemoryCapIsHeldAndReported) {
+  TempDir dir;
+  const std::string ply = dir.file("scene.ply"), ptl = dir.file("scene.ptl");
+  ASSERT_EQ(run_cli("generate --points 100000 -o " + ply).exit_code, 0);
+  ASSERT_EQ(run_cli("convert -q " + ply + " -o " + ptl).exit_code, 0);
+  const CliResult r = run_cli("render " + ptl + " -o " + dir.file("capped.png") +
+                              " --size 200x150 --memory 600K --stats -");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto peak_at = r.output.find("\"resident_bytes_peak\": ");
+  ASSERT_NE(peak_at, std::string::npos) << r.output;
+  EXPECT_LE(std::atoll(r.output.c_str() + peak_at + 23), 600 * 1024);
+  const ImageRgb8 img = read_png_rgb8(dir.file("capped.png"));
+  EXPECT_GT(drawn_pixels(img), 200u * 150u / 10);
+  const CliResult tiny = run_cli("render " + ptl + " -o " + dir.file("x.png") + " --memory 1K");
+  EXPECT_NE(tiny.exit_code, 0);
+  EXPECT_THAT(tiny.output, HasSubstr("smaller than the model's first page"));
+  const CliResult bad = run_cli("render " + ptl + " -o " + dir.file("x.png") + " --memory lots");
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_THAT(bad.output, HasSubstr("--memory 'lots'"));
+}

@@ -89,7 +89,8 @@ TEST(Paginate, EveryNodeIsInExactlyOnePageAndPagesRespectTheirSize) {
         stack.push_back({it.page, a.first_child + c, b.first_child + c});
       } else {
         EXPECT_TRUE(seen_pages.insert(cp).second || c > 0) << "page " << cp << " has two anchors";
-        stack.push_back({cp, c, b.first_child + c});
+        EXPECT_EQ(a.first_child, 0u);  // paginate gives each page one anchor
+        stack.push_back({cp, a.first_child + c, b.first_child + c});
       }
     }
   }

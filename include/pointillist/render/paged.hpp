@@ -19,10 +19,10 @@ namespace pointillist {
 inline constexpr std::uint32_t kNoPage = 0xffffffffu;
 
 // One page: a connected part of the hierarchy. Page 0 holds the root (nodes[0]) and the levels
-// below it; any other page holds the children of one node of another page (its anchor) as
-// nodes[0 .. anchor.child_count), then their descendants, breadth-first. A node's children are
-// either in its own page (first_child indexes `nodes`) or they are the first nodes of page
-// child_page[i].
+// below it; any other page holds the children of one or more nodes of another page (its
+// anchors), then their descendants. A node's children are nodes[first_child ..
+// first_child + child_count) of its own page when child_page[i] is kNoPage, and of page
+// child_page[i] otherwise.
 struct HierarchyPage {
   std::vector<SphereNode> nodes;
   std::vector<std::uint32_t> child_page;  // one per node; kNoPage: children (if any) are here
