@@ -88,6 +88,8 @@ summary() {
       rate("hierarchy build, 437k points (points/s)", "BM_BuildSphereTree/437645", "BM_BaselineSortFloats/437645", 1e6, "M/s", "items")
       rate("hierarchy build, 10M points (points/s)", "BM_BuildSphereTree/10000000", "BM_BaselineSortFloats/10000000", 1e6, "M/s", "items")
       time("hierarchy build, dragon (vs sorting 437k floats)", "BM_BuildSphereTreeDragon", "BM_BaselineSortFloats/437645")
+      time("ptl v2 encode+write, dragon (vs v1 write)", "BM_EncodePtlV2/Dragon", "BM_BaselineWritePtlV1/Dragon")
+      time("ptl v2 open+decode_all, dragon (vs v1 read)", "BM_DecodeAllPtlV2/Dragon", "BM_BaselineReadPtlV1/Dragon")
       b = "BM_BaselineProjectDragonPoints"
       for (th = 1; th <= 4; th *= 2) {
         n = "BM_RenderDragon/" th "/real_time"

@@ -19,6 +19,7 @@ struct ConvertOptions {
   PrepareOptions prepare;
   std::string columns;  // --columns for text inputs (empty = detect)
   bool ascii = false;  // .ply output only
+  unsigned ptl_version = 2;  // --ptl-version: 2 (quantized, paged) or 1 (float nodes)
   unsigned threads = 0;
   bool quiet = false;
 };

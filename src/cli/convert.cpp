@@ -8,6 +8,7 @@
 #include "cli/terminal_progress.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/format/ptl.hpp"
+#include "pointillist/format/ptl_v2.hpp"
 #include "pointillist/format/qs.hpp"
 #include "pointillist/io/ply.hpp"
 #include "pointillist/lod/sphere_tree.hpp"
@@ -42,6 +43,10 @@ int run_convert(const ConvertOptions& o) {
                       "model) or .ply (points with normals and radii)");
   }
   if (o.ascii && !to_ply) throw OptionError("convert: --ascii applies only to .ply output");
+  if (o.ptl_version != 1 && o.ptl_version != 2) {
+    throw OptionError("convert: --ptl-version " + std::to_string(o.ptl_version) +
+                      " does not exist; use 2 (compact, the default) or 1 (float nodes)");
+  }
   const auto start = std::chrono::steady_clock::now();
   ThreadPool pool(o.threads);
   TerminalProgress progress(!o.quiet && TerminalProgress::stderr_is_terminal());
@@ -67,7 +72,11 @@ int run_convert(const ConvertOptions& o) {
          << "radius_scale: " << o.prepare.radius_scale << "\n";
     for (const auto& c : points.comments) meta << "comment: " << c << "\n";
     ProgressPhase phase(progress, "write", 0);
-    write_ptl(o.output, tree, meta.str());
+    if (o.ptl_version == 1) {
+      write_ptl(o.output, tree, meta.str());
+    } else {
+      write_ptl_v2(o.output, tree, meta.str());
+    }
   } else {
     ProgressPhase phase(progress, "write", 0);
     write_ply(o.output, points,

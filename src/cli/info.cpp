@@ -28,14 +28,28 @@ std::string input_format_name(const std::string& path) {
 
 int run_info(const InfoOptions& o) {
   ThreadPool pool(o.threads);
-  const LoadedModel model = LoadedModel::open(o.input, {}, pool, Progress::none(), o.columns);
+  const LoadedModel model =
+      LoadedModel::open(o.input, {}, pool, Progress::none(), o.columns, false,
+                        o.spt ? LoadedModel::Paging::Never : LoadedModel::Paging::WhenLarge);
   const SphereTreeView& t = model.tree();
   std::array<std::uint64_t, 5> children{};
   for (const SphereNode& n : t.nodes) children[n.child_count <= 4 ? n.child_count : 0]++;
   const double leaves = double(t.leaf_count);
 
   std::printf("file:        %s\n", o.input.c_str());
-  if (model.memory_mapped()) {
+  const PtlV2File* v2 = model.ptl_v2();
+  if (v2) {
+    const std::uint64_t records = v2->node_count();
+    std::printf("format:      Pointillist model (.ptl) version 2: quantized %s-byte nodes in %u "
+                "pages, memory-mapped%s\n",
+                v2->has_colors() ? "6" : "4", v2->page_count(),
+                model.pages() ? ", too large to decode whole (rendered page by page)" : "");
+    if (t.nodes.empty()) {
+      std::printf("points:      %llu (leaves)\n", static_cast<unsigned long long>(t.leaf_count));
+      std::printf("nodes:       %llu (%.3f per point)\n", static_cast<unsigned long long>(records),
+                  leaves > 0 ? double(records) / leaves : 0.0);
+    }
+  } else if (model.memory_mapped()) {
     std::printf("format:      Pointillist model (.ptl) version %u, memory-mapped\n",
                 model.ptl()->version());
   } else if (model.qsplat()) {
@@ -46,12 +60,14 @@ int run_info(const InfoOptions& o) {
                 model.input_is_mesh ? "mesh" : "point cloud", model.input_points,
                 model.input_is_mesh ? " (vertices used by faces kept)" : "");
   }
-  std::printf("points:      %llu (leaves)\n", static_cast<unsigned long long>(t.leaf_count));
-  std::printf("nodes:       %zu (%.3f per point; children 2/3/4: %llu/%llu/%llu)\n",
-              t.nodes.size(), leaves > 0 ? double(t.nodes.size()) / leaves : 0.0,
-              static_cast<unsigned long long>(children[2]),
-              static_cast<unsigned long long>(children[3]),
-              static_cast<unsigned long long>(children[4]));
+  if (!t.nodes.empty()) {
+    std::printf("points:      %llu (leaves)\n", static_cast<unsigned long long>(t.leaf_count));
+    std::printf("nodes:       %zu (%.3f per point; children 2/3/4: %llu/%llu/%llu)\n",
+                t.nodes.size(), leaves > 0 ? double(t.nodes.size()) / leaves : 0.0,
+                static_cast<unsigned long long>(children[2]),
+                static_cast<unsigned long long>(children[3]),
+                static_cast<unsigned long long>(children[4]));
+  }
   std::printf("depth:       %u levels below the root\n", t.depth);
   if (model.memory_mapped() || model.qsplat()) {
     std::printf("attributes:  position, normal, normal cone, radius%s\n",
@@ -64,7 +80,11 @@ int run_info(const InfoOptions& o) {
   }
   std::printf("bounds:      min (%g, %g, %g)  max (%g, %g, %g)\n", t.bounds.lo.x, t.bounds.lo.y,
               t.bounds.lo.z, t.bounds.hi.x, t.bounds.hi.y, t.bounds.hi.z);
-  if (!t.nodes.empty()) {
+  if (v2) {
+    const Sphere& root = v2->root_sphere();
+    std::printf("sphere:      centre (%g, %g, %g), radius %g (root of the hierarchy)\n",
+                root.center.x, root.center.y, root.center.z, root.radius);
+  } else if (!t.nodes.empty()) {
     const SphereNode& root = t.nodes[0];
     std::printf("sphere:      centre (%g, %g, %g), radius %g (root of the hierarchy)\n",
                 root.center.x, root.center.y, root.center.z, root.radius);

@@ -157,6 +157,10 @@ int main(int argc, char** argv) {
   add_columns(convert_cmd, convert.columns);
   add_prepare_options(convert_cmd, convert.prepare);
   convert_cmd->add_flag("--ascii", convert.ascii, "Write .ply output as ascii");
+  convert_cmd->add_option("--ptl-version", convert.ptl_version,
+                          ".ptl version to write: 2 (quantized, paged; the default) or 1 (float "
+                          "nodes, 40 bytes each)")
+      ->default_val(2);
   add_threads(convert_cmd, convert.threads);
   convert_cmd->add_flag("-q,--quiet", convert.quiet, "No progress bars and no summary");
 

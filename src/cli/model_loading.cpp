@@ -1,5 +1,7 @@
 #include "cli/model_loading.hpp"
 
+#include <unistd.h>
+
 #include <array>
 #include <cstdio>
 #include <cstdlib>
@@ -7,6 +9,7 @@
 
 #include "pointillist/core/error.hpp"
 #include "pointillist/core/thread_pool.hpp"
+#include "pointillist/format/ptl_v2_pages.hpp"
 #include "pointillist/format/qs.hpp"
 #include "pointillist/io/point_file.hpp"
 
@@ -97,13 +100,30 @@ PointSet read_inputs(const std::vector<std::string>& paths, ThreadPool& pool, Pr
 
 LoadedModel LoadedModel::open(const std::string& path, const PrepareOptions& prepare,
                               ThreadPool& pool, Progress& progress, const std::string& columns,
-                              bool keep_source) {
+                              bool keep_source, Paging paging) {
   LoadedModel model;
   if (!std::filesystem::exists(path)) {
     throw IoError(path + ": no such file; check the path");
   }
   model.file_size = std::filesystem::file_size(path);
+  if (is_ptl_file(path) && ptl_file_version(path) == kPtlV2Version) {
+    model.v2_ = PtlV2File::open(path);
+    model.ptl_version_ = kPtlV2Version;
+    model.metadata = model.v2_->metadata();
+    const double decoded_bytes = double(model.v2_->node_count()) * sizeof(SphereNode);
+    const double memory = double(::sysconf(_SC_PHYS_PAGES)) * double(::sysconf(_SC_PAGESIZE));
+    if (paging == Paging::Always || (paging == Paging::WhenLarge && decoded_bytes > memory / 4)) {
+      model.pages_ = ptl_v2_page_source(*model.v2_);
+      model.view_ = model.pages_->summary();
+    } else {
+      ProgressPhase phase(progress, "decode", 0);
+      model.built_ = model.v2_->decode_all();
+      model.view_ = model.built_.view();
+    }
+    return model;
+  }
   if (is_ptl_file(path)) {
+    model.ptl_version_ = 1;
     model.file_ = PtlFile::open(path);
     model.view_ = model.file_->tree();
     model.metadata = model.file_->metadata();

@@ -10,6 +10,7 @@
 #include "pointillist/core/progress.hpp"
 #include "pointillist/core/thread_pool.hpp"
 #include "pointillist/format/ptl.hpp"
+#include "pointillist/format/ptl_v2.hpp"
 #include "pointillist/lod/sphere_tree.hpp"
 #include "pointillist/prep/prepare.hpp"
 #include "pointillist/render/paged.hpp"
@@ -31,7 +32,7 @@ PointSet read_inputs(const std::vector<std::string>& paths, ThreadPool& pool, Pr
 class LoadedModel {
  public:
   const SphereTreeView& tree() const { return view_; }
-  bool memory_mapped() const { return file_ != nullptr; }
+  bool memory_mapped() const { return file_ != nullptr || v2_ != nullptr; }
   const PtlFile* ptl() const { return file_.get(); }
   bool qsplat() const { return qsplat_; }
   // The pages of a paged model file (rendered out of core), or null: the whole hierarchy is in
@@ -46,13 +47,23 @@ class LoadedModel {
 
   // With keep_source, a scan's prepared points (normals and radii computed, faces kept) stay in
   // `source` (for the triangle reference renderer); models (.ptl, .qs) leave it empty.
+  // Paging (.ptl version 2 files only; other models are held whole): Never decodes the whole
+  // hierarchy into tree(); Always keeps it in the file and gives pages() (tree() then has no
+  // nodes, only the counts and boxes); WhenLarge pages when the decoded hierarchy would take
+  // more than a quarter of the machine's memory.
+  enum class Paging { Never, WhenLarge, Always };
   static LoadedModel open(const std::string& path, const PrepareOptions& prepare, ThreadPool& pool,
                           Progress& progress, const std::string& columns = {},
-                          bool keep_source = false);
+                          bool keep_source = false, Paging paging = Paging::Never);
+  // The .ptl version (1 or 2), 0 for other inputs.
+  std::uint32_t ptl_version() const { return ptl_version_; }
+  const PtlV2File* ptl_v2() const { return v2_.get(); }
   PointSet source;
 
  private:
   std::unique_ptr<PtlFile> file_;
+  std::unique_ptr<PtlV2File> v2_;
+  std::uint32_t ptl_version_ = 0;
   std::unique_ptr<PageSource> pages_;
   bool qsplat_ = false;
   SphereTree built_;

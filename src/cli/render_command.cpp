@@ -296,8 +296,13 @@ std::vector<FrameRecord> render_sequence(const RenderOptions& o, const SphereTre
 int run_render(const RenderOptions& o) {
   ThreadPool pool(o.threads);
   TerminalProgress progress(!o.quiet && TerminalProgress::stderr_is_terminal());
-  const LoadedModel model = LoadedModel::open(o.input, o.prepare, pool, progress, o.columns,
-                                              o.mode == RenderMode::Reference);
+  const bool paging_asked = o.memory_cap > 0 || o.progressive_frames > 0;
+  const bool paging_possible = o.mode == RenderMode::Fast && o.lod == LodScheme::QSplat;
+  const LoadedModel model = LoadedModel::open(
+      o.input, o.prepare, pool, progress, o.columns, o.mode == RenderMode::Reference,
+      paging_asked ? LoadedModel::Paging::Always
+                   : (paging_possible ? LoadedModel::Paging::WhenLarge
+                                      : LoadedModel::Paging::Never));
   FrameRenderer renderer(o, model, pool, progress);
   Frame frame;
   const bool sequence = o.orbit_frames > 0 || o.refine_frames > 0 || o.frame_ms > 0 ||

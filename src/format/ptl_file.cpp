@@ -54,11 +54,15 @@ bool finite_box(const Aabb& b) { return is_finite(b.lo) && is_finite(b.hi); }
 
 void check_header(const std::string& path, const ptl::Header& h, std::uint64_t file_size) {
   if (h.version == 0) fail_at(path, ptl::offset::kVersion, "invalid .ptl version 0");
+  if (h.version == 2) {
+    fail_at(path, ptl::offset::kVersion,
+            ".ptl version 2 (compact, paged) file; PtlFile maps version 1 only: open it with "
+            "PtlV2File or read_ptl (pointillist/format/ptl_v2.hpp), which read both");
+  }
   if (h.version > kPtlVersion) {
     fail_at(path, ptl::offset::kVersion,
             ".ptl version " + std::to_string(h.version) + " is newer than this build of "
-            "Pointillist reads (version " + std::to_string(kPtlVersion) +
-            "); upgrade Pointillist to open it");
+            "Pointillist reads (versions 1 and 2); upgrade Pointillist to open it");
   }
   if (h.header_size < ptl::kHeaderSize) {
     fail_at(path, ptl::offset::kHeaderSize,
@@ -256,19 +260,40 @@ PtlFile::~PtlFile() {
   if (map_ != nullptr) ::munmap(map_, size_);
 }
 
-bool is_ptl_file(const std::string& path) {
+namespace {
+
+// The first `n` bytes of the file (fewer when it is shorter or cannot be read).
+std::size_t read_prefix(const std::string& path, char* out, std::size_t n) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return false;
-  char magic[sizeof ptl::kMagic];
+  if (fd < 0) return 0;
   std::size_t got = 0;
-  while (got < sizeof magic) {
-    const ssize_t n = ::read(fd, magic + got, sizeof magic - got);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) break;
-    got += static_cast<std::size_t>(n);
+  while (got < n) {
+    const ssize_t k = ::read(fd, out + got, n - got);
+    if (k < 0 && errno == EINTR) continue;
+    if (k <= 0) break;
+    got += static_cast<std::size_t>(k);
   }
   ::close(fd);
-  return got == sizeof magic && std::memcmp(magic, ptl::kMagic, sizeof magic) == 0;
+  return got;
+}
+
+}  // namespace
+
+bool is_ptl_file(const std::string& path) {
+  char magic[sizeof ptl::kMagic];
+  return read_prefix(path, magic, sizeof magic) == sizeof magic &&
+         std::memcmp(magic, ptl::kMagic, sizeof magic) == 0;
+}
+
+std::uint32_t ptl_file_version(const std::string& path) {
+  char head[ptl::offset::kVersion + 4];
+  if (read_prefix(path, head, sizeof head) != sizeof head ||
+      std::memcmp(head, ptl::kMagic, sizeof ptl::kMagic) != 0) {
+    return 0;
+  }
+  std::uint32_t version = 0;
+  std::memcpy(&version, head + ptl::offset::kVersion, sizeof version);  // little endian
+  return version;
 }
 
 }  // namespace pointillist

@@ -138,7 +138,6 @@ DecodedTree decode_fragment(const std::string& path, const std::uint8_t* file, Q
   const bool color = (f.options & kQsOptionColor) != 0;
   const std::uint32_t record_size = color ? 6 : 4;
   const std::uint64_t end = f.offset + f.length;
-  const auto table = sphere_table();
   const auto normals = normal_table();
 
   DecodedTree tree;
@@ -214,10 +213,10 @@ DecodedTree decode_fragment(const std::string& path, const std::uint8_t* file, Q
       if (nodes.size() >= std::size_t{1} << 32) {
         fail_at(path, cursor, "more than 2^32 nodes");
       }
-      const SphereCandidate& sc = table[s];
+      const Sphere decoded = decode_sphere({pc, pr}, s);
       SphereNode n;
-      n.center = {pc.x + pr * sc.x, pc.y + pr * sc.y, pc.z + pr * sc.z};
-      n.radius = pr * sc.r;
+      n.center = decoded.center;
+      n.radius = decoded.radius;
       n.normal = q < kNormalCodeCount ? normals[q] : Vec3f{0, 0, 1};
       n.child_count = static_cast<std::uint8_t>(child_count_of_code(c));
       n.cone_sin = c == 0 ? 0.0f : (cone == 3 ? 2.0f : cone_sin_bound(cone));

@@ -28,6 +28,16 @@ std::span<const SphereCandidate, kSphereCodeCount> sphere_table();
 // (out of range or skipped).
 int sphere_code(int m, int x, int y, int z);
 
+// Decoded sphere of `code` (< kSphereCodeCount) relative to the decoded parent sphere (spec
+// §4.2): float32, each component multiplied then added, so every reader and writer of a format
+// built on these codes (.qs, .ptl version 2) computes the same bits.
+inline Sphere decode_sphere(const Sphere& parent, std::uint32_t code) {
+  const SphereCandidate& s = sphere_table()[code];
+  return {{parent.center.x + parent.radius * s.x, parent.center.y + parent.radius * s.y,
+           parent.center.z + parent.radius * s.z},
+          parent.radius * s.r};
+}
+
 // Code for a child sphere (centre c, radius r) quantized against its decoded parent (centre p,
 // radius rho) the way QSplat 1.0 does (spec §4.3). Where QSplat 1.0 would pick a cube that is not
 // in the table (and write the invalid code 8191), the cube is grown until it is.

@@ -110,10 +110,9 @@ class TreeWriter {
   // Encodes `child` against its decoded parent and replaces its sphere by the decoded one (§4.4).
   void write_record(const MakeNode& parent, MakeNode& child, std::vector<std::uint8_t>& out) {
     const int code = encode_sphere(parent.center, parent.radius, child.center, child.radius);
-    const SphereCandidate& s = sphere_table()[std::size_t(code)];
-    child.center = {parent.center.x + parent.radius * s.x, parent.center.y + parent.radius * s.y,
-                    parent.center.z + parent.radius * s.z};
-    child.radius = parent.radius * s.r;
+    const Sphere decoded = decode_sphere({parent.center, parent.radius}, std::uint32_t(code));
+    child.center = decoded.center;
+    child.radius = decoded.radius;
 
     const std::uint32_t c = child.child_count == 0 ? 0 : child.child_count - 1u;
     const std::uint32_t g = child.has_grandchild ? 1 : 0;

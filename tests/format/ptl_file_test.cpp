@@ -183,10 +183,10 @@ TEST(PtlFile, RejectsNewerVersion) {
   const std::string path = dir.file("future.ptl");
   write_ptl(path, tiny_tree(), "");
   std::vector<std::uint8_t> bytes = read_bytes(path);
-  patch_u32(bytes, 8, 2);
+  patch_u32(bytes, 8, 3);
   const std::string m = open_error(path, bytes);
-  expect_names(m, path, 8, "version 2");
-  EXPECT_NE(m.find("reads (version 1)"), std::string::npos) << m;
+  expect_names(m, path, 8, "version 3");
+  EXPECT_NE(m.find("reads (versions 1 and 2)"), std::string::npos) << m;
   EXPECT_NE(m.find("upgrade"), std::string::npos) << m;
 }
 

@@ -1,5 +1,6 @@
 // Native model file `.ptl`, version 1: a fixed little-endian header followed by the breadth-first
-// SphereNode array and a free-form metadata block. See docs/ptl-format.md.
+// SphereNode array and a free-form metadata block. See docs/ptl-format.md. The compact, paged
+// version 2 is read by PtlV2File, and either version by read_ptl (ptl_v2.hpp).
 #pragma once
 
 #include <cstdint>
@@ -23,7 +24,8 @@ class PtlFile {
  public:
   // Maps and validates the file: magic, version, sizes, and every node's child range (so a
   // corrupt file cannot make traversal read out of bounds). Throws FormatError naming the file
-  // and byte offset, or IoError.
+  // and byte offset (for a version 2 file: one saying to use PtlV2File or read_ptl), or
+  // IoError.
   static std::unique_ptr<PtlFile> open(const std::string& path);
   ~PtlFile();
   PtlFile(const PtlFile&) = delete;
@@ -45,5 +47,8 @@ class PtlFile {
 
 // True when the file starts with the .ptl magic (used to dispatch on content, not extension).
 bool is_ptl_file(const std::string& path);
+// The version field of a .ptl file's header, or 0 when the file does not start with the magic
+// (or is shorter than the field).
+std::uint32_t ptl_file_version(const std::string& path);
 
 }  // namespace pointillist

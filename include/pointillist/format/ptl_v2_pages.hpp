@@ -1,0 +1,19 @@
+// A .ptl version 2 file as the page source of the paged renderer (render/paged.hpp): each file
+// page is one HierarchyPage, decoded when it is loaded, so a model larger than memory renders
+// with only the pages it needs resident.
+#pragma once
+
+#include <memory>
+
+#include "pointillist/format/ptl_v2.hpp"
+#include "pointillist/render/paged.hpp"
+
+namespace pointillist {
+
+// Pages of `file`, which must outlive the result. open_bytes() is everything before the first
+// page (header, schema, page table); page_storage_bytes() a page's size in the file. load()
+// throws FormatError for a corrupt page (including an interior node of a page's last level that
+// no child page continues).
+std::unique_ptr<PageSource> ptl_v2_page_source(const PtlV2File& file);
+
+}  // namespace pointillist

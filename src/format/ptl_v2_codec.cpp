@@ -1,0 +1,151 @@
+// Conservative QSplat quantization for .ptl version 2. QSplat 1.0 (Rusinkiewicz & Levoy,
+// SIGGRAPH 2000) picks the cube that covers a child's extent and decodes it as the inscribed
+// sphere, which misses a third of the true spheres (../shared/specs/qsplat-qs-format.md §4.3).
+// Here the code is searched instead: the smallest decoded sphere that encloses the true one and
+// stays inside the decoded parent, so culling against decoded spheres is conservative.
+#include "format/ptl_v2_codec.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+namespace pointillist::ptl2 {
+namespace {
+
+using qs_detail::kNormalGrid;
+using qs_detail::kSphereCodeCount;
+using qs_detail::kSphereGrid;
+
+// The m = 13 cube: centre 0, radius 1 in parent units, i.e. the parent's own sphere (13·(1/13)
+// rounds to exactly 1.0f in the table, so it decodes to the parent's bits).
+constexpr std::uint32_t kParentCode = kSphereCodeCount - 1;
+
+double distance_squared(Vec3f a, Vec3f b) {
+  const double dx = double(a.x) - b.x, dy = double(a.y) - b.y, dz = double(a.z) - b.z;
+  return dx * dx + dy * dy + dz * dz;
+}
+
+// Nearest `bits`-bit value of an 8-bit channel under bit-replicated decoding.
+template <unsigned bits>
+constexpr std::array<std::uint8_t, 256> nearest_channel_table() {
+  std::array<std::uint8_t, 256> t{};
+  for (int c = 0; c < 256; ++c) {
+    int best = 0, best_error = 1 << 20;
+    for (int v = 0; v < (1 << bits); ++v) {
+      const int decoded = (v << (8 - bits)) | (v >> (2 * bits - 8));
+      const int error = decoded > c ? decoded - c : c - decoded;
+      if (error < best_error) best = v, best_error = error;
+    }
+    t[std::size_t(c)] = static_cast<std::uint8_t>(best);
+  }
+  return t;
+}
+constexpr auto kNearest5 = nearest_channel_table<5>();
+constexpr auto kNearest6 = nearest_channel_table<6>();
+
+}  // namespace
+
+bool encloses(const Sphere& outer, const Sphere& inner) {
+  return std::sqrt(distance_squared(outer.center, inner.center)) + double(inner.radius) <=
+         double(outer.radius);
+}
+
+std::uint32_t encode_enclosing_sphere(const Sphere& parent, const Sphere& target, bool* exact) {
+  const double rho = parent.radius;
+  if (!(rho > 0) || !std::isfinite(rho)) {
+    *exact = encloses(parent, target);
+    return kParentCode;
+  }
+  // Target in parent units; a candidate of size m has radius R = m/13 and centre coordinates
+  // X = (m + 2x)/13 - 1 (spec §4.1). It can only qualify when every |X - t| <= R - s (encloses)
+  // and |X| <= 1 - R (inside), which bounds x, y, z; the exact test runs on the decoded floats.
+  const double t[3] = {(double(target.center.x) - parent.center.x) / rho,
+                       (double(target.center.y) - parent.center.y) / rho,
+                       (double(target.center.z) - parent.center.z) / rho};
+  const double s = double(target.radius) / rho;
+  constexpr double kSlack = 1e-6;  // widens the box a little; the exact test decides
+  const int m_first = std::clamp(int(std::floor(kSphereGrid * s)), 1, kSphereGrid);
+  for (int m = m_first; m <= kSphereGrid; ++m) {
+    const double radius = double(m) / kSphereGrid;
+    const double reach = radius - s + kSlack, room = 1 - radius + kSlack;
+    if (reach < 0) continue;
+    int lo[3], hi[3];
+    bool empty = false;
+    for (int a = 0; a < 3 && !empty; ++a) {
+      const double x_lo = std::max(t[a] - reach, -room), x_hi = std::min(t[a] + reach, room);
+      // x = (13 (X + 1) - m) / 2
+      lo[a] = std::max(0, int(std::ceil((kSphereGrid * (x_lo + 1) - m) / 2)));
+      hi[a] = std::min(kSphereGrid - m, int(std::floor((kSphereGrid * (x_hi + 1) - m) / 2)));
+      empty = x_lo > x_hi || lo[a] > hi[a];
+    }
+    if (empty) continue;
+    int best = -1;
+    double best_distance = std::numeric_limits<double>::infinity();
+    for (int x = lo[0]; x <= hi[0]; ++x) {
+      for (int y = lo[1]; y <= hi[1]; ++y) {
+        for (int z = lo[2]; z <= hi[2]; ++z) {
+          const int code = qs_detail::sphere_code(m, x, y, z);
+          if (code < 0) continue;
+          const Sphere d = qs_detail::decode_sphere(parent, std::uint32_t(code));
+          if (!encloses(d, target) || !encloses(parent, d)) continue;
+          const double dist = distance_squared(d.center, target.center);
+          if (dist < best_distance) best = code, best_distance = dist;  // ties: lower code
+        }
+      }
+    }
+    if (best >= 0) {
+      *exact = true;
+      return std::uint32_t(best);
+    }
+  }
+  *exact = encloses(parent, target);
+  return kParentCode;
+}
+
+std::uint32_t encode_normal_nearest(Vec3f n) {
+  const std::uint32_t q = qs_detail::encode_normal(n);
+  const auto table = qs_detail::normal_table();
+  const int face = int(q / (kNormalGrid * kNormalGrid));
+  const int u = int(q / kNormalGrid) % kNormalGrid, v = int(q % kNormalGrid);
+  // The atan-warped grid is not equal-angle; a neighbouring cell's centre can be nearer.
+  std::uint32_t best = q;
+  double best_dot = double(dot(table[q], n));
+  for (int du = -1; du <= 1; ++du) {
+    for (int dv = -1; dv <= 1; ++dv) {
+      const int uu = u + du, vv = v + dv;
+      if (uu < 0 || vv < 0 || uu >= kNormalGrid || vv >= kNormalGrid) continue;
+      const auto c = std::uint32_t((face * kNormalGrid + uu) * kNormalGrid + vv);
+      const double d =
+          double(table[c].x) * n.x + double(table[c].y) * n.y + double(table[c].z) * n.z;
+      if (d > best_dot) best = c, best_dot = d;
+    }
+  }
+  return best;
+}
+
+double cone_half_angle(std::uint32_t k) {
+  return k < 3 ? std::asin(double(qs_detail::cone_sin_bound(k)))
+               : std::numeric_limits<double>::infinity();
+}
+
+std::uint32_t encode_cone_at_least(double theta) {
+  for (std::uint32_t k = 0; k < 3; ++k) {
+    if (cone_half_angle(k) >= theta + 1e-6) return k;
+  }
+  return 3;
+}
+
+std::uint16_t encode_rgb565_nearest(Rgb8 c) {
+  return static_cast<std::uint16_t>(kNearest5[c.r] << 11 | kNearest6[c.g] << 5 | kNearest5[c.b]);
+}
+
+double angle_between(Vec3f a, Vec3f b) {
+  const double la = std::sqrt(double(a.x) * a.x + double(a.y) * a.y + double(a.z) * a.z);
+  const double lb = std::sqrt(double(b.x) * b.x + double(b.y) * b.y + double(b.z) * b.z);
+  if (!(la > 0) || !(lb > 0)) return 0;
+  const double d = (double(a.x) * b.x + double(a.y) * b.y + double(a.z) * b.z) / (la * lb);
+  return std::acos(std::clamp(d, -1.0, 1.0));
+}
+
+}  // namespace pointillist::ptl2

@@ -1,0 +1,49 @@
+// Node records of .ptl version 2 (docs/ptl-format.md, "Version 2"): QSplat's quantization
+// (Rusinkiewicz & Levoy, SIGGRAPH 2000; tables in qs_tables.hpp) with encoders that keep every
+// decoded sphere and normal cone conservative. Private to the format module.
+#pragma once
+
+#include <cstdint>
+#include <span>
+
+#include "format/ptl_v2_layout.hpp"
+#include "format/qs_tables.hpp"
+#include "pointillist/core/math.hpp"
+
+namespace pointillist::ptl2 {
+
+// cone_sin of a decoded interior node whose cone code is 3 ("no bound").
+constexpr float kNoConeBound = 2.0f;
+
+// Sphere code for `target` against the decoded `parent`: among the codes whose decoded sphere
+// (qs_detail::decode_sphere, float32) encloses `target` and lies inside `parent` (both checked
+// in double on the decoded floats), one of the smallest radius, then nearest the target's
+// centre. When no code qualifies (only if `target` is not inside `parent`), the parent's own
+// sphere (code 7620). `*exact` says whether the returned code passed both checks.
+std::uint32_t encode_enclosing_sphere(const Sphere& parent, const Sphere& target, bool* exact);
+
+// True when `outer` holds `inner`: |c_o - c_i| + r_i <= r_o, in double.
+bool encloses(const Sphere& outer, const Sphere& inner);
+
+// Normal code of a unit normal: QSplat's cube-face cell (qs_detail::encode_normal), or the
+// neighbouring cell whose decoded normal is nearer. The decoded normal is within
+// kPtlV2NormalErrorRad (ptl_v2.hpp) of `n`.
+std::uint32_t encode_normal_nearest(Vec3f n);
+
+// Half-angle (radians) that cone code k promises: asin(((k + 1)/4)²) for k < 3; +inf for 3.
+double cone_half_angle(std::uint32_t k);
+// Smallest cone code whose half-angle is >= `theta` (radians) plus a 1e-6 margin; 3 when none.
+std::uint32_t encode_cone_at_least(double theta);
+// cone_sin a decoded interior node gets for code k.
+inline float decoded_cone_sin(std::uint32_t k) {
+  return k < 3 ? qs_detail::cone_sin_bound(k) : kNoConeBound;
+}
+
+// RGB 565 with each channel rounded to the nearest representable value (bit-replicated decode):
+// errors at most 4 levels in red and blue, 2 in green.
+std::uint16_t encode_rgb565_nearest(Rgb8 c);
+
+// Angle between two vectors (radians, double; 0 for a zero vector).
+double angle_between(Vec3f a, Vec3f b);
+
+}  // namespace pointillist::ptl2

@@ -1,0 +1,483 @@
+// Reading .ptl version 2 (docs/ptl-format.md, "Version 2"): the header and page table are
+// validated when the file is opened; each page is validated as it is decoded, so no byte outside
+// the file, the page or the tables is ever read.
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "format/ptl_header.hpp"
+#include "format/ptl_v2_codec.hpp"
+#include "format/ptl_v2_layout.hpp"
+#include "io/file_bytes.hpp"
+#include "pointillist/core/error.hpp"
+#include "pointillist/format/ptl.hpp"
+#include "pointillist/format/ptl_v2.hpp"
+
+namespace pointillist {
+
+struct PtlV2File::Mapping {
+  io_detail::FileBytes bytes;
+};
+
+namespace {
+
+using namespace ptl2;
+
+std::string str(std::uint64_t v) { return std::to_string(v); }
+
+[[noreturn]] void fail_at(const std::string& path, std::uint64_t byte, const std::string& what) {
+  throw FormatError(path + ": byte " + str(byte) + ": " + what);
+}
+
+bool finite_sphere(const Sphere& s) {
+  return is_finite(s.center) && std::isfinite(s.radius) && s.radius >= 0;
+}
+
+}  // namespace
+
+std::unique_ptr<PtlV2File> PtlV2File::open(const std::string& path) {
+  std::unique_ptr<PtlV2File> file(new PtlV2File);
+  file->path_ = path;
+  file->map_ = std::make_unique<Mapping>(Mapping{io_detail::FileBytes::map(path)});
+  const std::string_view view = file->map_->bytes.view();
+  const auto* b = reinterpret_cast<const std::uint8_t*>(view.data());
+  const std::uint64_t size = view.size();
+  file->size_ = size;
+
+  if (size < sizeof ptl::kMagic || std::memcmp(b, ptl::kMagic, sizeof ptl::kMagic) != 0) {
+    fail_at(path, 0, "not a Pointillist model file (expected \"PTLSPLAT\")");
+  }
+  if (size < offset::kVersion + 4) {
+    fail_at(path, size,
+            "file ends early: the header needs " + str(kHeaderSize) + " bytes, the file has only " +
+                str(size));
+  }
+  const std::uint32_t version = load_u32(b + offset::kVersion);
+  if (version == 1) {
+    fail_at(path, offset::kVersion,
+            ".ptl version 1 file; PtlV2File reads version 2 only (open it with PtlFile or "
+            "read_ptl, which reads both)");
+  }
+  if (version == 0) fail_at(path, offset::kVersion, "invalid .ptl version 0");
+  if (version != kPtlV2Version) {
+    fail_at(path, offset::kVersion,
+            ".ptl version " + str(version) +
+                " is newer than this build of Pointillist reads "
+                "(versions 1 and 2); upgrade Pointillist to open it");
+  }
+  if (size < kHeaderSize) {
+    fail_at(path, size,
+            "file ends early: the header needs " + str(kHeaderSize) + " bytes, the file has only " +
+                str(size));
+  }
+  const std::uint32_t header_size = load_u32(b + offset::kHeaderSize);
+  if (header_size < kHeaderSize || header_size > size) {
+    fail_at(path, offset::kHeaderSize,
+            "header size " + str(header_size) + " (at least " + str(kHeaderSize) + ", within the " +
+                str(size) + "-byte file)");
+  }
+  const std::uint32_t endian = load_u32(b + offset::kEndian);
+  if (endian != kEndianMarker) {
+    fail_at(path, offset::kEndian,
+            "endianness marker does not read 0x01020304 little-endian; the file is corrupt or "
+            "was written byte-swapped");
+  }
+  const std::uint32_t flags = load_u32(b + offset::kFlags);
+  if ((flags & ~kKnownFlags) != 0) {
+    fail_at(path, offset::kFlags,
+            "flags " + str(flags) +
+                " name features this build does not know; upgrade "
+                "Pointillist to open the file");
+  }
+  file->has_colors_ = (flags & kFlagHasColors) != 0;
+  file->record_size_ = load_u32(b + offset::kRecordSize);
+  const std::uint32_t want_record = file->has_colors_ ? 6 : 4;
+  if (file->record_size_ != want_record) {
+    fail_at(path, offset::kRecordSize,
+            "record size " + str(file->record_size_) + ", expected " + str(want_record) +
+                (file->has_colors_ ? " (with colours)" : " (without colours)"));
+  }
+  const Schema expected = schema(file->has_colors_);
+  if (load_u32(b + offset::kAttributeCount) != expected.count) {
+    fail_at(path, offset::kAttributeCount,
+            "attribute count " + str(load_u32(b + offset::kAttributeCount)) + ", expected " +
+                str(expected.count));
+  }
+  for (std::uint32_t a = 0; a < expected.count; ++a) {
+    const std::uint8_t* e = b + offset::kAttributes + 8 * a;
+    const Attribute& x = expected.entries[a];
+    if (load_u16(e) != x.attribute || load_u16(e + 2) != x.encoding || e[4] != x.first_bit ||
+        e[5] != x.bit_count) {
+      fail_at(path, offset::kAttributes + 8 * a,
+              "attribute " + str(a) + " is not the version 2 layout (attribute " +
+                  str(x.attribute) + ", encoding " + str(x.encoding) + ", bits " +
+                  str(x.first_bit) + ".." + str(x.first_bit + x.bit_count - 1) +
+                  "); upgrade Pointillist to open the file");
+    }
+  }
+  file->node_count_ = load_u64(b + offset::kNodeCount);
+  file->leaf_count_ = load_u64(b + offset::kLeafCount);
+  file->depth_ = load_u32(b + offset::kDepth);
+  if (file->node_count_ == 0 || file->node_count_ > 0xfffffffeu) {
+    fail_at(path, offset::kNodeCount, "node count " + str(file->node_count_) + " (1 to 2^32 - 2)");
+  }
+  file->root_sphere_ = {load_vec(b + offset::kRootSphere), load_f32(b + offset::kRootSphere + 12)};
+  file->bounds_ = {load_vec(b + offset::kBoundsLo), load_vec(b + offset::kBoundsHi)};
+  file->view_sphere_ = {load_vec(b + offset::kViewCenter), load_f32(b + offset::kViewRadius)};
+  if (!finite_sphere(file->root_sphere_)) {
+    fail_at(path, offset::kRootSphere, "root sphere is not finite or has a negative radius");
+  }
+  if (!is_finite(file->bounds_.lo) || !is_finite(file->bounds_.hi) ||
+      !is_finite(file->view_sphere_.center) || !std::isfinite(file->view_sphere_.radius)) {
+    fail_at(path, offset::kBoundsLo, "bounds or view sphere are not finite");
+  }
+
+  // Page table.
+  const std::uint32_t page_count = load_u32(b + offset::kPageCount);
+  const std::uint64_t table = load_u64(b + offset::kPageTableOffset);
+  if (page_count == 0) fail_at(path, offset::kPageCount, "page count is 0");
+  if (table < header_size || table > size ||
+      std::uint64_t{page_count} * kPageEntrySize > size - table) {
+    fail_at(path, table < header_size ? offset::kPageTableOffset : size,
+            "file ends early or page table misplaced: " + str(page_count) + " entries at byte " +
+                str(table) + " need " + str(std::uint64_t{page_count} * kPageEntrySize) +
+                " bytes, the file has " + str(size));
+  }
+  file->pages_.resize(page_count);
+  std::uint64_t records = 0;
+  std::uint64_t pages_end = table + std::uint64_t{page_count} * kPageEntrySize;
+  for (std::uint32_t p = 0; p < page_count; ++p) {
+    const std::uint64_t at = table + std::uint64_t{p} * kPageEntrySize;
+    const std::uint8_t* e = b + at;
+    PtlV2PageInfo& info = file->pages_[p];
+    info = {load_u64(e),      load_u32(e + 8),  load_u32(e + 12), load_u32(e + 16),
+            load_u32(e + 20), load_u32(e + 24), load_u32(e + 28)};
+    const std::string which = "page " + str(p) + " of " + str(page_count) + ": ";
+    if (info.offset > size || info.byte_size > size - info.offset) {
+      fail_at(path, size,
+              which + "file ends early: the page needs bytes " + str(info.offset) + " to " +
+                  str(info.offset + info.byte_size) + ", the file has only " + str(size) +
+                  " bytes; it was probably truncated");
+    }
+    if (info.offset < pages_end) {
+      fail_at(path, at,
+              which + "offset " + str(info.offset) + " overlaps the " +
+                  (p == 0 ? std::string("page table") : "previous page") + " (which ends at byte " +
+                  str(pages_end) + ")");
+    }
+    pages_end = info.offset + info.byte_size;
+    const bool root_page = p == 0;
+    if (root_page ? (info.parent_page != kPtlNoPage || info.root_count != 1 || info.first_root != 0)
+                  : (info.parent_page >= p)) {
+      fail_at(path, at + 16,
+              which + "parent page " + str(info.parent_page) +
+                  (root_page ? " (page 0 has none and one root)" : " must come before the page"));
+    }
+    if (!root_page) {
+      const PtlV2PageInfo& parent = file->pages_[info.parent_page];
+      if (info.root_count == 0 || info.first_root >= parent.node_count ||
+          info.root_count > parent.node_count - info.first_root) {
+        fail_at(path, at + 20,
+                which + "roots " + str(info.first_root) + " + " + str(info.root_count) +
+                    " are outside parent page " + str(info.parent_page) + " (" +
+                    str(parent.node_count) + " records)");
+      }
+    }
+    const std::uint64_t want = std::uint64_t{info.root_count} * kRootEntrySize +
+                               std::uint64_t{info.node_count} * file->record_size_;
+    if (info.node_count == 0 || info.level_count == 0 || info.byte_size != want) {
+      fail_at(path, at + 8,
+              which + "byte size " + str(info.byte_size) + ", " + str(info.node_count) +
+                  " records in " + str(info.level_count) + " levels under " + str(info.root_count) +
+                  " roots need " + str(want));
+    }
+    records += info.node_count;
+  }
+  if (records != file->node_count_) {
+    fail_at(path, offset::kNodeCount,
+            "header says " + str(file->node_count_) + " nodes, the pages hold " + str(records));
+  }
+  const std::uint64_t metadata_offset = load_u64(b + offset::kMetadataOffset);
+  const std::uint64_t metadata_size = load_u64(b + offset::kMetadataSize);
+  if (metadata_offset < header_size) {
+    fail_at(path, offset::kMetadataOffset,
+            "metadata offset " + str(metadata_offset) + " lies inside the header");
+  }
+  if (metadata_offset > size || metadata_size > size - metadata_offset) {
+    fail_at(path, size,
+            "file ends early: the metadata needs bytes " + str(metadata_offset) + " to " +
+                str(metadata_offset + metadata_size) + ", the file has only " + str(size) +
+                " bytes; it was probably truncated");
+  }
+  file->metadata_.assign(view.data() + metadata_offset, metadata_size);
+  return file;
+}
+
+PtlV2File::~PtlV2File() = default;
+
+void PtlV2File::decode_page(std::uint32_t page, PtlV2Page& out) const {
+  assert(page < pages_.size());
+  const PtlV2PageInfo& info = pages_[page];
+  const auto* base = reinterpret_cast<const std::uint8_t*>(map_->bytes.view().data());
+  const std::uint8_t* b = base + info.offset;
+  const std::string which = "page " + str(page) + ": ";
+  const std::uint32_t roots = info.root_count;
+  out.root_spheres.resize(roots);
+  out.root_child_counts.resize(roots);
+  for (std::uint32_t r = 0; r < roots; ++r) {
+    const Sphere s{load_vec(b + 16 * r), load_f32(b + 16 * r + 12)};
+    if (!finite_sphere(s)) {
+      fail_at(path_, info.offset + 16 * r,
+              which + "root " + str(r) + " sphere is not finite or has a negative radius");
+    }
+    const std::uint8_t k = b[16 * roots + r];
+    if (page == 0 ? k != 1 : (k < 2 || k > 4)) {
+      fail_at(path_, info.offset + 16 * roots + r,
+              which + "root " + str(r) + " has child count " + str(k) +
+                  (page == 0 ? " (page 0's root: 1)" : " (2 to 4)"));
+    }
+    out.root_spheres[r] = s;
+    out.root_child_counts[r] = k;
+  }
+  const std::uint64_t records_at = info.offset + std::uint64_t{roots} * kRootEntrySize;
+  const std::uint32_t count = info.node_count, rs = record_size_;
+  const auto normals = qs_detail::normal_table();
+  out.nodes.resize(count);
+  // Level by level: the parents of level L + 1 are the roots (L = 0) or the interior records of
+  // level L, in order; a level holds exactly their children.
+  std::uint64_t need = 0;
+  for (std::uint32_t r = 0; r < roots; ++r) need += out.root_child_counts[r];
+  std::uint32_t next_root = 0;
+  std::uint64_t next_parent = 0;  // scan position for interior records
+  std::uint64_t i = 0, level_begin = 0;
+  std::uint32_t levels = 0;
+  while (need > 0 && i < count) {
+    if (need > count - i) {
+      fail_at(path_, records_at + i * rs,
+              which + "level " + str(levels + 1) + " needs " + str(need) +
+                  " records, the page has " + str(count - i) + " left of " + str(count));
+    }
+    level_begin = i;
+    const std::uint64_t level_end = i + need;
+    ++levels;
+    need = 0;
+    while (i < level_end) {
+      // The level's records are exactly the children of these parents, so the scan stays
+      // within the previous level.
+      Sphere ps;
+      std::uint32_t k;
+      if (next_root < roots) {
+        ps = out.root_spheres[next_root];
+        k = out.root_child_counts[next_root++];
+      } else {
+        while (out.nodes[next_parent].child_count == 0) ++next_parent;
+        SphereNode& pn = out.nodes[next_parent++];
+        pn.first_child = static_cast<std::uint32_t>(i);
+        ps = {pn.center, pn.radius};
+        k = pn.child_count;
+      }
+      for (std::uint32_t c = 0; c < k; ++c, ++i) {
+        const std::uint64_t at = records_at + i * rs;
+        const std::uint8_t* r = base + at;
+        std::uint64_t rec = load_u32(r);
+        if (rs == 6) rec |= std::uint64_t{load_u16(r + 4)} << 32;
+        const auto code = std::uint32_t(field(rec, kSphereShift, kSphereBits));
+        const auto children_code = std::uint32_t(field(rec, kChildShift, kChildBits));
+        const auto normal = std::uint32_t(field(rec, kNormalShift, kNormalBits));
+        const auto cone = std::uint32_t(field(rec, kConeShift, kConeBits));
+        if (code >= qs_detail::kSphereCodeCount) {
+          fail_at(path_, at,
+                  which + "record " + str(i) + ": sphere code " + str(code) +
+                      " is outside the table (0.." + str(qs_detail::kSphereCodeCount - 1) + ")");
+        }
+        if (field(rec, kReservedShift, 1) != 0) {
+          fail_at(path_, at + 1, which + "record " + str(i) + ": reserved bit 15 is set");
+        }
+        if (normal >= qs_detail::kNormalCodeCount) {
+          fail_at(path_, at + 2,
+                  which + "record " + str(i) + ": normal code " + str(normal) +
+                      " is outside the table (0.." + str(qs_detail::kNormalCodeCount - 1) + ")");
+        }
+        const Sphere s = qs_detail::decode_sphere(ps, code);
+        SphereNode& n = out.nodes[i];
+        n.center = s.center;
+        n.radius = s.radius;
+        n.normal = normals[normal];
+        n.child_count = static_cast<std::uint8_t>(children_code == 0 ? 0 : children_code + 1);
+        n.cone_sin = n.child_count == 0 ? 0.0f : decoded_cone_sin(cone);
+        n.first_child = 0;
+        n.color =
+            has_colors_ ? qs_detail::decode_rgb565(std::uint16_t(rec >> kColorShift)) : Rgb8{};
+        need += n.child_count;
+      }
+    }
+  }
+  if (i != count) {
+    fail_at(path_, records_at + i * rs,
+            which + "record " + str(i) + " of " + str(count) +
+                " has no parent (the tree of the page ends before it)");
+  }
+  if (levels != info.level_count) {
+    fail_at(path_, records_at + std::uint64_t{count} * rs - rs,
+            which + "the records form " + str(levels) + " levels, the page table says " +
+                str(info.level_count));
+  }
+  // The last level's interior nodes have their children in child pages.
+  out.last_level_begin = static_cast<std::uint32_t>(level_begin);
+}
+
+SphereTree PtlV2File::decode_all() const {
+  const std::uint32_t page_count = this->page_count();
+  std::vector<PtlV2Page> pages(page_count);
+  for (std::uint32_t p = 0; p < page_count; ++p) decode_page(p, pages[p]);
+
+  // Child page links: for each page, its last level's interior nodes in order, each mapped to
+  // (child page, root index, first child record in that page).
+  struct Link {
+    std::uint32_t page = kPtlNoPage, first = 0;
+  };
+  std::vector<std::vector<Link>> links(page_count);
+  std::vector<std::uint32_t> cursor(page_count, 0);  // next last-level node to link, per page
+  for (std::uint32_t p = 0; p < page_count; ++p) links[p].assign(pages[p].nodes.size(), {});
+  for (std::uint32_t c = 1; c < page_count; ++c) {
+    const PtlV2PageInfo& info = pages_[c];
+    const std::uint32_t p = info.parent_page;
+    const PtlV2Page& parent = pages[p];
+    const std::uint64_t parent_records =
+        pages_[p].offset + std::uint64_t{pages_[p].root_count} * kRootEntrySize;
+    std::uint32_t v = std::max(cursor[p], parent.last_level_begin);
+    while (v < parent.nodes.size() && parent.nodes[v].child_count == 0) ++v;
+    std::uint32_t first = 0;
+    for (std::uint32_t r = 0; r < info.root_count; ++r) {
+      while (v < parent.nodes.size() && parent.nodes[v].child_count == 0) ++v;
+      if (v >= parent.nodes.size() || (r == 0 && v != info.first_root)) {
+        fail_at(path_, pages_[c].offset,
+                "page " + str(c) + ": its roots do not continue the last level of parent page " +
+                    str(p) + " (expected record " + str(v) + ", the page table says " +
+                    str(info.first_root) + ")");
+      }
+      const SphereNode& node = parent.nodes[v];
+      const Sphere& stored = pages[c].root_spheres[r];
+      if (std::memcmp(&stored.center, &node.center, sizeof(Vec3f)) != 0 ||
+          std::memcmp(&stored.radius, &node.radius, sizeof(float)) != 0 ||
+          pages[c].root_child_counts[r] != node.child_count) {
+        fail_at(path_, pages_[c].offset + 16 * r,
+                "page " + str(c) + ": root " + str(r) + " differs from record " + str(v) +
+                    " of parent page " + str(p) + " (byte " +
+                    str(parent_records + std::uint64_t{v} * record_size_) + ")");
+      }
+      links[p][v] = {c, first};
+      first += node.child_count;
+      ++v;
+    }
+    cursor[p] = v;
+  }
+  for (std::uint32_t p = 0; p < page_count; ++p) {
+    const PtlV2Page& pg = pages[p];
+    for (std::uint32_t v = pg.last_level_begin; v < pg.nodes.size(); ++v) {
+      if (pg.nodes[v].child_count > 0 && links[p][v].page == kPtlNoPage) {
+        fail_at(path_,
+                pages_[p].offset + std::uint64_t{pages_[p].root_count} * kRootEntrySize +
+                    std::uint64_t{v} * record_size_,
+                "page " + str(p) + ": record " + str(v) + " has children, but no page holds them");
+      }
+    }
+  }
+  if (std::memcmp(&pages[0].root_spheres[0], &root_sphere_, sizeof(Sphere)) != 0) {
+    fail_at(path_, pages_[0].offset, "page 0's root sphere differs from the header's");
+  }
+
+  // Breadth-first over the linked pages: the order in which the tree was written.
+  SphereTree tree;
+  tree.nodes.reserve(node_count_);
+  struct Ref {
+    std::uint32_t page, record;
+  };
+  std::vector<Ref> refs;
+  refs.reserve(node_count_);
+  tree.nodes.push_back(pages[0].nodes[0]);
+  refs.push_back({0, 0});
+  std::uint64_t leaves = 0;
+  std::uint32_t depth = 0;
+  std::uint64_t level_end = 1;
+  for (std::size_t i = 0; i < tree.nodes.size(); ++i) {
+    if (i == level_end) {
+      ++depth;
+      level_end = tree.nodes.size();
+    }
+    const Ref ref = refs[i];
+    const SphereNode& src = pages[ref.page].nodes[ref.record];
+    if (src.child_count == 0) {
+      ++leaves;
+      continue;
+    }
+    Ref child{ref.page, src.first_child};
+    if (ref.record >= pages[ref.page].last_level_begin) {
+      const Link& l = links[ref.page][ref.record];
+      child = {l.page, l.first};
+    }
+    if (tree.nodes.size() + src.child_count > node_count_) {
+      fail_at(path_, offset::kNodeCount,
+              "the pages hold more nodes than the header's " + str(node_count_));
+    }
+    tree.nodes[i].first_child = static_cast<std::uint32_t>(tree.nodes.size());
+    for (std::uint32_t k = 0; k < src.child_count; ++k) {
+      SphereNode n = pages[child.page].nodes[child.record + k];
+      n.first_child = 0;
+      tree.nodes.push_back(n);
+      refs.push_back({child.page, child.record + k});
+    }
+  }
+  if (leaves != leaf_count_) {
+    fail_at(path_, offset::kLeafCount,
+            "header says " + str(leaf_count_) + " leaves, the pages hold " + str(leaves));
+  }
+  if (depth != depth_) {
+    fail_at(path_, offset::kDepth,
+            "header says depth " + str(depth_) + ", the pages have depth " + str(depth));
+  }
+  tree.has_colors = has_colors_;
+  tree.leaf_count = leaves;
+  tree.depth = depth;
+  tree.bounds = bounds_;
+  tree.view_sphere = view_sphere_;
+  return tree;
+}
+
+PtlModel read_ptl(const std::string& path) {
+  std::uint32_t version = 0;
+  {
+    const io_detail::FileBytes bytes = io_detail::FileBytes::map(path);
+    const std::string_view v = bytes.view();
+    if (v.size() >= 12 && std::memcmp(v.data(), ptl::kMagic, sizeof ptl::kMagic) == 0) {
+      version = load_u32(reinterpret_cast<const std::uint8_t*>(v.data()) + 8);
+    }
+  }
+  PtlModel model;
+  if (version == kPtlV2Version) {
+    const auto file = PtlV2File::open(path);
+    model.tree = file->decode_all();
+    model.metadata = file->metadata();
+    model.file_size = file->file_size();
+  } else {
+    // Version 1, a bad magic or an unknown version: PtlFile says what is wrong.
+    const auto file = PtlFile::open(path);
+    const SphereTreeView& t = file->tree();
+    model.tree.nodes.assign(t.nodes.begin(), t.nodes.end());
+    model.tree.has_colors = t.has_colors;
+    model.tree.leaf_count = t.leaf_count;
+    model.tree.depth = t.depth;
+    model.tree.bounds = t.bounds;
+    model.tree.view_sphere = t.view_sphere;
+    model.metadata = file->metadata();
+    model.file_size = file->file_size();
+  }
+  model.version = version == kPtlV2Version ? kPtlV2Version : 1;
+  return model;
+}
+
+}  // namespace pointillist
