@@ -424,3 +424,37 @@ TEST(PagedCli, MemoryCapIsHeldAndReported) {
   EXPECT_NE(bad.exit_code, 0);
   EXPECT_THAT(bad.output, HasSubstr("--memory 'lots'"));
 }
+
+TEST(PtlCli, ConvertWritesVersion2ByDefaultAndVersion1OnRequestAndBothRender) {
+  TempDir dir;
+  const std::string ply = dir.file("scene.ply");
+  ASSERT_EQ(run_cli("generate --scene sphere --points 30000 -o " + ply).exit_code, 0);
+  ASSERT_EQ(run_cli("convert -q " + ply + " -o " + dir.file("v2.ptl")).exit_code, 0);
+  ASSERT_EQ(run_cli("convert -q " + ply + " -o " + dir.file("v1.ptl") + " --ptl-version 1")
+                .exit_code,
+            0);
+  const CliResult i2 = run_cli("info " + dir.file("v2.ptl"));
+  const CliResult i1 = run_cli("info " + dir.file("v1.ptl"));
+  EXPECT_THAT(i2.output, HasSubstr("version 2: quantized 4-byte nodes"));
+  EXPECT_THAT(i1.output, HasSubstr("version 1"));
+  // At most 6 bytes per point without colour (QSplat's figure), 40+ for float nodes.
+  const double v2_bytes = double(fs::file_size(dir.file("v2.ptl"))) / 30000.0;
+  const double v1_bytes = double(fs::file_size(dir.file("v1.ptl"))) / 30000.0;
+  EXPECT_LE(v2_bytes, 6.0);
+  EXPECT_GT(v1_bytes, 40.0);
+  // Both render the same sphere: the quantized spheres only grow a little.
+  const std::string view = " --size 200x150 --view 30,20 --splat ellipse";
+  ASSERT_EQ(run_cli("render " + dir.file("v1.ptl") + " -o " + dir.file("v1.png") + view).exit_code, 0);
+  ASSERT_EQ(run_cli("render " + dir.file("v2.ptl") + " -o " + dir.file("v2.png") + view).exit_code, 0);
+  const CliResult cmp =
+      run_cli("compare " + dir.file("v1.png") + " " + dir.file("v2.png") + " --json -");
+  const auto at = cmp.output.find("\"silhouette_iou\": ");
+  ASSERT_NE(at, std::string::npos) << cmp.output;
+  EXPECT_GE(std::atof(cmp.output.c_str() + at + 18), 0.97) << cmp.output;
+  const auto holes = cmp.output.find("\"hole_pixels\": ");
+  ASSERT_NE(holes, std::string::npos);
+  EXPECT_EQ(std::atoi(cmp.output.c_str() + holes + 15), 0) << cmp.output;
+  EXPECT_NE(run_cli("convert -q " + ply + " -o " + dir.file("v3.ptl") + " --ptl-version 3")
+                .exit_code,
+            0);
+}
