@@ -163,3 +163,4 @@ summary
 
 echo
 bash bench/lod.sh "$work"
+bash bench/paged.sh "$work"

@@ -170,11 +170,15 @@ class FrameRenderer {
   }
   // After a frame has been recorded: loads the pages it asked for (paged models). Returns the
   // number of pages loaded.
+  // --progressive loads between frames (deterministic frames); a camera path hands the pages
+  // to the loader thread, as a viewer does, and the frames show what has arrived.
   std::size_t after_frame() {
     if (!paged_) return 0;
-    return o_.progressive_frames > 0
-               ? paged_->load_requested(pool_, SIZE_MAX, o_.read_per_frame)
-               : paged_->load_requested(pool_);
+    if (o_.progressive_frames > 0) {
+      return paged_->load_requested(pool_, SIZE_MAX, o_.read_per_frame);
+    }
+    if (o_.orbit_frames > 0 || o_.refine_frames > 0) return paged_->request_in_background();
+    return paged_->load_requested(pool_);
   }
   // Draws the view until a paged model has loaded all it needs (or all the cap allows).
   void draw_settled(const Camera& camera, float detail, Frame& frame) {

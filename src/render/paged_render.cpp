@@ -1,5 +1,11 @@
 // The paged QSplat traversal and its page cache (see paged.hpp).
 #include <algorithm>
+#include <condition_variable>
+#include <deque>
+#include <exception>
+#include <mutex>
+#include <thread>
+#include <utility>
 #include <chrono>
 #include <cmath>
 #include <string>
@@ -26,6 +32,98 @@ struct PagedPending {
 
 }  // namespace
 
+struct PagedRenderer::Loader {
+  std::mutex mutex;
+  std::condition_variable wake, idle;
+  std::deque<Request> queue;  // handed over, not yet decoded
+  std::vector<std::pair<Request, std::unique_ptr<HierarchyPage>>> ready;
+  std::exception_ptr error;
+  std::size_t busy = 0;  // pages being decoded now
+  bool stopping = false;
+  std::thread thread;
+};
+
+PagedRenderer::~PagedRenderer() {
+  if (!loader_) return;
+  {
+    std::lock_guard<std::mutex> lock(loader_->mutex);
+    loader_->stopping = true;
+  }
+  loader_->wake.notify_all();
+  loader_->thread.join();
+}
+
+void PagedRenderer::loader_loop() {
+  Loader& l = *loader_;
+  std::unique_lock<std::mutex> lock(l.mutex);
+  for (;;) {
+    l.wake.wait(lock, [&] { return l.stopping || !l.queue.empty(); });
+    if (l.stopping) return;
+    const Request r = l.queue.front();
+    l.queue.pop_front();
+    ++l.busy;
+    lock.unlock();
+    auto page = std::make_unique<HierarchyPage>();
+    std::exception_ptr error;
+    try {
+      source_.load(r.page, r.parent_page == kNoPage ? nullptr : &r.anchor, *page);
+    } catch (...) {
+      error = std::current_exception();
+    }
+    lock.lock();
+    --l.busy;
+    if (error) {
+      if (!l.error) l.error = error;
+    } else {
+      l.ready.emplace_back(r, std::move(page));
+    }
+    if (l.queue.empty() && l.busy == 0) l.idle.notify_all();
+  }
+}
+
+std::size_t PagedRenderer::request_in_background(std::size_t max_pages,
+                                                 std::uint64_t max_storage_bytes) {
+  std::vector<Request> chosen = choose(max_pages, max_storage_bytes);
+  if (chosen.empty()) return 0;
+  if (!loader_) {
+    loader_ = std::make_unique<Loader>();
+    loader_->thread = std::thread([this] { loader_loop(); });
+  }
+  {
+    std::lock_guard<std::mutex> lock(loader_->mutex);
+    for (const Request& r : chosen) {
+      in_flight_[r.page] = 1;
+      loader_->queue.push_back(r);
+    }
+    in_flight_count_ += chosen.size();
+  }
+  loader_->wake.notify_all();
+  return chosen.size();
+}
+
+void PagedRenderer::wait_for_loader() {
+  if (!loader_) return;
+  std::unique_lock<std::mutex> lock(loader_->mutex);
+  loader_->idle.wait(lock, [&] { return loader_->queue.empty() && loader_->busy == 0; });
+  if (loader_->error) std::rethrow_exception(loader_->error);
+}
+
+void PagedRenderer::take_ready() {
+  if (!loader_) return;
+  std::vector<std::pair<Request, std::unique_ptr<HierarchyPage>>> ready;
+  {
+    std::lock_guard<std::mutex> lock(loader_->mutex);
+    if (loader_->error) std::rethrow_exception(loader_->error);
+    ready.swap(loader_->ready);
+  }
+  for (auto& [r, page] : ready) {
+    in_flight_[r.page] = 0;
+    --in_flight_count_;
+    adopt(r, std::move(page));
+  }
+  stats_.resident_bytes_peak = std::max(stats_.resident_bytes_peak, stats_.resident_bytes);
+}
+
 PagedRenderer::PagedRenderer(const PageSource& source, std::uint64_t memory_cap, ThreadPool& pool)
     : source_(source), cap_(memory_cap), summary_(source.summary()) {
   const std::uint32_t n = source.page_count();
@@ -34,6 +132,7 @@ PagedRenderer::PagedRenderer(const PageSource& source, std::uint64_t memory_cap,
   resident_children_.assign(n, 0);
   last_used_.assign(n, 0);
   requested_.assign(n, 0);
+  in_flight_.assign(n, 0);
   stats_.bytes_read = source.open_bytes();
   if (n == 0) return;
   const std::uint64_t first = HierarchyPage::memory_bytes(source.page_node_count(0));
@@ -61,6 +160,7 @@ void PagedRenderer::render(const Camera& camera, const RenderSettings& settings,
   frame.color.resize(pixels);
   frame.depth.resize(pixels);
 
+  take_ready();
   ++frame_number_;
   for (const Request& r : requests_) requested_[r.page] = 0;
   requests_.clear();
@@ -111,7 +211,7 @@ void PagedRenderer::render(const Camera& camera, const RenderSettings& settings,
       } else {
         // Not resident: this node stands in for its subtree, and the page is wanted.
         emit(n, d, z, true);
-        if (!requested_[child_page]) {
+        if (!requested_[child_page] && !in_flight_[child_page]) {
           requested_[child_page] = 1;
           requests_.push_back({child_page, p.page, n, z > 0 ? n.radius / z : 0.0f});
         }
@@ -163,59 +263,66 @@ bool PagedRenderer::make_room(std::uint64_t bytes) {
   return true;
 }
 
-std::size_t PagedRenderer::load_requested(ThreadPool& pool, std::size_t max_pages,
-                                          std::uint64_t max_storage_bytes) {
+std::vector<PagedRenderer::Request> PagedRenderer::choose(std::size_t max_pages,
+                                                          std::uint64_t max_storage_bytes) {
   std::stable_sort(requests_.begin(), requests_.end(),
                    [](const Request& a, const Request& b) { return a.priority > b.priority; });
   // Choose what fits, reserving its memory (pages chosen now are marked used in this frame, so
   // they are not evicted for each other).
-  std::vector<const Request*> chosen;
+  std::vector<Request> chosen;
   std::uint64_t storage = 0;
   for (const Request& r : requests_) {
     if (chosen.size() >= max_pages) break;
-    if (pages_[r.page]) continue;
+    if (pages_[r.page] || in_flight_[r.page]) continue;
     const std::uint64_t read = source_.page_storage_bytes(r.page);
     if (!chosen.empty() && storage + read > max_storage_bytes) break;
     if (r.parent_page != kNoPage && !pages_[r.parent_page]) continue;
     const std::uint64_t bytes = HierarchyPage::memory_bytes(source_.page_node_count(r.page));
     if (!make_room(bytes)) continue;
     stats_.resident_bytes += bytes;
-    // Keep the parent from being evicted for a later choice of this batch.
+    // Keep the parent from being evicted while the page is on its way.
     if (r.parent_page != kNoPage) {
       ++resident_children_[r.parent_page];
       last_used_[r.parent_page] = std::max(last_used_[r.parent_page], frame_number_);
     }
     last_used_[r.page] = frame_number_;
     storage += read;
-    chosen.push_back(&r);
+    chosen.push_back(r);
   }
+  for (const Request& r : requests_) requested_[r.page] = 0;
+  requests_.clear();
+  stats_.resident_bytes_peak = std::max(stats_.resident_bytes_peak, stats_.resident_bytes);
+  return chosen;
+}
+
+void PagedRenderer::adopt(const Request& r, std::unique_ptr<HierarchyPage> page) {
+  if (page->nodes.size() != source_.page_node_count(r.page) ||
+      page->child_page.size() != page->nodes.size()) {
+    throw FormatError("page " + std::to_string(r.page) + " decoded to " +
+                      std::to_string(page->nodes.size()) + " nodes where the page table says " +
+                      std::to_string(source_.page_node_count(r.page)) +
+                      "; the model file is corrupt (convert it again)");
+  }
+  pages_[r.page] = std::move(page);
+  parent_[r.page] = r.parent_page;
+  last_used_[r.page] = std::max(last_used_[r.page], frame_number_);
+  stats_.bytes_read += source_.page_storage_bytes(r.page);
+  ++stats_.pages_loaded;
+  ++stats_.resident_pages;
+}
+
+std::size_t PagedRenderer::load_requested(ThreadPool& pool, std::size_t max_pages,
+                                          std::uint64_t max_storage_bytes) {
+  const std::vector<Request> chosen = choose(max_pages, max_storage_bytes);
   std::vector<std::unique_ptr<HierarchyPage>> loaded(chosen.size());
   pool.run(chosen.size(), [&](std::size_t i) {
     auto page = std::make_unique<HierarchyPage>();
-    const Request& r = *chosen[i];
+    const Request& r = chosen[i];
     source_.load(r.page, r.parent_page == kNoPage ? nullptr : &r.anchor, *page);
     loaded[i] = std::move(page);
   });
-  for (std::size_t i = 0; i < chosen.size(); ++i) {
-    const Request& r = *chosen[i];
-    if (loaded[i]->nodes.size() != source_.page_node_count(r.page) ||
-        loaded[i]->child_page.size() != loaded[i]->nodes.size()) {
-      throw FormatError("page " + std::to_string(r.page) + " decoded to " +
-                        std::to_string(loaded[i]->nodes.size()) + " nodes where the page table says " +
-                        std::to_string(source_.page_node_count(r.page)) +
-                        "; the model file is corrupt (convert it again)");
-    }
-    pages_[r.page] = std::move(loaded[i]);
-    parent_[r.page] = r.parent_page;
-    stats_.bytes_read += source_.page_storage_bytes(r.page);
-    ++stats_.pages_loaded;
-    ++stats_.resident_pages;
-  }
-  stats_.resident_bytes_peak = std::max(stats_.resident_bytes_peak, stats_.resident_bytes);
-  const std::size_t count = chosen.size();
-  requests_.clear();
-  std::fill(requested_.begin(), requested_.end(), 0);
-  return count;
+  for (std::size_t i = 0; i < chosen.size(); ++i) adopt(chosen[i], std::move(loaded[i]));
+  return chosen.size();
 }
 
 }  // namespace pointillist

@@ -196,3 +196,39 @@ TEST(PagedRender, CapBelowTheFirstPageIsRefusedWithTheSizeNeeded) {
   }
   EXPECT_THROW(paginate(demo_tree().view(), 100), OptionError);
 }
+
+TEST(PagedRender, BackgroundLoaderReachesTheFullImageAndHoldsTheCap) {
+  // Pages decoded on the loader thread while frames render: whatever the timing, the frames
+  // never show holes, the cap holds, and once everything has arrived the image is render()'s.
+  ThreadPool pool(2);
+  const SphereTree& tree = demo_tree();
+  const auto source = paginate(tree.view(), 4096, 4);
+  const Camera cam = view(200);
+  Frame full, frame;
+  render(tree.view(), cam, RenderSettings{}, pool, full);
+  {
+    PagedRenderer paged(*source, UINT64_MAX, pool);
+    for (int i = 0; i < 400; ++i) {
+      paged.render(cam, RenderSettings{}, pool, frame);
+      EXPECT_EQ(compare(full, frame).hole_count, 0u) << "frame " << i;
+      if (paged.complete()) break;
+      paged.request_in_background(SIZE_MAX, 64 * 1024);
+      if (i % 8 == 7) paged.wait_for_loader();
+    }
+    EXPECT_TRUE(paged.complete());
+    EXPECT_EQ(frame.color, full.color);
+  }
+  std::uint64_t total = 0;
+  for (std::uint32_t p = 0; p < source->page_count(); ++p) {
+    total += HierarchyPage::memory_bytes(source->page_node_count(p));
+  }
+  PagedRenderer capped(*source, total / 8, pool);
+  for (float az = 0; az < 360; az += 60) {
+    for (int i = 0; i < 60; ++i) {
+      capped.render(view(az, 1.2f), RenderSettings{}, pool, frame);
+      if (capped.request_in_background() == 0) capped.wait_for_loader();
+      if (capped.complete()) break;
+    }
+    EXPECT_LE(capped.stats().resident_bytes_peak, total / 8) << "azimuth " << az;
+  }
+}

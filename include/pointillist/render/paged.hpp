@@ -74,12 +74,15 @@ struct PagedRenderStats {
 };
 
 // Renders a paged model. Not thread-safe: one frame at a time; the pool parallelises page loads
-// and rasterization.
+// and rasterization, and an optional loader thread decodes pages in the background.
 class PagedRenderer {
  public:
   // Loads page 0. Throws OptionError when page 0 alone needs more than `memory_cap` bytes (the
   // message gives the size needed), and what the source throws.
   PagedRenderer(const PageSource& source, std::uint64_t memory_cap, ThreadPool& pool);
+  ~PagedRenderer();  // stops the loader thread, if one was started
+  PagedRenderer(const PagedRenderer&) = delete;
+  PagedRenderer& operator=(const PagedRenderer&) = delete;
 
   // The QSplat traversal of render() (same tests, threshold and culling, same splats where the
   // pages are resident) over the resident pages. A node whose children are in a page that is
@@ -96,8 +99,20 @@ class PagedRenderer {
   std::size_t load_requested(ThreadPool& pool, std::size_t max_pages = SIZE_MAX,
                              std::uint64_t max_storage_bytes = UINT64_MAX);
 
-  // True when the last frame requested nothing: what is resident is all that view needs.
-  bool complete() const { return stats_.pages_requested == 0; }
+  // Background loading, as an interactive viewer does it: hands the pages the last render
+  // requested (chosen as load_requested chooses them, their memory reserved under the cap) to
+  // a loader thread, which decodes them while the next frames render; every render() first
+  // takes in the pages that are ready. A page on its way is not requested again. Returns the
+  // number of pages handed over. Frames then depend on timing; load_requested() does not.
+  std::size_t request_in_background(std::size_t max_pages = SIZE_MAX,
+                                    std::uint64_t max_storage_bytes = UINT64_MAX);
+  // Waits until the loader has decoded every page handed to it (they are taken in by the next
+  // render()). Rethrows what loading a page threw.
+  void wait_for_loader();
+
+  // True when the last frame requested nothing and no page is on its way: what is resident is
+  // all that view needs.
+  bool complete() const { return stats_.pages_requested == 0 && in_flight_count_ == 0; }
   const PagedRenderStats& stats() const { return stats_; }
   // Counts and boxes of the model (PageSource::summary), for the camera.
   const SphereTreeView& summary() const { return summary_; }
@@ -110,6 +125,13 @@ class PagedRenderer {
     float priority;  // the anchor's projected radius: larger first
   };
   bool make_room(std::uint64_t bytes);
+  // Chooses requests to load (see load_requested), reserving their memory; clears requests_.
+  std::vector<Request> choose(std::size_t max_pages, std::uint64_t max_storage_bytes);
+  // Makes a loaded page resident (its memory was reserved by choose).
+  void adopt(const Request& r, std::unique_ptr<HierarchyPage> page);
+  void take_ready();
+  void loader_loop();
+  struct Loader;
 
   const PageSource& source_;
   std::uint64_t cap_;
@@ -121,8 +143,11 @@ class PagedRenderer {
   std::vector<Request> requests_;
   std::vector<std::uint8_t> requested_;                // per page: already in requests_
   std::vector<SphereNode> emitted_;                    // the nodes of the last frame's splats
+  std::vector<std::uint8_t> in_flight_;                // per page: handed to the loader
+  std::size_t in_flight_count_ = 0;
   std::uint64_t frame_number_ = 0;
   PagedRenderStats stats_;
+  std::unique_ptr<Loader> loader_;
 };
 
 }  // namespace pointillist

@@ -1,0 +1,65 @@
+#!/usr/bin/env bash
+# Opening and streaming models: bytes per point, time to the first frame and to full detail,
+# and the cost of rendering page by page (decoded on load) against the whole hierarchy in
+# memory, on the dragon and on a generated 20-million-point cloud.
+#   bash bench/paged.sh [WORKDIR]      (BENCH_QUICK=1: the dragon only)
+# Wall times of whole `pointillist` runs (process start to PNG written), so they include opening
+# the file; the baseline of each row is stated in it.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cli=build/release/pointillist
+[ -x "$cli" ] || { echo "bench: build first (make build)" >&2; exit 1; }
+models="${POINTILLIST_MODELS:-${XDG_CACHE_HOME:-$HOME/.cache}/pointillist/models}"
+work=${1:-$(mktemp -d)}
+mkdir -p "$work"
+
+seconds() {  # seconds CMD...: wall time of one run
+  local t0 t1
+  t0=$(date +%s.%N); "$@" >/dev/null; t1=$(date +%s.%N)
+  awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.3f", b - a }'
+}
+field() {  # field NAME FILE: a top-level numeric field of a stats JSON
+  sed -n "s/^  \"$1\": \([0-9.e+-]*\).*/\1/p" "$2" | head -1
+}
+median_ms() {  # median of the frames' "ms" from the 10th frame on
+  grep '"phase"' "$1" | tail -n +10 | sed -n 's/.*"ms": \([0-9.]*\).*/\1/p' | sort -g |
+    awk '{ v[NR] = $1 } END { print (NR ? v[int((NR + 1) / 2)] : "nan") }'
+}
+
+rows() {  # rows NAME MODEL.ptl POINTS
+  local name=$1 model=$2 points=$3 size
+  size=$(stat -c %s "$model")
+  printf '%-10s %-42s %12s\n' "$name" "file size, bytes per point" \
+    "$(awk -v s="$size" -v n="$points" 'BEGIN { printf "%.1f MB, %.2f", s / 1e6, s / n }')"
+  local first full whole
+  first=$(seconds "$cli" render "$model" -o "$work/p.png" --progressive 1 -q)
+  "$cli" render "$model" -o "$work/p.png" --progressive 1 -q --stats "$work/first.json"
+  full=$(seconds "$cli" render "$model" -o "$work/p.png" --memory 1000G -q)
+  whole=$(seconds "$cli" render "$model" -o "$work/p.png" -q)
+  printf '%-10s %-42s %12s\n' "" "first frame, s (bytes read for it)" \
+    "$first ($(grep '"phase"' "$work/first.json" | sed -n 's/.*"bytes_read": \([0-9]*\).*/\1/p'))"
+  printf '%-10s %-42s %12s\n' "" "full detail page by page, s" "$full"
+  printf '%-10s %-42s %12s\n' "" "baseline: decode whole + render, s" "$whole"
+  # Steady-state frames: the same view 40 times, paged (everything resident after a few frames)
+  # against the whole hierarchy in memory.
+  "$cli" render "$model" -o "$work/p.png" --progressive 40 --read-per-frame 1000G -q \
+    --stats "$work/paged.json"
+  "$cli" render "$model" -o "$work/p.png" --refine 40 -q --stats "$work/mem.json"
+  local pm mm
+  pm=$(median_ms "$work/paged.json"); mm=$(median_ms "$work/mem.json")
+  printf '%-10s %-42s %12s\n' "" "frame ms: paged / in memory (ratio)" \
+    "$pm / $mm ($(awk -v a="$pm" -v b="$mm" 'BEGIN { printf "%.2f", a / b }'))"
+}
+
+echo "== opening and streaming models (1280x720, 1 px threshold)"
+if [ -f "$models/dragon_vrip.ply.gz" ]; then
+  "$cli" convert -q "$models/dragon_vrip.ply.gz" -o "$work/dragon.ptl"
+  rows dragon "$work/dragon.ptl" 437645
+fi
+if [ -z "${BENCH_QUICK:-}" ]; then
+  [ -f "$work/cloud20m.ply" ] || "$cli" generate -q --points 20000000 --with-normals \
+    -o "$work/cloud20m.ply"
+  "$cli" convert -q "$work/cloud20m.ply" -o "$work/cloud20m.ptl"
+  rm -f "$work/cloud20m.ply"
+  rows "20M cloud" "$work/cloud20m.ptl" 20000000
+fi
