@@ -26,6 +26,10 @@ FrameTimeController::FrameTimeController(const FrameControlOptions& o, float ini
         "coarsest level of detail " + std::to_string(o.coarsest) + " is below the finest " +
             std::to_string(o.finest) + "; give coarsest >= finest");
   check(o.gain > 0 && o.gain <= 1, "gain " + std::to_string(o.gain) + " must be in (0, 1]");
+  check(o.spike_gain > 0 && o.spike_gain <= 1,
+        "spike gain " + std::to_string(o.spike_gain) + " must be in (0, 1]");
+  check(o.spike_ratio > 1 && std::isfinite(o.spike_ratio),
+        "spike ratio " + std::to_string(o.spike_ratio) + " must be a finite factor > 1");
   check(o.deadband >= 0 && o.deadband < 1,
         "deadband " + std::to_string(o.deadband) + " must be in [0, 1)");
   check(o.max_step > 1 && std::isfinite(o.max_step),
@@ -44,6 +48,8 @@ void FrameTimeController::report(double frame_ms) {
   if (!std::isfinite(frame_ms) || frame_ms < 0) return;
   const double log_ms = std::log(std::max(frame_ms, 1e-6));
   const double log_p = std::log(static_cast<double>(parameter_));
+  const bool spike = has_last_ && std::abs(log_p - last_log_p_) <= 0.02 &&
+                     log_ms - last_log_ms_ > std::log(options_.spike_ratio);
   if (has_last_ && std::abs(log_p - last_log_p_) > 0.02) {
     const double observed = -(log_ms - last_log_ms_) / (log_p - last_log_p_);
     exponent_ = 0.5 * (exponent_ + std::clamp(observed, options_.min_exponent, options_.max_exponent));
@@ -53,7 +59,8 @@ void FrameTimeController::report(double frame_ms) {
   has_last_ = true;
   const double log_ratio = log_ms - std::log(options_.target_ms);  // > 0: too slow
   if (std::abs(std::exp(log_ratio) - 1) <= options_.deadband) return;
-  const double log_step = std::clamp(options_.gain * log_ratio / exponent_,
+  const double gain = spike ? options_.spike_gain : options_.gain;
+  const double log_step = std::clamp(gain * log_ratio / exponent_,
                                      -std::log(options_.max_step), std::log(options_.max_step));
   const double next = static_cast<double>(parameter_) * std::exp(log_step);
   parameter_ = static_cast<float>(

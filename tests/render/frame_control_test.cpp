@@ -114,6 +114,25 @@ TEST(FrameTimeController, OneSlowFrameMovesTheThresholdAtMostMaxStep) {
   EXPECT_FLOAT_EQ(c.parameter(), 3.0f);
 }
 
+TEST(FrameTimeController, AnIsolatedSpikeBarelyMovesTheThreshold) {
+  // Cost model ms = 40·p^-2 (target 10 ms at p = 2). On target, then one frame 50% slow at the
+  // same p: a gain of 0.7 would coarsen p by 1.5^(0.7/2) = +15% and make the next normal frame
+  // 25% fast (a miss); with the spike gain 0.2, p moves by 1.5^(0.2/2) = +4.1%, and the next
+  // normal frame (8% fast) is within the deadband, so p stays.
+  FrameTimeController c({.target_ms = 10}, 2.0f);
+  const auto cost = [](float p) { return 40.0 / (double(p) * p); };
+  c.report(cost(c.parameter()));
+  EXPECT_FLOAT_EQ(c.parameter(), 2.0f);
+  c.report(1.5 * cost(c.parameter()));
+  EXPECT_NEAR(c.parameter(), 2.0 * std::pow(1.5, 0.1), 1e-4);
+  const float after = c.parameter();
+  c.report(cost(after));
+  EXPECT_FLOAT_EQ(c.parameter(), after);
+  EXPECT_NEAR(cost(after), 10.0, 1.0);
+  EXPECT_THROW(FrameTimeController({.target_ms = 10, .spike_ratio = 1.0}, 1.0f), OptionError);
+  EXPECT_THROW(FrameTimeController({.target_ms = 10, .spike_gain = 0}, 1.0f), OptionError);
+}
+
 TEST(FrameTimeController, RejectsBadOptions) {
   EXPECT_THROW(FrameTimeController({.target_ms = 0}, 1.0f), OptionError);
   EXPECT_THROW(FrameTimeController({.target_ms = 10, .finest = 0}, 1.0f), OptionError);

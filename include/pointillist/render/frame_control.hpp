@@ -36,6 +36,12 @@ struct FrameControlOptions {
   // steps (crossing a flat region quickly), bounded by max_step.
   double min_exponent = 0.25;
   double max_exponent = 4.0;
+  // A frame more than spike_ratio times slower than the previous one at (nearly) the same
+  // parameter is taken as a spike (a page fault, another process) rather than a change of
+  // scene: the correction it asks for is applied with spike_gain instead of gain. A real change
+  // of scene is still followed at full gain from the next frame on.
+  double spike_ratio = 1.3;
+  double spike_gain = 0.2;
 };
 
 // Feedback controller for one view sequence. Usage per frame: render with parameter(), then
