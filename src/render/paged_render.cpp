@@ -13,6 +13,7 @@
 
 #include "pointillist/core/error.hpp"
 #include "pointillist/render/paged.hpp"
+#include "render/frame_timing.hpp"
 #include "render/shading.hpp"
 #include "render/traversal_common.hpp"
 
@@ -20,10 +21,6 @@ namespace pointillist {
 namespace {
 
 using namespace render_detail;
-
-double ms_between(std::chrono::steady_clock::time_point a, std::chrono::steady_clock::time_point b) {
-  return std::chrono::duration<double, std::milli>(b - a).count();
-}
 
 struct PagedPending {
   std::uint32_t page, node;
@@ -151,14 +148,9 @@ void PagedRenderer::render(const Camera& camera, const RenderSettings& settings,
     throw OptionError("splat size threshold " + std::to_string(settings.threshold_px) +
                       " px is invalid; give a positive number of pixels (1 draws every detail)");
   }
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = Clock::now();
   const CameraFrame cam = make_camera_frame(camera);
-  const std::size_t pixels =
-      static_cast<std::size_t>(cam.width) * static_cast<std::size_t>(cam.height);
-  frame.width = cam.width;
-  frame.height = cam.height;
-  frame.color.resize(pixels);
-  frame.depth.resize(pixels);
+  size_frame(frame, cam);
 
   take_ready();
   ++frame_number_;
@@ -223,22 +215,13 @@ void PagedRenderer::render(const Camera& camera, const RenderSettings& settings,
     }
   }
   finish_chunk(emitted_, v, with_colors, chunk);
-  const auto selected = std::chrono::steady_clock::now();
+  const auto selected = Clock::now();
   rasterize_splats(stream, cam, settings, pool, frame.scratch, frame.color, frame.depth);
-  const auto done = std::chrono::steady_clock::now();
-
-  RenderStats& s = frame.stats;
-  s = {};
-  s.splats = chunk.count;
-  s.nodes_visited = counters.visited;
-  s.culled_frustum = counters.culled_frustum;
-  s.culled_backface = counters.culled_backface;
-  s.width = cam.width;
-  s.height = cam.height;
-  s.threads = pool.thread_count();
-  s.ms_select = ms_between(start, selected);
-  s.ms_raster = ms_between(selected, done);
-  s.ms_total = ms_between(start, done);
+  fill_stats(frame,
+             {.splats = chunk.count, .nodes_visited = counters.visited,
+              .culled_frustum = counters.culled_frustum,
+              .culled_backface = counters.culled_backface},
+             cam, pool.thread_count(), start, selected, Clock::now());
   stats_.pages_requested = requests_.size();
 }
 
