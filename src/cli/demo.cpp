@@ -8,7 +8,7 @@
 #include "cli/model_loading.hpp"
 #include "cli/terminal_progress.hpp"
 #include "pointillist/core/error.hpp"
-#include "pointillist/format/ptl.hpp"
+#include "pointillist/format/ptl_v2.hpp"
 #include "pointillist/io/ply.hpp"
 #include "pointillist/io/png.hpp"
 #include "pointillist/scene/analytic.hpp"
@@ -42,7 +42,7 @@ void convert_for_demo(const std::string& input, const std::string& output, Threa
   PointSet points = read_inputs({input}, pool, progress);
   prepare_splats(points, pool, progress, {});
   const SphereTree tree = build_sphere_tree(points, pool, progress);
-  write_ptl(output, tree, "generator: pointillist demo\nsource: " + input + "\n");
+  write_ptl_v2(output, tree, "generator: pointillist demo\nsource: " + input + "\n");
   const double s = seconds_since(start);
   std::printf("  convert %-28s %9zu points  %7.3f s  %6.2f M points/s  %5.1f bytes/point\n",
               std::filesystem::path(input).filename().c_str(), points.size(), s,
