@@ -156,69 +156,134 @@ void PagedRenderer::render(const Camera& camera, const RenderSettings& settings,
   ++frame_number_;
   for (const Request& r : requests_) requested_[r.page] = 0;
   requests_.clear();
-  emitted_.clear();
 
   const bool with_colors = summary_.has_colors;
   SplatStream& stream = frame.splats;
   stream.has_colors = with_colors;
-  if (stream.chunks.empty()) stream.chunks.resize(1);
-  stream.chunk_count = 1;
-  SplatChunk& chunk = stream.chunks[0];
-  chunk.count = 0;
-  chunk.reserve(kInitialChunkCapacity, with_colors);
-
+  stream.chunk_count = 0;
   const Shader shader(settings, cam);
   const ViewConstants v = make_view_constants(shader, cam, settings);
   Counters counters;
-  if (pages_.size() > 0 && pages_[0]) {
+  if (!pages_.empty() && pages_[0]) {
     last_used_[0] = frame_number_;
-    Emitter emitter(chunk, with_colors);
-    const auto emit = [&](const SphereNode& n, Vec3f d, float z, bool stand_in = false) {
-      emitter.emit(n, static_cast<std::uint32_t>(emitted_.size()), d, z, v, counters, !stand_in);
-      emitted_.push_back(n);
-      // A stand-in is drawn even when its mean normal faces away (its subtree may hold surfaces
-      // facing the eye); it is then lit from the front, not drawn black.
-      if (stand_in && dot(d, n.normal) > 0) emitted_.back().normal = -n.normal;
+    // Where the children of a refined node are: {page, first} or, when that page is not
+    // resident, page = the wanted page and resident = false.
+    struct Children {
+      std::uint32_t page, first;
+      bool resident;
     };
-    std::vector<PagedPending> stack;
-    stack.push_back({0, 0,
-                     static_cast<std::uint8_t>((settings.frustum_culling ? kTestFrustum : 0) |
-                                               (settings.backface_culling ? kTestBackface : 0))});
-    while (!stack.empty()) {
-      PagedPending p = stack.back();
-      stack.pop_back();
-      const HierarchyPage& page = *pages_[p.page];
-      const SphereNode& n = page.nodes[p.node];
-      Vec3f d;
-      float z;
-      const Decision decision = visit(n, v, p.tests, counters, d, z);
-      if (decision == Decision::Draw) emit(n, d, z);
-      if (decision != Decision::Refine) continue;
-      std::uint32_t child_page = page.child_page[p.node];
-      std::uint32_t first = n.first_child;
-      if (child_page == kNoPage) {
-        child_page = p.page;
-      } else if (pages_[child_page]) {
-        last_used_[child_page] = frame_number_;
-      } else {
-        // Not resident: this node stands in for its subtree, and the page is wanted.
-        emit(n, d, z, true);
-        if (!requested_[child_page] && !in_flight_[child_page]) {
-          requested_[child_page] = 1;
-          requests_.push_back({child_page, p.page, n, z > 0 ? n.radius / z : 0.0f});
+    const auto children_of = [&](const PagedPending& p, const SphereNode& n) {
+      const std::uint32_t cp = pages_[p.page]->child_page[p.node];
+      if (cp == kNoPage) return Children{p.page, n.first_child, true};
+      return Children{cp, n.first_child, pages_[cp] != nullptr};
+    };
+
+    // The top of the hierarchy expanded level by level (as the in-memory traversal does) into
+    // subtrees walked in parallel, each into its own chunk; chunks in order give the
+    // depth-first order whatever the thread count. A node is expanded here only when its
+    // children are resident; anything else is left for its task to visit.
+    std::vector<PagedPending> items{
+        {0, 0,
+         static_cast<std::uint8_t>((settings.frustum_culling ? kTestFrustum : 0) |
+                                   (settings.backface_culling ? kTestBackface : 0))}};
+    std::vector<PagedPending> next;
+    while (items.size() < kTargetTasks) {
+      bool expanded = false;
+      next.clear();
+      for (PagedPending p : items) {
+        const SphereNode& n = pages_[p.page]->nodes[p.node];
+        Counters trial;
+        Vec3f d;
+        float z;
+        std::uint8_t tests = p.tests;
+        const Decision decision = visit(n, v, tests, trial, d, z);
+        const Children c = decision == Decision::Refine ? children_of(p, n) : Children{};
+        if (decision == Decision::Cull || (decision == Decision::Refine && c.resident)) {
+          counters.visited += trial.visited;
+          counters.culled_frustum += trial.culled_frustum;
+          counters.culled_backface += trial.culled_backface;
+          if (decision == Decision::Cull) continue;
+          if (c.page != p.page) last_used_[c.page] = frame_number_;
+          for (std::uint32_t k = 0; k < n.child_count; ++k) {
+            next.push_back({c.page, c.first + k, tests});
+          }
+          expanded = true;
+        } else {
+          next.push_back(p);  // drawn, or a stand-in: its task visits it
         }
-        continue;
       }
-      for (std::uint32_t k = n.child_count; k-- > 0;) {
-        stack.push_back({child_page, first + k, p.tests});
+      items.swap(next);
+      if (!expanded) break;
+    }
+
+    if (stream.chunks.size() < items.size()) stream.chunks.resize(items.size());
+    stream.chunk_count = items.size();
+    if (task_out_.size() < items.size()) task_out_.resize(items.size());
+    std::vector<Counters> task_counters(items.size());
+    pool.run(items.size(), [&](std::size_t t) {
+      TaskOut& out = task_out_[t];
+      Counters& task_count = task_counters[t];
+      out.emitted.clear();
+      out.requests.clear();
+      out.touched.clear();
+      SplatChunk& chunk = stream.chunks[t];
+      chunk.count = 0;
+      chunk.reserve(kInitialChunkCapacity, with_colors);
+      {
+        Emitter emitter(chunk, with_colors);
+        const auto emit = [&](const SphereNode& n, Vec3f d, float z, bool stand_in) {
+          emitter.emit(n, static_cast<std::uint32_t>(out.emitted.size()), d, z, v, task_count,
+                       !stand_in);
+          out.emitted.push_back(n);
+          // A stand-in is drawn even when its mean normal faces away (its subtree may hold
+          // surfaces facing the eye); it is then lit from the front, not drawn black.
+          if (stand_in && dot(d, n.normal) > 0) out.emitted.back().normal = -n.normal;
+        };
+        std::vector<PagedPending> stack{items[t]};
+        while (!stack.empty()) {
+          const PagedPending p = stack.back();
+          stack.pop_back();
+          const SphereNode& n = pages_[p.page]->nodes[p.node];
+          Vec3f d;
+          float z;
+          std::uint8_t tests = p.tests;
+          const Decision decision = visit(n, v, tests, task_count, d, z);
+          if (decision == Decision::Draw) emit(n, d, z, false);
+          if (decision != Decision::Refine) continue;
+          const Children c = children_of(p, n);
+          if (!c.resident) {
+            // Not resident: this node stands in for its subtree, and the page is wanted.
+            emit(n, d, z, true);
+            out.requests.push_back({c.page, p.page, n, z > 0 ? n.radius / z : 0.0f});
+            continue;
+          }
+          if (c.page != p.page) out.touched.push_back(c.page);
+          for (std::uint32_t k = n.child_count; k-- > 0;) {
+            stack.push_back({c.page, c.first + k, tests});
+          }
+        }
+      }
+      finish_chunk(out.emitted, v, with_colors, chunk);
+    });
+    for (std::size_t t = 0; t < items.size(); ++t) {
+      const TaskOut& out = task_out_[t];
+      counters.visited += task_counters[t].visited;
+      counters.culled_frustum += task_counters[t].culled_frustum;
+      counters.culled_backface += task_counters[t].culled_backface;
+      for (const std::uint32_t page : out.touched) last_used_[page] = frame_number_;
+      for (const Request& r : out.requests) {
+        if (requested_[r.page] || in_flight_[r.page]) continue;
+        requested_[r.page] = 1;
+        requests_.push_back(r);
       }
     }
   }
-  finish_chunk(emitted_, v, with_colors, chunk);
+  std::uint64_t splats = 0;
+  for (std::size_t t = 0; t < stream.chunk_count; ++t) splats += stream.chunks[t].count;
   const auto selected = Clock::now();
   rasterize_splats(stream, cam, settings, pool, frame.scratch, frame.color, frame.depth);
   fill_stats(frame,
-             {.splats = chunk.count, .nodes_visited = counters.visited,
+             {.splats = splats, .nodes_visited = counters.visited,
               .culled_frustum = counters.culled_frustum,
               .culled_backface = counters.culled_backface},
              cam, pool.thread_count(), start, selected, Clock::now());

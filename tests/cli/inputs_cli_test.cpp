@@ -58,6 +58,7 @@ std::vector<double> info_bounds(const std::string& info) {
 }  // namespace
 
 TEST(QsCli, InfoAndRenderOpenTheFilesQsplatMakeWrote) {
+  POINTILLIST_REQUIRE_SHARED_TESTDATA();
   TempDir dir;
   const CliResult info = run_cli("info " + qsplat_sample("dragon_vrip_res4_color.strict.qs"));
   ASSERT_EQ(info.exit_code, 0) << info.output;
@@ -81,6 +82,7 @@ TEST(QsCli, InfoAndRenderOpenTheFilesQsplatMakeWrote) {
 }
 
 TEST(QsCli, ConvertToQsWritesTheBytesQsplatMakeWrote) {
+  POINTILLIST_REQUIRE_SHARED_TESTDATA();
   TempDir dir;
   for (const std::string base : {"dragon_vrip_res4", "dragon_vrip_res4_color"}) {
     const std::string out = dir.file(base + ".qs");
@@ -91,6 +93,7 @@ TEST(QsCli, ConvertToQsWritesTheBytesQsplatMakeWrote) {
 }
 
 TEST(QsCli, AQsModelIsNotAnInputToConvert) {
+  POINTILLIST_REQUIRE_SHARED_TESTDATA();
   TempDir dir;
   const CliResult r =
       run_cli("convert " + qsplat_sample("dragon_vrip_res4.qs") + " -o " + dir.file("x.ptl"));

@@ -64,6 +64,7 @@ const ReferenceFacts kReferences[] = {
 };
 
 TEST(QsReader, ReproducesTheReferenceFilesFacts) {
+  POINTILLIST_REQUIRE_SHARED_TESTDATA();
   for (const ReferenceFacts& ref : kReferences) {
     SCOPED_TRACE(ref.file);
     const QsModel m = read_qs(qsplat_file(ref.file));
@@ -104,6 +105,7 @@ TEST(QsReader, ReproducesTheReferenceFilesFacts) {
 }
 
 TEST(QsReader, CountsRecordsOutsideTheirParentAsTheReadmeStates) {
+  POINTILLIST_REQUIRE_SHARED_TESTDATA();
   const QsModel m = read_qs(qsplat_file("dragon_vrip_res4.strict.qs"));
   EXPECT_EQ(m.stats.records_outside_parent, 1428u);
   // Those records force their parents (or ancestors) to grow.
@@ -116,6 +118,7 @@ TEST(QsReader, CountsRecordsOutsideTheirParentAsTheReadmeStates) {
 
 // Worked example of spec §11: the root's first child and its first child, hand-decoded there.
 TEST(QsReader, DecodesTheSpecWorkedExample) {
+  POINTILLIST_REQUIRE_SHARED_TESTDATA();
   const QsModel m = read_qs(qsplat_file("dragon_vrip_res4.strict.qs"));
   const auto& n = m.tree.nodes;
   ASSERT_EQ(n[0].first_child, 1u);
@@ -148,6 +151,7 @@ TEST(QsReader, DecodesTheSpecWorkedExample) {
 // After decoding, every child lies inside its parent and every parent's normal cone covers its
 // children's: checked in double, independently of the fix's own arithmetic.
 TEST(QsReader, EnclosureFixNestsEveryChildInItsParent) {
+  POINTILLIST_REQUIRE_SHARED_TESTDATA();
   for (const char* file : {"dragon_vrip_res4.strict.qs", "dragon_vrip_res4_color.strict.qs"}) {
     SCOPED_TRACE(file);
     const QsModel m = read_qs(qsplat_file(file));
@@ -192,6 +196,7 @@ TEST(QsReader, EnclosureFixNestsEveryChildInItsParent) {
 
 // The leaves keep their decoded spheres: the fix only grows interior nodes.
 TEST(QsReader, LeavesKeepTheirDecodedSpheres) {
+  POINTILLIST_REQUIRE_SHARED_TESTDATA();
   const QsModel m = read_qs(qsplat_file("dragon_vrip_res4.strict.qs"));
   // Leaf radii are parent radius × m/13: never below 1/13 of the root radius to the 9th level,
   // and bounded by the root radius; the bounding box holds every leaf centre.
@@ -207,6 +212,7 @@ TEST(QsReader, LeavesKeepTheirDecodedSpheres) {
 }
 
 TEST(QsReader, RecognizesQsFilesByContent) {
+  POINTILLIST_REQUIRE_SHARED_TESTDATA();
   EXPECT_TRUE(is_qs_file(qsplat_file("dragon_vrip_res4.qs")));
   EXPECT_FALSE(is_qs_file(qsplat_file("dragon_vrip_res4.bbe.ply")));
   EXPECT_FALSE(is_qs_file(qsplat_file("no_such_file.qs")));
@@ -263,6 +269,7 @@ Bytes two_leaf_file() {
 }
 
 TEST(QsReader, DecodesAHandMadeFile) {
+  POINTILLIST_REQUIRE_SHARED_TESTDATA();
   pointillist::testing::TempDir dir;
   const std::string path = dir.file("two.qs");
   write_bytes(path, two_leaf_file());
@@ -292,6 +299,7 @@ TEST(QsReader, DecodesAHandMadeFile) {
 
 // Two concatenated files are one model (spec §2): an added root above both fragment roots.
 TEST(QsReader, JoinsConcatenatedFiles) {
+  POINTILLIST_REQUIRE_SHARED_TESTDATA();
   pointillist::testing::TempDir dir;
   Bytes both = read_bytes(qsplat_file("dragon_vrip_res4.strict.qs"));
   const Bytes color = read_bytes(qsplat_file("dragon_vrip_res4_color.strict.qs"));
@@ -351,6 +359,7 @@ void expect_error_at(const Bytes& bytes, std::uint64_t byte, const std::string& 
 }
 
 TEST(QsReader, RejectsTruncatedFilesNamingTheOffset) {
+  POINTILLIST_REQUIRE_SHARED_TESTDATA();
   const Bytes file = read_bytes(qsplat_file("dragon_vrip_res4.strict.qs"));
   expect_error_at({}, 0, "empty");
   // Inside the comment header, inside the comment, inside the tree header, inside the tree.
@@ -367,6 +376,7 @@ TEST(QsReader, RejectsTruncatedFilesNamingTheOffset) {
 }
 
 TEST(QsReader, RejectsBadMagicAndVersion) {
+  POINTILLIST_REQUIRE_SHARED_TESTDATA();
   Bytes file = read_bytes(qsplat_file("dragon_vrip_res4.strict.qs"));
   Bytes bad = file;
   bad[0] = 'X';
@@ -380,6 +390,7 @@ TEST(QsReader, RejectsBadMagicAndVersion) {
 }
 
 TEST(QsReader, RejectsFragmentLengthPastTheEnd) {
+  POINTILLIST_REQUIRE_SHARED_TESTDATA();
   Bytes file = read_bytes(qsplat_file("dragon_vrip_res4.strict.qs"));
   put_be32(file, 52, 34548);
   expect_error_at(file, 52, "past the end of the file");
@@ -390,6 +401,7 @@ TEST(QsReader, RejectsFragmentLengthPastTheEnd) {
 }
 
 TEST(QsReader, RejectsATreeThatDoesNotFitItsFragment) {
+  POINTILLIST_REQUIRE_SHARED_TESTDATA();
   // Cut the last record off both the file and the fragment length: the last group no longer fits.
   Bytes file = read_bytes(qsplat_file("dragon_vrip_res4.strict.qs"));
   file.resize(file.size() - 4);
@@ -401,6 +413,7 @@ TEST(QsReader, RejectsATreeThatDoesNotFitItsFragment) {
 }
 
 TEST(QsReader, RejectsChildCountsPastTheEnd) {
+  POINTILLIST_REQUIRE_SHARED_TESTDATA();
   // The second leaf claims two children, but the fragment ends after the root group.
   Bytes b = two_leaf_file();
   b[49] = std::uint8_t(b[49] | 1);  // second record (byte 48): child-count code 1
@@ -408,6 +421,7 @@ TEST(QsReader, RejectsChildCountsPastTheEnd) {
 }
 
 TEST(QsReader, RejectsCorruptRecordsAndHeaders) {
+  POINTILLIST_REQUIRE_SHARED_TESTDATA();
   Bytes b = two_leaf_file();
   b[44] = std::uint8_t(7621 >> 5);  // sphere code 7621 (byte 44-45)
   b[45] = std::uint8_t((7621 & 31) << 3);
@@ -450,6 +464,7 @@ TEST(QsReader, RejectsCorruptRecordsAndHeaders) {
 }
 
 TEST(QsReader, RejectsAGroupWhereThePointerDoesNotLead) {
+  POINTILLIST_REQUIRE_SHARED_TESTDATA();
   // Root: first leaf has two leaf children (group at byte 52); the pointer says byte 56.
   QsBuilder q;
   q.header(60, 3, 0, {0, 0, 0}, 1.0f, 2);
@@ -480,6 +495,7 @@ TEST(QsReader, RejectsAGroupWhereThePointerDoesNotLead) {
 // Random damage: read_qs either decodes or throws FormatError, never crashes or hangs (run
 // under ASan/UBSan to check the "never reads out of bounds" part).
 TEST(QsReader, SurvivesRandomCorruption) {
+  POINTILLIST_REQUIRE_SHARED_TESTDATA();
   const Bytes file = read_bytes(qsplat_file("dragon_vrip_res4_color.strict.qs"));
   pointillist::testing::TempDir dir;
   const std::string path = dir.file("fuzz.qs");
@@ -537,6 +553,7 @@ MaskComparison compare_masks(const Frame& a, const Frame& b) {
 // silhouettes must agree to IoU >= 0.97 (measured 0.978-0.984), which checks positions, normals
 // (backface culling) and the tree structure of the decoded model.
 TEST(QsReader, RendersLikeOurOwnHierarchyOfTheSameMesh) {
+  POINTILLIST_REQUIRE_SHARED_TESTDATA();
   ThreadPool pool(2);
   const QsModel qs = read_qs(qsplat_file("dragon_vrip_res4.strict.qs"));
   const PointSet input = read_ply(qsplat_file("dragon_vrip_res4.bbe.ply"));

@@ -53,6 +53,7 @@ std::string qsplat_file(const std::string& name) {
 }
 
 TEST(QsWriter, ReproducesQsplatMakeByteForByte) {
+  POINTILLIST_REQUIRE_SHARED_TESTDATA();
   pointillist::testing::TempDir dir;
   const PointSet mesh = read_ply(qsplat_file("dragon_vrip_res4.bbe.ply"));
   const std::string out = dir.file("dragon.qs");
@@ -68,6 +69,7 @@ TEST(QsWriter, ReproducesQsplatMakeByteForByte) {
 }
 
 TEST(QsWriter, ReproducesQsplatMakeWithColorsByteForByte) {
+  POINTILLIST_REQUIRE_SHARED_TESTDATA();
   pointillist::testing::TempDir dir;
   const PointSet mesh = read_ply(qsplat_file("dragon_vrip_res4_color.bbe.ply"));
   ASSERT_TRUE(mesh.has_colors());
@@ -81,6 +83,7 @@ TEST(QsWriter, ReproducesQsplatMakeWithColorsByteForByte) {
 // The original makefile's build (-ffast-math) rounds the root sphere differently: only the 3
 // header bytes of its low-order bits differ (README of the test data).
 TEST(QsWriter, DiffersFromTheFastMathBuildOnlyInTheRootSphere) {
+  POINTILLIST_REQUIRE_SHARED_TESTDATA();
   pointillist::testing::TempDir dir;
   const std::string out = dir.file("dragon.qs");
   write_qs(out, read_ply(qsplat_file("dragon_vrip_res4.bbe.ply")));
@@ -146,6 +149,7 @@ double angle_deg(Vec3f a, Vec3f b) {
 }
 
 TEST(QsWriter, RoundTripKeepsEveryVertexNormalAndColor) {
+  POINTILLIST_REQUIRE_SHARED_TESTDATA();
   pointillist::testing::TempDir dir;
   const PointSet mesh = bumpy_grid();
   const std::string path = dir.file("grid.qs");
@@ -182,6 +186,7 @@ TEST(QsWriter, RoundTripKeepsEveryVertexNormalAndColor) {
 }
 
 TEST(QsWriter, WritesFourByteRecordsWithoutColors) {
+  POINTILLIST_REQUIRE_SHARED_TESTDATA();
   pointillist::testing::TempDir dir;
   const PointSet mesh = bumpy_grid();
   const std::string with = dir.file("with.qs"), without = dir.file("without.qs");
@@ -207,6 +212,7 @@ TEST(QsWriter, WritesFourByteRecordsWithoutColors) {
 }
 
 TEST(QsWriter, DitherSpreadsTheNormalsOfAFlatPlane) {
+  POINTILLIST_REQUIRE_SHARED_TESTDATA();
   pointillist::testing::TempDir dir;
   PointSet plane = bumpy_grid();
   for (Vec3f& p : plane.positions) p.z = 0;
@@ -229,6 +235,7 @@ TEST(QsWriter, DitherSpreadsTheNormalsOfAFlatPlane) {
 }
 
 TEST(QsWriter, WritesPointSetsWithTheirOwnNormalsAndRadii) {
+  POINTILLIST_REQUIRE_SHARED_TESTDATA();
   pointillist::testing::TempDir dir;
   PointSet cloud;
   for (int i = 0; i < 50; ++i) {
@@ -263,6 +270,7 @@ TEST(QsWriter, WritesPointSetsWithTheirOwnNormalsAndRadii) {
 }
 
 TEST(QsWriter, RejectsUnusableInputAndLeavesExistingFilesAlone) {
+  POINTILLIST_REQUIRE_SHARED_TESTDATA();
   pointillist::testing::TempDir dir;
   const std::string path = dir.file("keep.qs");
   write_bytes(path, {1, 2, 3});
@@ -303,6 +311,7 @@ TEST(QsWriter, RejectsUnusableInputAndLeavesExistingFilesAlone) {
 // The full Stanford dragon (when fetched): the structure spec §13 measured on QSplat 1.0's
 // output for the same mesh.
 TEST(QsWriter, MatchesQsplatMakeStatisticsOnTheFullDragon) {
+  POINTILLIST_REQUIRE_SHARED_TESTDATA();
   const auto path = pointillist::testing::cached_model("dragon_vrip.ply.gz");
   if (path.empty()) GTEST_SKIP() << "dragon not fetched (run scripts/fetch-models.sh)";
   pointillist::testing::TempDir dir;

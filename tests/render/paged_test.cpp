@@ -232,3 +232,25 @@ TEST(PagedRender, BackgroundLoaderReachesTheFullImageAndHoldsTheCap) {
     EXPECT_LE(capped.stats().resident_bytes_peak, total / 8) << "azimuth " << az;
   }
 }
+
+TEST(PagedRender, ImageDoesNotDependOnTheThreadCount) {
+  // Partly resident (two load rounds), so stand-ins and refined subtrees mix.
+  const SphereTree& tree = demo_tree();
+  const auto source = paginate(tree.view(), 4096, 4);
+  std::vector<Rgb8> images[2];
+  std::uint64_t requested[2] = {};
+  for (unsigned threads : {1u, 2u}) {
+    ThreadPool pool(threads);
+    PagedRenderer paged(*source, UINT64_MAX, pool);
+    Frame frame;
+    for (int i = 0; i < 3; ++i) {
+      paged.render(view(310), RenderSettings{}, pool, frame);
+      if (i < 2) paged.load_requested(pool, 6);
+    }
+    images[threads - 1] = frame.color;
+    requested[threads - 1] = paged.stats().pages_requested;
+  }
+  EXPECT_GT(requested[0], 0u);
+  EXPECT_EQ(requested[0], requested[1]);
+  EXPECT_EQ(images[0], images[1]);
+}

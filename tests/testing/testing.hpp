@@ -10,6 +10,14 @@ namespace pointillist::testing {
 std::filesystem::path test_data_dir();
 // ../shared/testdata beside the project (QSplat reference files and friends).
 std::filesystem::path shared_testdata_dir();
+// Skips the current test, saying why, when ../shared/testdata is not beside the project (a
+// checkout on its own): the QSplat reference files live there, not in the repository.
+#define POINTILLIST_REQUIRE_SHARED_TESTDATA()                                                  \
+  if (!std::filesystem::is_directory(::pointillist::testing::shared_testdata_dir() / "qsplat")) \
+  GTEST_SKIP() << "QSplat reference files not found in "                                   \
+               << ::pointillist::testing::shared_testdata_dir()                           \
+               << " (../shared/testdata beside the project)"
+
 // The model cache filled by scripts/fetch-models.sh: $POINTILLIST_MODELS, else
 // $XDG_CACHE_HOME/pointillist/models, else ~/.cache/pointillist/models.
 std::filesystem::path model_cache_dir();

@@ -87,7 +87,7 @@ class PagedRenderer {
   // The QSplat traversal of render() (same tests, threshold and culling, same splats where the
   // pages are resident) over the resident pages. A node whose children are in a page that is
   // not resident is drawn as a splat whatever its size, and the page is requested. Selection
-  // is single-threaded; rasterization uses the pool.
+  // and rasterization run on the pool; the image does not depend on the thread count.
   void render(const Camera& camera, const RenderSettings& settings, ThreadPool& pool,
               Frame& frame);
 
@@ -142,7 +142,13 @@ class PagedRenderer {
   std::vector<std::uint64_t> last_used_;               // frame number of the last use
   std::vector<Request> requests_;
   std::vector<std::uint8_t> requested_;                // per page: already in requests_
-  std::vector<SphereNode> emitted_;                    // the nodes of the last frame's splats
+  // What each selection task produced in the last frame.
+  struct TaskOut {
+    std::vector<SphereNode> emitted;   // the nodes of its splats, in its chunk's order
+    std::vector<Request> requests;     // pages it wanted, in traversal order
+    std::vector<std::uint32_t> touched;  // resident pages it used below the top
+  };
+  std::vector<TaskOut> task_out_;
   std::vector<std::uint8_t> in_flight_;                // per page: handed to the loader
   std::size_t in_flight_count_ = 0;
   std::uint64_t frame_number_ = 0;
