@@ -222,8 +222,9 @@ void PagedRenderer::render(const Camera& camera, const RenderSettings& settings,
     std::vector<Counters> task_counters(items.size());
     pool.run(items.size(), [&](std::size_t t) {
       TaskOut& out = task_out_[t];
-      Counters& task_count = task_counters[t];
+      Counters task_count;  // local: the hot loop keeps it in registers
       out.emitted.clear();
+      out.stand_ins.clear();
       out.requests.clear();
       out.touched.clear();
       SplatChunk& chunk = stream.chunks[t];
@@ -234,10 +235,15 @@ void PagedRenderer::render(const Camera& camera, const RenderSettings& settings,
         const auto emit = [&](const SphereNode& n, Vec3f d, float z, bool stand_in) {
           emitter.emit(n, static_cast<std::uint32_t>(out.emitted.size()), d, z, v, task_count,
                        !stand_in);
-          out.emitted.push_back(n);
           // A stand-in is drawn even when its mean normal faces away (its subtree may hold
           // surfaces facing the eye); it is then lit from the front, not drawn black.
-          if (stand_in && dot(d, n.normal) > 0) out.emitted.back().normal = -n.normal;
+          if (stand_in && dot(d, n.normal) > 0) {
+            out.stand_ins.push_back(n);
+            out.stand_ins.back().normal = -n.normal;
+            out.emitted.push_back(&out.stand_ins.back());
+          } else {
+            out.emitted.push_back(&n);
+          }
         };
         std::vector<PagedPending> stack{items[t]};
         while (!stack.empty()) {
@@ -258,12 +264,24 @@ void PagedRenderer::render(const Camera& camera, const RenderSettings& settings,
             continue;
           }
           if (c.page != p.page) out.touched.push_back(c.page);
-          for (std::uint32_t k = n.child_count; k-- > 0;) {
-            stack.push_back({c.page, c.first + k, tests});
+          // Leading leaf children are visited right here (most nodes near the bottom have only
+          // leaves), in order; the rest go on the stack last to first.
+          const SphereNode* kids = pages_[c.page]->nodes.data() + c.first;
+          std::uint32_t k = 0;
+          for (; k < n.child_count && kids[k].child_count == 0; ++k) {
+            std::uint8_t leaf_tests = tests;
+            if (visit(kids[k], v, leaf_tests, task_count, d, z) == Decision::Draw) {
+              emit(kids[k], d, z, false);
+            }
+          }
+          for (std::uint32_t j = n.child_count; j-- > k;) {
+            stack.push_back({c.page, c.first + j, tests});
           }
         }
       }
-      finish_chunk(out.emitted, v, with_colors, chunk);
+      finish_chunk([&](std::uint32_t i) -> const SphereNode& { return *out.emitted[i]; }, v,
+                   with_colors, chunk);
+      task_counters[t] = task_count;
     });
     for (std::size_t t = 0; t < items.size(); ++t) {
       const TaskOut& out = task_out_[t];

@@ -157,7 +157,8 @@ void select_splats(const SphereTreeView& tree, const CameraFrame& camera,
     std::vector<Pending> stack;
     stack.reserve(64);
     walk_subtree(tree.nodes, items[t], v, with_colors, stack, chunk, counters[t]);
-    finish_chunk(tree.nodes, v, with_colors, chunk);
+    finish_chunk([&](std::uint32_t i) -> const SphereNode& { return tree.nodes[i]; }, v,
+                 with_colors, chunk);
   });
 
   stats.nodes_visited = top.visited;

@@ -156,7 +156,9 @@ class Emitter {
 // Copies normals and colors of the chunk's nodes and shades them, four at a time (a second pass
 // keeps the traversal loop small; the nodes are still in cache). A last partial group repeats
 // its last splat in the unused lanes.
-inline void finish_chunk(std::span<const SphereNode> nodes, const ViewConstants& v, bool with_colors,
+// `node_at(i)` gives the node of the chunk's node index i (a const SphereNode&).
+template <class NodeAt>
+void finish_chunk(const NodeAt& node_at, const ViewConstants& v, bool with_colors,
                   SplatChunk& out) {
   const Shader& shader = *v.shader;
   const std::size_t count = out.count;
@@ -164,7 +166,7 @@ inline void finish_chunk(std::span<const SphereNode> nodes, const ViewConstants&
     const std::size_t lanes = std::min<std::size_t>(render_detail::kLanes, count - i);
     const SphereNode* n[render_detail::kLanes];
     for (std::size_t k = 0; k < render_detail::kLanes; ++k) {
-      n[k] = &nodes[out.node[i + std::min(k, lanes - 1)]];
+      n[k] = &node_at(out.node[i + std::min(k, lanes - 1)]);
     }
     for (std::size_t k = 0; k < lanes; ++k) {
       out.normal[i + k] = n[k]->normal;

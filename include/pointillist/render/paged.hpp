@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <deque>
 #include <memory>
 #include <vector>
 
@@ -144,7 +145,8 @@ class PagedRenderer {
   std::vector<std::uint8_t> requested_;                // per page: already in requests_
   // What each selection task produced in the last frame.
   struct TaskOut {
-    std::vector<SphereNode> emitted;   // the nodes of its splats, in its chunk's order
+    std::vector<const SphereNode*> emitted;  // the nodes of its splats, in its chunk's order
+    std::deque<SphereNode> stand_ins;        // copies of stand-ins lit from the front
     std::vector<Request> requests;     // pages it wanted, in traversal order
     std::vector<std::uint32_t> touched;  // resident pages it used below the top
   };
