@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include <array>
 #include <bit>
 #include <cmath>
@@ -578,6 +580,18 @@ TEST(QsReader, RendersLikeOurOwnHierarchyOfTheSameMesh) {
     EXPECT_GE(equal_size.iou, 0.97) << "azimuth " << az;
     EXPECT_GE(raw.iou, 0.94) << "azimuth " << az;
     EXPECT_GE(raw.b_covered_by_a, 0.995) << "azimuth " << az;
+    // With ellipses (splats turned with the surface, so a larger radius widens the silhouette
+    // less) the raw renders agree more closely: measured 0.965-0.971 against 0.953-0.964.
+    RenderSettings ellipses;
+    ellipses.shape = SplatShape::Ellipse;
+    Frame qe, oe;
+    render(qs.tree.view(), cam, ellipses, pool, qe);
+    render(ours.view(), cam, ellipses, pool, oe);
+    const MaskComparison raw_ellipses = compare_masks(qe, oe);
+    std::printf("azimuth %.0f: circles raw IoU %.4f, equal size %.4f; ellipses raw %.4f\n", az,
+                raw.iou, equal_size.iou, raw_ellipses.iou);
+    EXPECT_GE(raw_ellipses.iou, 0.96) << "azimuth " << az;
+    EXPECT_GE(raw_ellipses.iou, raw.iou) << "azimuth " << az;
   }
 }
 
