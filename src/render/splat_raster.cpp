@@ -7,6 +7,10 @@
 #include "pointillist/render/splat_raster.hpp"
 
 #include <algorithm>
+#include <cstdint>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 #include <atomic>
 #include <bit>
 #include <cassert>
@@ -359,11 +363,30 @@ void unpack_band(const Target& t, std::span<Rgb8> out) {
   auto* bytes = reinterpret_cast<unsigned char*>(dst);
   std::size_t p = 0;
   if constexpr (std::endian::native == std::endian::little) {
+#if defined(__SSE2__)
+    // Streaming stores: the output is written once per frame and not read back here, so
+    // bypassing the cache saves reading each line before overwriting it. Words must be 4-byte
+    // aligned: go pixel by pixel until the output is.
+    for (; p < n && (reinterpret_cast<std::uintptr_t>(bytes + 3 * p) & 3) != 0; ++p) {
+      const std::uint32_t c = in[p];
+      dst[p] = Rgb8{static_cast<std::uint8_t>(c), static_cast<std::uint8_t>(c >> 8),
+                    static_cast<std::uint8_t>(c >> 16)};
+    }
+    for (; p + 4 <= n; p += 4) {
+      const std::uint32_t a = in[p], b = in[p + 1], c = in[p + 2], d = in[p + 3];
+      int* out = reinterpret_cast<int*>(bytes + 3 * p);
+      _mm_stream_si32(out, static_cast<int>(a | b << 24));
+      _mm_stream_si32(out + 1, static_cast<int>(b >> 8 | c << 16));
+      _mm_stream_si32(out + 2, static_cast<int>(c >> 16 | d << 8));
+    }
+    _mm_sfence();
+#else
     for (; p + 4 <= n; p += 4) {
       const std::uint32_t a = in[p], b = in[p + 1], c = in[p + 2], d = in[p + 3];
       const std::uint32_t words[3] = {a | b << 24, b >> 8 | c << 16, c >> 16 | d << 8};
       std::memcpy(bytes + 3 * p, words, sizeof words);
     }
+#endif
   }
   for (; p < n; ++p) {
     const std::uint32_t c = in[p];
