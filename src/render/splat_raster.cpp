@@ -374,10 +374,10 @@ void unpack_band(const Target& t, std::span<Rgb8> out) {
     }
     for (; p + 4 <= n; p += 4) {
       const std::uint32_t a = in[p], b = in[p + 1], c = in[p + 2], d = in[p + 3];
-      int* out = reinterpret_cast<int*>(bytes + 3 * p);
-      _mm_stream_si32(out, static_cast<int>(a | b << 24));
-      _mm_stream_si32(out + 1, static_cast<int>(b >> 8 | c << 16));
-      _mm_stream_si32(out + 2, static_cast<int>(c >> 16 | d << 8));
+      int* words = reinterpret_cast<int*>(bytes + 3 * p);
+      _mm_stream_si32(words, static_cast<int>(a | b << 24));
+      _mm_stream_si32(words + 1, static_cast<int>(b >> 8 | c << 16));
+      _mm_stream_si32(words + 2, static_cast<int>(c >> 16 | d << 8));
     }
     _mm_sfence();
 #else
