@@ -52,7 +52,8 @@ void orient_normals_ordered(const OrderedCloud& cloud, std::uint32_t graph_k,
                             std::span<Vec3f> normals, ThreadPool& pool, Progress& progress);
 
 // Mean distance to the first `neighbours` entries of each row, capped at outlier_ratio × the
-// median of the same for those entries (0 = no cap), times `factor`, Morton order.
+// median of the same over the row's first kOutlierNeighbours entries (all of them when the row
+// is shorter; 0 = no cap), times `factor`, Morton order.
 std::vector<float> cloud_radii_ordered(const OrderedCloud& cloud, std::uint32_t neighbours,
                                        float factor, float outlier_ratio, ThreadPool& pool,
                                        Progress& progress);

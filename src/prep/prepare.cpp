@@ -135,7 +135,11 @@ void prepare_splats(PointSet& points, ThreadPool& pool, Progress& progress,
   prep_detail::OrderedCloud cloud;
   if (want_pca || want_cloud_radii) {
     const std::uint32_t k =
-        std::max(want_pca ? options.k - 1 : 0u, want_cloud_radii ? kRadiusNeighbours : 0u);
+        std::max(want_pca ? options.k - 1 : 0u,
+                 want_cloud_radii
+                     ? (options.outlier_ratio > 0 ? std::max(kRadiusNeighbours, kOutlierNeighbours)
+                                                  : kRadiusNeighbours)
+                     : 0u);
     cloud = prep_detail::order_cloud(points.positions, k, pool, progress);
   }
 

@@ -90,7 +90,8 @@ std::vector<float> cloud_radii_ordered(const OrderedCloud& cloud, std::uint32_t 
     for (std::size_t j = begin; j < end; ++j) {
       float r = raw[j];
       if (outlier_ratio > 0.0f) {
-        const std::size_t m = std::min<std::size_t>(used, theirs.size());
+        const std::size_t m =
+            std::min<std::size_t>({cloud.k, kOutlierNeighbours, theirs.size()});
         const auto row = cloud.row(j);
         for (std::size_t q = 0; q < m; ++q) theirs[q] = raw[row[q]];
         std::nth_element(theirs.begin(), theirs.begin() + m / 2, theirs.begin() + m);
@@ -114,7 +115,11 @@ std::vector<float> cloud_radii(std::span<const Vec3f> positions, ThreadPool& poo
         "nearest neighbour (5 is typical)");
   }
   const prep_detail::OrderedCloud cloud =
-      prep_detail::order_cloud(positions, options.neighbours, pool, progress);
+      prep_detail::order_cloud(
+          positions,
+          options.outlier_ratio > 0 ? std::max(options.neighbours, kOutlierNeighbours)
+                                    : options.neighbours,
+          pool, progress);
   const std::vector<float> radii = prep_detail::cloud_radii_ordered(
       cloud, options.neighbours, options.coverage * options.scale, options.outlier_ratio, pool,
       progress);

@@ -38,6 +38,9 @@ inline constexpr float kDefaultCloudCoverage = 2.5f;
 // 4 leaves randomly (Poisson) sampled surfaces covered as measured above (the coverage tests
 // run with the cap on); 3 already caps some points of a random sample when few neighbours are used.
 inline constexpr float kDefaultOutlierRatio = 4.0f;
+// The outlier cap compares a point with this many nearest neighbours: enough to reach past a
+// small cluster of stray points to the surface they float beside.
+inline constexpr std::uint32_t kOutlierNeighbours = 15;
 
 struct CloudRadiusOptions {
   std::uint32_t neighbours = 5;  // the mean distance to this many nearest neighbours is measured
@@ -48,15 +51,16 @@ struct CloudRadiusOptions {
   float scale = 1.0f;  // the user's --radius-scale
   // Isolated points (stray returns, a leaf far from the rest) would get discs as large as the
   // gap to the main cloud. Each point's mean distance is capped at outlier_ratio × the median
-  // of its neighbours' mean distances before the coverage factor is applied. A point in a
+  // of the mean distances of its kOutlierNeighbours nearest neighbours (so a small cluster of
+  // strays is compared with the surface around it) before the coverage factor is applied. A point in a
   // uniformly sparse region is not affected (its neighbours are as sparse); only a point much
   // sparser than its own neighbours is. 0 = no cap.
   float outlier_ratio = kDefaultOutlierRatio;
 };
 
 // Radius of each point of a cloud (world units): the mean distance to its `neighbours` nearest
-// other points (capped at outlier_ratio × the median of the same for those neighbours) ×
-// coverage × scale. Points whose neighbours all coincide with them get 0.
+// other points (capped at outlier_ratio × the median of the same for its kOutlierNeighbours
+// nearest) × coverage × scale. Points whose neighbours all coincide with them get 0.
 // Throws OptionError when neighbours == 0, Error when a position is not finite. Progress phases
 // "neighbours", "radii". Deterministic for any thread count.
 std::vector<float> cloud_radii(std::span<const Vec3f> positions, ThreadPool& pool,
