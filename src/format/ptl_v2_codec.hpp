@@ -46,4 +46,13 @@ std::uint16_t encode_rgb565_nearest(Rgb8 c);
 // Angle between two vectors (radians, double; 0 for a zero vector).
 double angle_between(Vec3f a, Vec3f b);
 
+// A leaf's drawn radius: its decoded sphere's radius trimmed by t/8 (t in 0..3, stored in the
+// leaf's cone bits, which leaves do not otherwise use). The writer picks the largest t whose
+// trimmed sphere, around the decoded centre, still holds the leaf's true sphere; the trimmed
+// sphere is concentric with the decoded one, so it stays inside the decoded parent. Computed the
+// same way (float) by the writer and the reader.
+inline float trimmed_leaf_radius(float decoded_radius, std::uint32_t t) {
+  return decoded_radius * (1.0f - 0.125f * static_cast<float>(t));
+}
+
 }  // namespace pointillist::ptl2

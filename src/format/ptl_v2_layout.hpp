@@ -64,7 +64,9 @@ constexpr unsigned kSphereShift = 0, kSphereBits = 13;   // code 0..7620 relativ
 constexpr unsigned kChildShift = 13, kChildBits = 2;     // 0 leaf, 1..3 = 2..4 children
 constexpr unsigned kReservedShift = 15;                  // 1 bit, 0
 constexpr unsigned kNormalShift = 16, kNormalBits = 14;  // code 0..16223
-constexpr unsigned kConeShift = 30, kConeBits = 2;       // cone code (interior nodes; leaves 0)
+constexpr unsigned kConeShift = 30, kConeBits = 2;       // cone code (interior nodes);
+                                                         // leaves: radius trim t (0..3)
+constexpr std::uint32_t kMaxLeafTrim = 3;
 constexpr unsigned kColorShift = 32, kColorBits = 16;    // RGB 565, present with colours
 
 constexpr std::uint64_t field(std::uint64_t record, unsigned shift, unsigned bits) {

@@ -305,9 +305,10 @@ void PtlV2File::decode_page(std::uint32_t page, PtlV2Page& out) const {
         const Sphere s = qs_detail::decode_sphere(ps, code);
         SphereNode& n = out.nodes[i];
         n.center = s.center;
-        n.radius = s.radius;
-        n.normal = normals[normal];
         n.child_count = static_cast<std::uint8_t>(children_code == 0 ? 0 : children_code + 1);
+        // Leaves keep their radius trim in the cone bits (see trimmed_leaf_radius).
+        n.radius = n.child_count == 0 ? trimmed_leaf_radius(s.radius, cone) : s.radius;
+        n.normal = normals[normal];
         n.cone_sin = n.child_count == 0 ? 0.0f : decoded_cone_sin(cone);
         n.first_child = 0;
         n.color =

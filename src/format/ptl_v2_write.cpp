@@ -252,12 +252,22 @@ PtlV2WriteReport write_ptl_v2(const std::string& path, const SphereTree& tree,
     if (!exact) code = encode_enclosing_sphere(p, target[i], &exact);
     decoded[i] = qs_detail::decode_sphere(p, code);
     if (i > 0 && code == qs_detail::kSphereCodeCount - 1) ++report.parent_fallbacks;
-    if (nodes[i].child_count == 0 && nodes[i].radius > 0) {
-      leaf_ratio_sum += double(decoded[i].radius) / nodes[i].radius;
-      ++leaf_ratio_count;
-    }
     const std::uint64_t children = nodes[i].child_count == 0 ? 0 : nodes[i].child_count - 1u;
     record[i] = std::uint64_t{code} << kSphereShift | children << kChildShift;
+    if (nodes[i].child_count == 0) {
+      // Leaves are drawn at their decoded radius: trim it as far as the true sphere allows.
+      std::uint32_t trim = 0;
+      while (trim < kMaxLeafTrim &&
+             encloses({decoded[i].center, trimmed_leaf_radius(decoded[i].radius, trim + 1)},
+                      target[i])) {
+        ++trim;
+      }
+      record[i] |= std::uint64_t{trim} << kConeShift;
+      if (nodes[i].radius > 0) {
+        leaf_ratio_sum += double(trimmed_leaf_radius(decoded[i].radius, trim)) / nodes[i].radius;
+        ++leaf_ratio_count;
+      }
+    }
   }
   report.mean_leaf_radius_ratio = leaf_ratio_count ? leaf_ratio_sum / double(leaf_ratio_count) : 1;
 

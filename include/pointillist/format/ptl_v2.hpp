@@ -56,8 +56,9 @@ struct PtlV2WriteReport {
 // smallest decoded sphere that holds the written sphere and lies inside the decoded parent
 // (interior nodes first try for 15% spare room, so their children fit tightly); the header keeps
 // the sphere the root is decoded against (float32), bounds and view sphere. Single-threaded:
-// about 200 ms for the 437k-leaf dragon. Leaves come out 1.24-1.36 times their written radius
-// on average (the grid is 1/13 of the parent). A tree whose spheres do not nest is handled
+// about 200 ms for the 437k-leaf dragon. Leaves come out 1.2-1.28 times their written radius
+// on average (the grid is 1/13 of the parent; a 2-bit trim in the leaf's cone bits recovers
+// part of a step). A tree whose spheres do not nest is handled
 // (spheres_enlarged). Throws Error for an empty tree, more than 2^32 - 2 nodes, a malformed
 // structure (children not breadth-first, child counts other than 0, 2, 3, 4) or non-finite
 // values, naming the node; OptionError for page_bytes < 1024; IoError naming the file.
