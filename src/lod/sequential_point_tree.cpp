@@ -23,12 +23,12 @@
 #include <limits>
 #include <string>
 
+#include "lod/splat_input.hpp"
 #include "pointillist/core/error.hpp"
 
 namespace pointillist {
 namespace {
 
-constexpr std::size_t kMaxPoints = std::size_t{1} << 31;
 constexpr std::uint32_t kMaxChunkLevel = 10;
 constexpr int kLevels = 21;  // octree depth of the finest Morton cells
 constexpr std::uint8_t kLeafLevel = kLevels;
@@ -62,35 +62,10 @@ struct BuildNode {
 
 // ---- Input checks --------------------------------------------------------------------------
 
-std::string vec_text(Vec3f v) {
-  char buf[96];
-  std::snprintf(buf, sizeof buf, "(%g, %g, %g)", v.x, v.y, v.z);
-  return buf;
-}
 
 void check_input(const PointSet& points, const SequentialPointTreeOptions& options) {
   const std::string what = "cannot build a sequential point tree";
-  const std::size_t n = points.size();
-  if (n == 0) throw Error(what + " from an empty point set; the input has no points");
-  if (n > kMaxPoints) {
-    throw Error(what + " over " + std::to_string(n) +
-                " points: the limit is 2^31 (2147483648); split the input into chunks");
-  }
-  if (!points.has_normals()) {
-    throw Error(what + ": the points have no normals; estimate them first");
-  }
-  if (!points.has_radii()) {
-    throw Error(what + ": the points have no splat radii; compute them first");
-  }
-  const auto check_size = [&](std::size_t size, const char* attribute) {
-    if (size != n) {
-      throw Error(what + ": " + std::to_string(size) + " " + attribute + " for " +
-                  std::to_string(n) + " points; expected one per point");
-    }
-  };
-  check_size(points.normals.size(), "normals");
-  check_size(points.radii.size(), "radii");
-  if (points.has_colors()) check_size(points.colors.size(), "colors");
+  lod_detail::check_splat_attributes(points, what);
   if (options.chunk_level > kMaxChunkLevel) {
     throw OptionError(what + ": chunk_level " + std::to_string(options.chunk_level) +
                       " is out of range; use 0 to " + std::to_string(kMaxChunkLevel));
@@ -101,57 +76,7 @@ void check_input(const PointSet& points, const SequentialPointTreeOptions& optio
   }
 }
 
-// Checks every point is finite and bounds the positions. Inner loops never throw: each chunk
-// notes its first bad point and the lowest one is reported.
-Aabb check_points_and_bound(const PointSet& points, ThreadPool& pool) {
-  const std::size_t n = points.size();
-  const std::size_t chunks = (n + kPointGrain - 1) / kPointGrain;
-  std::vector<Aabb> boxes(chunks);
-  std::vector<std::size_t> first_bad(chunks, n);
-  parallel_for(pool, n, kPointGrain, [&](std::size_t begin, std::size_t end) {
-    const std::size_t c = begin / kPointGrain;
-    Aabb box;
-    for (std::size_t i = begin; i < end; ++i) {
-      const bool ok = is_finite(points.positions[i]) && is_finite(points.normals[i]) &&
-                      std::isfinite(points.radii[i]) && points.radii[i] >= 0;
-      if (!ok && first_bad[c] == n) first_bad[c] = i;
-      box.extend(points.positions[i]);
-    }
-    boxes[c] = box;
-  });
-  Aabb bounds;
-  for (std::size_t c = 0; c < chunks; ++c) {
-    if (const std::size_t i = first_bad[c]; i != n) {
-      const std::string where =
-          "cannot build a sequential point tree: point " + std::to_string(i) + ": ";
-      if (!is_finite(points.positions[i])) {
-        throw Error(where + "position " + vec_text(points.positions[i]) +
-                    " is not finite; remove or repair the point");
-      }
-      if (!is_finite(points.normals[i])) {
-        throw Error(where + "normal " + vec_text(points.normals[i]) +
-                    " is not finite; re-estimate the normals");
-      }
-      throw Error(where + "splat radius " + std::to_string(points.radii[i]) +
-                  " is not a finite non-negative number; recompute the radii");
-    }
-    bounds.extend(boxes[c]);
-  }
-  return bounds;
-}
 
-float max_distance(const std::vector<Vec3f>& positions, Vec3f center, ThreadPool& pool) {
-  const std::size_t chunks = (positions.size() + kPointGrain - 1) / kPointGrain;
-  std::vector<float> d2(chunks, 0.0f);
-  parallel_for(pool, positions.size(), kPointGrain, [&](std::size_t begin, std::size_t end) {
-    float m = 0;
-    for (std::size_t i = begin; i < end; ++i) {
-      m = std::max(m, length_squared(positions[i] - center));
-    }
-    d2[begin / kPointGrain] = m;
-  });
-  return std::sqrt(*std::max_element(d2.begin(), d2.end()));
-}
 
 // ---- Pass 1: Morton order ------------------------------------------------------------------
 
@@ -645,9 +570,10 @@ SequentialPointTree build_sequential_point_tree(const PointSet& points, ThreadPo
   SequentialPointTree tree;
   tree.has_colors = points.has_colors();
   tree.leaf_count = points.size();
-  tree.bounds = check_points_and_bound(points, pool);
+  tree.bounds =
+      lod_detail::check_points_and_bound(points, pool, "cannot build a sequential point tree");
   tree.view_sphere = {tree.bounds.center(),
-                      max_distance(points.positions, tree.bounds.center(), pool)};
+                      lod_detail::max_distance(points.positions, tree.bounds.center(), pool)};
 
   std::vector<BuildNode> nodes;
   {

@@ -18,6 +18,7 @@
 #include <map>
 #include <string>
 
+#include "lod/splat_input.hpp"
 #include "lod/median_split.hpp"
 #include "lod/node_bounds.hpp"
 #include "pointillist/core/error.hpp"
@@ -27,9 +28,7 @@ namespace {
 
 using lod_detail::split_half;
 
-constexpr std::size_t kMaxPoints = std::size_t{1} << 31;
 constexpr std::size_t kNodeGrain = 8192;   // nodes per task in the per-level passes
-constexpr std::size_t kPointGrain = 65536;  // points per task in the validation pass
 
 // Children of a node over a range of n >= 2 points: each half (first split_half(n) points, then
 // the rest) contributes itself when it holds one point, or when `halves_only`, and its two
@@ -94,91 +93,9 @@ TreeShape tree_shape(std::uint32_t n) {
   return shape;
 }
 
-std::string vec_text(Vec3f v) {
-  char buf[96];
-  std::snprintf(buf, sizeof buf, "(%g, %g, %g)", v.x, v.y, v.z);
-  return buf;
-}
 
-void check_attributes(const PointSet& points) {
-  const std::size_t n = points.size();
-  if (n == 0) {
-    throw Error("cannot build a splat hierarchy from an empty point set; the input has no points");
-  }
-  if (n > kMaxPoints) {
-    throw Error("cannot build a splat hierarchy over " + std::to_string(n) +
-                " points: the limit is 2^31 (2147483648); split the input into chunks");
-  }
-  if (!points.has_normals()) {
-    throw Error("cannot build a splat hierarchy: the points have no normals; estimate them first");
-  }
-  if (!points.has_radii()) {
-    throw Error("cannot build a splat hierarchy: the points have no splat radii; compute them "
-                "first");
-  }
-  const auto check_size = [n](std::size_t size, const char* what) {
-    if (size != n) {
-      throw Error(std::string("cannot build a splat hierarchy: ") + std::to_string(size) + " " +
-                  what + " for " + std::to_string(n) + " points; expected one per point");
-    }
-  };
-  check_size(points.normals.size(), "normals");
-  check_size(points.radii.size(), "radii");
-  if (points.has_colors()) check_size(points.colors.size(), "colors");
-}
 
-// Checks every point is finite and computes the box around the positions. Inner loops never
-// throw: each chunk notes its first bad point and the lowest one is reported.
-Aabb check_points_and_bound(const PointSet& points, ThreadPool& pool) {
-  const std::size_t n = points.size();
-  const std::size_t chunks = (n + kPointGrain - 1) / kPointGrain;
-  std::vector<Aabb> boxes(chunks);
-  std::vector<std::size_t> first_bad(chunks, n);
-  parallel_for(pool, n, kPointGrain, [&](std::size_t begin, std::size_t end) {
-    const std::size_t c = begin / kPointGrain;
-    Aabb box;
-    for (std::size_t i = begin; i < end; ++i) {
-      const Vec3f p = points.positions[i];
-      const bool ok = is_finite(p) && is_finite(points.normals[i]) &&
-                      std::isfinite(points.radii[i]) && points.radii[i] >= 0;
-      if (!ok && first_bad[c] == n) first_bad[c] = i;
-      box.extend(p);
-    }
-    boxes[c] = box;
-  });
-  Aabb bounds;
-  for (std::size_t c = 0; c < chunks; ++c) {
-    if (const std::size_t i = first_bad[c]; i != n) {
-      const std::string where = "cannot build a splat hierarchy: point " + std::to_string(i) + ": ";
-      if (!is_finite(points.positions[i])) {
-        throw Error(where + "position " + vec_text(points.positions[i]) +
-                    " is not finite; remove or repair the point");
-      }
-      if (!is_finite(points.normals[i])) {
-        throw Error(where + "normal " + vec_text(points.normals[i]) +
-                    " is not finite; re-estimate the normals");
-      }
-      throw Error(where + "splat radius " + std::to_string(points.radii[i]) +
-                  " is not a finite non-negative number; recompute the radii");
-    }
-    bounds.extend(boxes[c]);
-  }
-  return bounds;
-}
 
-// Largest distance from `center` to a position (max is exact, so chunking cannot change it).
-float max_distance(const std::vector<Vec3f>& positions, Vec3f center, ThreadPool& pool) {
-  const std::size_t chunks = (positions.size() + kPointGrain - 1) / kPointGrain;
-  std::vector<float> d2(chunks, 0.0f);
-  parallel_for(pool, positions.size(), kPointGrain, [&](std::size_t begin, std::size_t end) {
-    float m = 0;
-    for (std::size_t i = begin; i < end; ++i) m = std::max(m, length_squared(positions[i] - center));
-    d2[begin / kPointGrain] = m;
-  });
-  float m = 0;
-  for (float v : d2) m = std::max(m, v);
-  return std::sqrt(m);
-}
 
 // Pass 2: lays out the breadth-first node array for n points. Fills first_child and child_count
 // of every node, the input range start of every node (`range_begin`, needed for leaves), and
@@ -266,14 +183,15 @@ void compute_attributes(const PointSet& points, std::span<const std::uint32_t> o
 
 SphereTree build_sphere_tree(const PointSet& points, ThreadPool& pool, Progress& progress,
                              const SphereTreeOptions& options) {
-  check_attributes(points);
+  lod_detail::check_splat_attributes(points, "cannot build a splat hierarchy");
   const auto n = static_cast<std::uint32_t>(points.size());
   SphereTree tree;
   tree.has_colors = points.has_colors();
   tree.leaf_count = n;
-  tree.bounds = check_points_and_bound(points, pool);
+  tree.bounds =
+      lod_detail::check_points_and_bound(points, pool, "cannot build a splat hierarchy");
   tree.view_sphere = {tree.bounds.center(),
-                      max_distance(points.positions, tree.bounds.center(), pool)};
+                      lod_detail::max_distance(points.positions, tree.bounds.center(), pool)};
 
   const TreeShape shape = tree_shape(n);
   ProgressPhase phase(progress, "hierarchy", std::uint64_t{n} + shape.node_count);

@@ -199,8 +199,8 @@ TEST(PtlV2, LeavesGetTheSmallestEnclosingCodeInsideTheirParentThenTheLargestTrim
       // sphere, around the decoded centre, still holds the true leaf.
       const SphereNode& leaf = d.nodes[i];
       int t = -1;
-      for (int k = 0; k <= 3; ++k) {
-        if (leaf.radius == best * (1.0f - 0.125f * float(k))) t = k;
+      for (int trim = 0; trim <= 3; ++trim) {
+        if (leaf.radius == best * (1.0f - 0.125f * float(trim))) t = trim;
       }
       ASSERT_GE(t, 0) << "leaf " << i << ": radius " << leaf.radius << " is no trim of " << best;
       const double need = dist(leaf.center, tree.nodes[i].center) + double(tree.nodes[i].radius);
