@@ -14,6 +14,7 @@
 #include <cstring>
 #include <string>
 
+#include "format/printable.hpp"
 #include "format/ptl_header.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/format/ptl.hpp"
@@ -33,17 +34,7 @@ std::string hex(std::uint32_t v) {
 
 // Printable rendering of up to 8 leading bytes, for "found ..." in the magic error.
 std::string leading_bytes(const std::uint8_t* p, std::size_t size) {
-  std::string s = "\"";
-  for (std::size_t i = 0; i < std::min<std::size_t>(size, 8); ++i) {
-    if (p[i] >= 0x20 && p[i] < 0x7f && p[i] != '"' && p[i] != '\\') {
-      s += static_cast<char>(p[i]);
-    } else {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\x%02x", p[i]);
-      s += buf;
-    }
-  }
-  return s + "\"";
+  return format_detail::printable_bytes(p, std::min<std::size_t>(size, 8));
 }
 
 [[noreturn]] void fail_at(const std::string& path, std::uint64_t byte, const std::string& what) {

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "format/printable.hpp"
 #include "format/qs_assemble.hpp"
 #include "format/qs_layout.hpp"
 #include "format/qs_tables.hpp"
@@ -28,20 +29,6 @@ using namespace qs_detail;
   throw FormatError(path + ": byte " + std::to_string(byte) + ": " + what);
 }
 
-// Printable rendering of up to `n` bytes, for "found ..." in messages.
-std::string shown(const std::uint8_t* p, std::size_t n) {
-  std::string s = "\"";
-  for (std::size_t i = 0; i < n; ++i) {
-    if (p[i] >= 0x20 && p[i] < 0x7f && p[i] != '"' && p[i] != '\\') {
-      s += static_cast<char>(p[i]);
-    } else {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\x%02x", p[i]);
-      s += buf;
-    }
-  }
-  return s + "\"";
-}
 
 std::string str(std::uint64_t v) { return std::to_string(v); }
 
@@ -59,11 +46,12 @@ QsFragment read_fragment_header(const std::string& path, const std::uint8_t* fil
   if (std::memcmp(h, kMagic, sizeof kMagic) != 0) {
     fail_at(path, at,
             (at == 0 ? std::string("not a QSplat file: ") : std::string()) +
-                "expected the fragment magic \"QSplat\", found " + shown(h, sizeof kMagic));
+                "expected the fragment magic \"QSplat\", found " +
+                format_detail::printable_bytes(h, sizeof kMagic));
   }
   if (std::memcmp(h + offset::kVersion, kVersion, sizeof kVersion) != 0) {
     fail_at(path, at + offset::kVersion,
-            "QSplat version " + shown(h + offset::kVersion, 2) +
+            "QSplat version " + format_detail::printable_bytes(h + offset::kVersion, 2) +
                 ", this reader knows only version \"11\" (QSplat 1.1)");
   }
   QsFragment f;

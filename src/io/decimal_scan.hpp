@@ -52,6 +52,21 @@ const char* scan_decimal(const char* p, const char* end, Decimal& d, EndsAt ends
   return p;
 }
 
+// Scans an optionally signed decimal integer of at most 18 digits at `p` into `out`. Returns the
+// first character after it, or null when there are no digits, too many, or `ends_at(q, end)`
+// rejects the character after them.
+template <class EndsAt>
+const char* scan_integer(const char* p, const char* end, std::int64_t& out, EndsAt ends_at) {
+  bool negative = false;
+  if (p < end && (*p == '-' || *p == '+')) negative = *p++ == '-';
+  const char* digits = p;
+  std::int64_t v = 0;
+  while (p < end && is_digit(*p) && p - digits < 18) v = v * 10 + (*p++ - '0');
+  if (p == digits || !ends_at(p, end)) return nullptr;
+  out = negative ? -v : v;
+  return p;
+}
+
 // Normalizes in place; a zero or non-finite normal becomes (0, 0, 1). When no normal is usable
 // the file had none in substance, and the array is dropped.
 inline void finish_normals(std::vector<Vec3f>& normals) {

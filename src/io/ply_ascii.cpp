@@ -86,14 +86,7 @@ inline const char* fast_double(const char* p, const char* end, double& out) {
 }
 
 inline const char* fast_integer(const char* p, const char* end, std::int64_t& out) {
-  bool negative = false;
-  if (p < end && (*p == '-' || *p == '+')) negative = *p++ == '-';
-  const char* digits = p;
-  std::int64_t v = 0;
-  while (p < end && is_digit(*p) && p - digits < 18) v = v * 10 + (*p++ - '0');
-  if (p == digits || !ends_token_at(p, end)) return nullptr;
-  out = negative ? -v : v;
-  return p;
+  return io_detail::scan_integer(p, end, out, ends_token_at);
 }
 
 class AsciiParser {

@@ -108,14 +108,9 @@ const char* parse_real(const char* p, const char* end, T& out) {
 // (OBJ face corners). Returns the first character after it, or null (not an integer, or more
 // than 18 digits).
 inline const char* parse_index(const char* p, const char* end, std::int64_t& out) {
-  bool negative = false;
-  if (p < end && (*p == '-' || *p == '+')) negative = *p++ == '-';
-  const char* digits = p;
-  std::int64_t v = 0;
-  while (p < end && is_digit(*p) && p - digits < 18) v = v * 10 + (*p++ - '0');
-  if (p == digits || !(ends_number_at(p, end) || *p == '/')) return nullptr;
-  out = negative ? -v : v;
-  return p;
+  return scan_integer(p, end, out, [](const char* q, const char* e) {
+    return ends_number_at(q, e) || (q < e && *q == '/');
+  });
 }
 
 // Shortest text without an exponent that reads back as the same double ("700000", "0.25");
