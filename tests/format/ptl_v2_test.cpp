@@ -505,12 +505,7 @@ std::string open_error(const std::string& path, const Bytes& bytes) {
   return "";
 }
 
-void expect_names(const std::string& message, const std::string& path, std::uint64_t byte,
-                  const std::string& what) {
-  EXPECT_NE(message.find(path), std::string::npos) << message;
-  EXPECT_NE(message.find("byte " + std::to_string(byte) + ":"), std::string::npos) << message;
-  EXPECT_NE(message.find(what), std::string::npos) << message;
-}
+using pointillist::testing::expect_names;
 
 TEST(PtlV2, RejectsTruncatedFiles) {
   TempDir dir;

@@ -5,6 +5,8 @@
 #include <random>
 #include <unistd.h>
 
+#include <gtest/gtest.h>
+
 namespace pointillist::testing {
 
 std::filesystem::path test_data_dir() { return POINTILLIST_TEST_DATA_DIR; }
@@ -36,6 +38,13 @@ TempDir::TempDir() {
 TempDir::~TempDir() {
   std::error_code ec;
   std::filesystem::remove_all(path_, ec);
+}
+
+void expect_names(const std::string& message, const std::string& path, std::uint64_t byte,
+                  const std::string& what) {
+  EXPECT_NE(message.find(path), std::string::npos) << message;
+  EXPECT_NE(message.find("byte " + std::to_string(byte) + ":"), std::string::npos) << message;
+  EXPECT_NE(message.find(what), std::string::npos) << message;
 }
 
 }  // namespace pointillist::testing

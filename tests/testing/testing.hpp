@@ -1,6 +1,7 @@
 // Helpers shared by the test suites: where test data lives, temporary folders.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 
@@ -37,5 +38,10 @@ class TempDir {
  private:
   std::filesystem::path path_;
 };
+
+// Expects an error message of a binary reader to name the file, the place ("byte N:") and what
+// was wrong.
+void expect_names(const std::string& message, const std::string& path, std::uint64_t byte,
+                  const std::string& what);
 
 }  // namespace pointillist::testing
