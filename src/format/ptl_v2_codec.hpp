@@ -12,9 +12,6 @@
 
 namespace pointillist::ptl2 {
 
-// cone_sin of a decoded interior node whose cone code is 3 ("no bound").
-constexpr float kNoConeBound = 2.0f;
-
 // Sphere code for `target` against the decoded `parent`: among the codes whose decoded sphere
 // (qs_detail::decode_sphere, float32) encloses `target` and lies inside `parent` (both checked
 // in double on the decoded floats), one of the smallest radius, then nearest the target's
@@ -34,25 +31,11 @@ std::uint32_t encode_normal_nearest(Vec3f n);
 double cone_half_angle(std::uint32_t k);
 // Smallest cone code whose half-angle is >= `theta` (radians) plus a 1e-6 margin; 3 when none.
 std::uint32_t encode_cone_at_least(double theta);
-// cone_sin a decoded interior node gets for code k.
-inline float decoded_cone_sin(std::uint32_t k) {
-  return k < 3 ? qs_detail::cone_sin_bound(k) : kNoConeBound;
-}
-
 // RGB 565 with each channel rounded to the nearest representable value (bit-replicated decode):
 // errors at most 4 levels in red and blue, 2 in green.
 std::uint16_t encode_rgb565_nearest(Rgb8 c);
 
 // Angle between two vectors (radians, double; 0 for a zero vector).
 double angle_between(Vec3f a, Vec3f b);
-
-// A leaf's drawn radius: its decoded sphere's radius trimmed by t/8 (t in 0..3, stored in the
-// leaf's cone bits, which leaves do not otherwise use). The writer picks the largest t whose
-// trimmed sphere, around the decoded centre, still holds the leaf's true sphere; the trimmed
-// sphere is concentric with the decoded one, so it stays inside the decoded parent. Computed the
-// same way (float) by the writer and the reader.
-inline float trimmed_leaf_radius(float decoded_radius, std::uint32_t t) {
-  return decoded_radius * (1.0f - 0.125f * static_cast<float>(t));
-}
 
 }  // namespace pointillist::ptl2

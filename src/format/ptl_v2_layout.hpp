@@ -7,8 +7,11 @@
 #include <cstring>
 
 #include "pointillist/core/math.hpp"
+#include "pointillist/lod/quantization.hpp"
 
 namespace pointillist::ptl2 {
+
+using namespace pointillist::quant;  // NOLINT(google-build-using-namespace): the record layout
 
 constexpr std::uint32_t kHeaderSize = 256;
 constexpr std::uint32_t kEndianMarker = 0x01020304;  // stored little-endian: 04 03 02 01
@@ -57,36 +60,30 @@ enum AttributeId : std::uint16_t {
   kAttrNormal = 3,    // encoding 1: QSplat 14-bit cube-face normal code
   kAttrCone = 4,      // encoding 1: QSplat 2-bit cone code
   kAttrColor = 5,     // encoding 1: RGB 565, bit-replicated on decoding
+  // encoding 1: the low bit of a leaf's radius trim, whose high bits are the cone bits: the trim
+  // counts sixteenths of the decoded radius (without this attribute: the cone bits, eighths).
+  // Interior nodes keep the bit 0.
+  kAttrLeafTrimLow = 6,
 };
 
-// A record is a little-endian integer of 4 bytes (6 with colour); bit fields from bit 0 up.
-constexpr unsigned kSphereShift = 0, kSphereBits = 13;   // code 0..7620 relative to the parent
-constexpr unsigned kChildShift = 13, kChildBits = 2;     // 0 leaf, 1..3 = 2..4 children
-constexpr unsigned kReservedShift = 15;                  // 1 bit, 0
-constexpr unsigned kNormalShift = 16, kNormalBits = 14;  // code 0..16223
-constexpr unsigned kConeShift = 30, kConeBits = 2;       // cone code (interior nodes);
-                                                         // leaves: radius trim t (0..3)
-constexpr std::uint32_t kMaxLeafTrim = 3;
-constexpr unsigned kColorShift = 32, kColorBits = 16;    // RGB 565, present with colours
+// A record is a little-endian integer of 4 bytes (6 with colour): the packed node record of
+// lod/quantization.hpp in bits 0..31, then RGB 565 in bits 32..47 with colours.
+constexpr unsigned kColorShift = 32, kColorBits = 16;
 
-constexpr std::uint64_t field(std::uint64_t record, unsigned shift, unsigned bits) {
-  return (record >> shift) & ((std::uint64_t{1} << bits) - 1);
-}
-
-// The attribute table a file with (or without) colours has; version 2 knows no other.
+// The attribute table of a file with (or without) colours, whose leaves keep their radius trim
+// in eighths (the first version 2 files) or sixteenths (kAttrLeafTrimLow present).
 struct Schema {
   Attribute entries[kMaxAttributes];
   std::uint32_t count = 0;
 };
-inline Schema schema(bool colors) {
+inline Schema schema(bool colors, LeafTrim trim) {
   Schema s{{{kAttrSphere, 1, kSphereShift, kSphereBits},
             {kAttrChildren, 1, kChildShift, kChildBits},
             {kAttrNormal, 1, kNormalShift, kNormalBits},
-            {kAttrCone, 1, kConeShift, kConeBits},
-            {kAttrColor, 1, kColorShift, kColorBits},
-            {}},
-           colors ? 5u : 4u};
-  if (!colors) s.entries[4] = {};
+            {kAttrCone, 1, kConeShift, kConeBits}},
+           4};
+  if (colors) s.entries[s.count++] = {kAttrColor, 1, kColorShift, kColorBits};
+  if (trim == LeafTrim::Sixteenths) s.entries[s.count++] = {kAttrLeafTrimLow, 1, kLowTrimShift, 1};
   return s;
 }
 

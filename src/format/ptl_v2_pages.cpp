@@ -1,4 +1,4 @@
-// PtlV2File pages as HierarchyPages (see ptl_v2_pages.hpp).
+// PtlV2File pages as packed HierarchyPages (see ptl_v2_pages.hpp).
 #include "pointillist/format/ptl_v2_pages.hpp"
 
 #include <algorithm>
@@ -10,11 +10,16 @@
 namespace pointillist {
 namespace {
 
+std::string str(std::uint64_t v) { return std::to_string(v); }
+
 class PtlV2Pages final : public PageSource {
  public:
-  explicit PtlV2Pages(const PtlV2File& file) : file_(file), children_(file.page_count()) {
+  explicit PtlV2Pages(const PtlV2File& file)
+      : file_(file), children_(file.page_count()), link_count_(file.page_count(), 0) {
     for (std::uint32_t q = 1; q < file.page_count(); ++q) {
-      children_[file.page_info(q).parent_page].push_back(q);
+      const PtlV2PageInfo& info = file.page_info(q);
+      children_[info.parent_page].push_back(q);
+      link_count_[info.parent_page] += info.root_count;
     }
     for (auto& c : children_) {
       std::sort(c.begin(), c.end(), [&](std::uint32_t a, std::uint32_t b) {
@@ -36,29 +41,53 @@ class PtlV2Pages final : public PageSource {
   std::uint32_t page_node_count(std::uint32_t page) const override {
     return file_.page_info(page).node_count;
   }
+  std::uint64_t page_memory_bytes(std::uint32_t page) const override {
+    return PackedPage::memory_bytes(file_.page_info(page).node_count, link_count_[page],
+                                    file_.has_colors());
+  }
   std::uint64_t open_bytes() const override { return open_bytes_; }
   SphereTreeView summary() const override { return summary_; }
 
   void load(std::uint32_t page, const SphereNode*, HierarchyPage& out) const override {
-    PtlV2Page decoded;
-    file_.decode_page(page, decoded);
-    out.nodes = std::move(decoded.nodes);
-    out.child_page.assign(out.nodes.size(), kNoPage);
+    out.nodes.clear();
+    out.child_page.clear();
+    PackedPage& packed = out.packed;
+    file_.pack_page(page, packed);
+    const auto corrupt = [&](std::uint32_t node, const std::string& what) {
+      throw FormatError("page " + str(page) + ", node " + str(node) + ": " + what +
+                        "; the model file is corrupt (convert it again)");
+    };
+    // Link the last level's interior nodes to the child pages that hold their children.
+    const auto count = static_cast<std::uint32_t>(packed.records.size());
+    std::vector<std::uint8_t> linked(count - packed.last_level_begin, 0);
     for (const std::uint32_t q : children_[page]) {
       const PtlV2PageInfo& info = file_.page_info(q);
       std::uint32_t offset = 0;
       for (std::uint32_t j = 0; j < info.root_count; ++j) {
-        SphereNode& anchor = out.nodes.at(info.first_root + j);
-        out.child_page[info.first_root + j] = q;
-        anchor.first_child = offset;
-        offset += anchor.child_count;
+        const std::uint32_t node = info.first_root + j;
+        const std::uint32_t children =
+            quant::bits(packed.records[node], quant::kChildShift, quant::kChildBits);
+        if (node < packed.last_level_begin || children == 0) {
+          corrupt(node, "page " + str(q) + " continues it, but it is not an interior node of the "
+                            "page's last level");
+        }
+        if (linked[node - packed.last_level_begin]++) {
+          corrupt(node, "two pages continue it");
+        }
+        const auto index = static_cast<std::uint32_t>(packed.links.size());
+        if (packed.link16.empty()) {
+          packed.link32[node] = index;
+        } else {
+          packed.link16[node] = static_cast<std::uint16_t>(index);
+        }
+        packed.links.push_back({q, offset});
+        offset += children + 1;
       }
     }
-    for (std::size_t i = decoded.last_level_begin; i < out.nodes.size(); ++i) {
-      if (out.nodes[i].child_count > 0 && out.child_page[i] == kNoPage) {
-        throw FormatError("page " + std::to_string(page) + ", node " + std::to_string(i) +
-                          ": has children but no page holds them; the model file is corrupt "
-                          "(convert it again)");
+    for (std::uint32_t i = packed.last_level_begin; i < count; ++i) {
+      if (quant::bits(packed.records[i], quant::kChildShift, quant::kChildBits) != 0 &&
+          !linked[i - packed.last_level_begin]) {
+        corrupt(i, "has children but no page holds them");
       }
     }
   }
@@ -66,6 +95,7 @@ class PtlV2Pages final : public PageSource {
  private:
   const PtlV2File& file_;
   std::vector<std::vector<std::uint32_t>> children_;  // child pages of each page, by first root
+  std::vector<std::uint64_t> link_count_;             // roots of each page's child pages
   std::uint64_t open_bytes_ = 0;
   SphereTreeView summary_;
 };

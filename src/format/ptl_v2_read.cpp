@@ -16,6 +16,7 @@
 #include "pointillist/core/error.hpp"
 #include "pointillist/format/ptl.hpp"
 #include "pointillist/format/ptl_v2.hpp"
+#include "pointillist/render/paged.hpp"
 
 namespace pointillist {
 
@@ -101,12 +102,16 @@ std::unique_ptr<PtlV2File> PtlV2File::open(const std::string& path) {
             "record size " + str(file->record_size_) + ", expected " + str(want_record) +
                 (file->has_colors_ ? " (with colours)" : " (without colours)"));
   }
-  const Schema expected = schema(file->has_colors_);
-  if (load_u32(b + offset::kAttributeCount) != expected.count) {
+  // Known layouts: leaf trims in eighths (the first files) or sixteenths (one more attribute).
+  const std::uint32_t attribute_count = load_u32(b + offset::kAttributeCount);
+  const std::uint32_t eighths_count = schema(file->has_colors_, LeafTrim::Eighths).count;
+  if (attribute_count != eighths_count && attribute_count != eighths_count + 1) {
     fail_at(path, offset::kAttributeCount,
-            "attribute count " + str(load_u32(b + offset::kAttributeCount)) + ", expected " +
-                str(expected.count));
+            "attribute count " + str(attribute_count) + ", expected " + str(eighths_count) +
+                " or " + str(eighths_count + 1) + "; upgrade Pointillist to open the file");
   }
+  file->leaf_trim_ = attribute_count == eighths_count ? LeafTrim::Eighths : LeafTrim::Sixteenths;
+  const Schema expected = schema(file->has_colors_, file->leaf_trim_);
   for (std::uint32_t a = 0; a < expected.count; ++a) {
     const std::uint8_t* e = b + offset::kAttributes + 8 * a;
     const Attribute& x = expected.entries[a];
@@ -219,38 +224,42 @@ std::unique_ptr<PtlV2File> PtlV2File::open(const std::string& path) {
 
 PtlV2File::~PtlV2File() = default;
 
-void PtlV2File::decode_page(std::uint32_t page, PtlV2Page& out) const {
+template <class OnRecord>
+std::uint32_t PtlV2File::scan_page(std::uint32_t page, std::vector<Sphere>& root_spheres,
+                                   std::vector<std::uint8_t>& root_child_counts,
+                                   OnRecord&& on_record) const {
   assert(page < pages_.size());
   const PtlV2PageInfo& info = pages_[page];
   const auto* base = reinterpret_cast<const std::uint8_t*>(map_->bytes.view().data());
   const std::uint8_t* b = base + info.offset;
-  const std::string which = "page " + str(page) + ": ";
+  const auto which = [&] { return "page " + str(page) + ": "; };
   const std::uint32_t roots = info.root_count;
-  out.root_spheres.resize(roots);
-  out.root_child_counts.resize(roots);
+  root_spheres.resize(roots);
+  root_child_counts.resize(roots);
   for (std::uint32_t r = 0; r < roots; ++r) {
-    const Sphere s{load_vec(b + 16 * r), load_f32(b + 16 * r + 12)};
-    if (!finite_sphere(s)) {
+    const Sphere sphere{load_vec(b + 16 * r), load_f32(b + 16 * r + 12)};
+    if (!finite_sphere(sphere)) {
       fail_at(path_, info.offset + 16 * r,
-              which + "root " + str(r) + " sphere is not finite or has a negative radius");
+              which() + "root " + str(r) + " sphere is not finite or has a negative radius");
     }
     const std::uint8_t k = b[16 * roots + r];
     if (page == 0 ? k != 1 : (k < 2 || k > 4)) {
       fail_at(path_, info.offset + 16 * roots + r,
-              which + "root " + str(r) + " has child count " + str(k) +
+              which() + "root " + str(r) + " has child count " + str(k) +
                   (page == 0 ? " (page 0's root: 1)" : " (2 to 4)"));
     }
-    out.root_spheres[r] = s;
-    out.root_child_counts[r] = k;
+    root_spheres[r] = sphere;
+    root_child_counts[r] = k;
   }
   const std::uint64_t records_at = info.offset + std::uint64_t{roots} * kRootEntrySize;
   const std::uint32_t count = info.node_count, rs = record_size_;
-  const auto normals = qs_detail::normal_table();
-  out.nodes.resize(count);
+  const bool trim_low_bit = leaf_trim_ == LeafTrim::Sixteenths;
   // Level by level: the parents of level L + 1 are the roots (L = 0) or the interior records of
-  // level L, in order; a level holds exactly their children.
+  // level L, in order; a level holds exactly their children. Child counts of the records seen
+  // so far (the scan for the next parent never passes the current record).
+  std::vector<std::uint8_t> child_counts(count);
   std::uint64_t need = 0;
-  for (std::uint32_t r = 0; r < roots; ++r) need += out.root_child_counts[r];
+  for (std::uint32_t r = 0; r < roots; ++r) need += root_child_counts[r];
   std::uint32_t next_root = 0;
   std::uint64_t next_parent = 0;  // scan position for interior records
   std::uint64_t i = 0, level_begin = 0;
@@ -258,7 +267,7 @@ void PtlV2File::decode_page(std::uint32_t page, PtlV2Page& out) const {
   while (need > 0 && i < count) {
     if (need > count - i) {
       fail_at(path_, records_at + i * rs,
-              which + "level " + str(levels + 1) + " needs " + str(need) +
+              which() + "level " + str(levels + 1) + " needs " + str(need) +
                   " records, the page has " + str(count - i) + " left of " + str(count));
     }
     level_begin = i;
@@ -268,67 +277,126 @@ void PtlV2File::decode_page(std::uint32_t page, PtlV2Page& out) const {
     while (i < level_end) {
       // The level's records are exactly the children of these parents, so the scan stays
       // within the previous level.
-      Sphere ps;
+      PageParent parent;
       std::uint32_t k;
       if (next_root < roots) {
-        ps = out.root_spheres[next_root];
-        k = out.root_child_counts[next_root++];
+        parent = {true, next_root};
+        k = root_child_counts[next_root++];
       } else {
-        while (out.nodes[next_parent].child_count == 0) ++next_parent;
-        SphereNode& pn = out.nodes[next_parent++];
-        pn.first_child = static_cast<std::uint32_t>(i);
-        ps = {pn.center, pn.radius};
-        k = pn.child_count;
+        while (child_counts[next_parent] == 0) ++next_parent;
+        parent = {false, static_cast<std::uint32_t>(next_parent)};
+        k = child_counts[next_parent++];
       }
       for (std::uint32_t c = 0; c < k; ++c, ++i) {
         const std::uint64_t at = records_at + i * rs;
         const std::uint8_t* r = base + at;
-        std::uint64_t rec = load_u32(r);
-        if (rs == 6) rec |= std::uint64_t{load_u16(r + 4)} << 32;
-        const auto code = std::uint32_t(field(rec, kSphereShift, kSphereBits));
-        const auto children_code = std::uint32_t(field(rec, kChildShift, kChildBits));
-        const auto normal = std::uint32_t(field(rec, kNormalShift, kNormalBits));
-        const auto cone = std::uint32_t(field(rec, kConeShift, kConeBits));
-        if (code >= qs_detail::kSphereCodeCount) {
+        const std::uint32_t rec = load_u32(r);
+        const std::uint16_t color = rs == 6 ? load_u16(r + 4) : 0;
+        const std::uint32_t code = bits(rec, kSphereShift, kSphereBits);
+        const std::uint32_t children = bits(rec, kChildShift, kChildBits);
+        const std::uint32_t normal = bits(rec, kNormalShift, kNormalBits);
+        if (code >= kSphereCodeCount) {
           fail_at(path_, at,
-                  which + "record " + str(i) + ": sphere code " + str(code) +
-                      " is outside the table (0.." + str(qs_detail::kSphereCodeCount - 1) + ")");
+                  which() + "record " + str(i) + ": sphere code " + str(code) +
+                      " is outside the table (0.." + str(kSphereCodeCount - 1) + ")");
         }
-        if (field(rec, kReservedShift, 1) != 0) {
-          fail_at(path_, at + 1, which + "record " + str(i) + ": reserved bit 15 is set");
+        if (bits(rec, kLowTrimShift, 1) != 0 && (children != 0 || !trim_low_bit)) {
+          fail_at(path_, at + 1,
+                  which() + "record " + str(i) + ": reserved bit 15 is set" +
+                      (trim_low_bit ? " on an interior node" : ""));
         }
-        if (normal >= qs_detail::kNormalCodeCount) {
+        if (normal >= kNormalCodeCount) {
           fail_at(path_, at + 2,
-                  which + "record " + str(i) + ": normal code " + str(normal) +
-                      " is outside the table (0.." + str(qs_detail::kNormalCodeCount - 1) + ")");
+                  which() + "record " + str(i) + ": normal code " + str(normal) +
+                      " is outside the table (0.." + str(kNormalCodeCount - 1) + ")");
         }
-        const Sphere s = qs_detail::decode_sphere(ps, code);
-        SphereNode& n = out.nodes[i];
-        n.center = s.center;
-        n.child_count = static_cast<std::uint8_t>(children_code == 0 ? 0 : children_code + 1);
-        // Leaves keep their radius trim in the cone bits (see trimmed_leaf_radius).
-        n.radius = n.child_count == 0 ? trimmed_leaf_radius(s.radius, cone) : s.radius;
-        n.normal = normals[normal];
-        n.cone_sin = n.child_count == 0 ? 0.0f : decoded_cone_sin(cone);
-        n.first_child = 0;
-        n.color =
-            has_colors_ ? qs_detail::decode_rgb565(std::uint16_t(rec >> kColorShift)) : Rgb8{};
-        need += n.child_count;
+        child_counts[i] = static_cast<std::uint8_t>(children == 0 ? 0 : children + 1);
+        need += child_counts[i];
+        on_record(static_cast<std::uint32_t>(i), rec, color, parent, c == 0);
       }
     }
   }
   if (i != count) {
     fail_at(path_, records_at + i * rs,
-            which + "record " + str(i) + " of " + str(count) +
+            which() + "record " + str(i) + " of " + str(count) +
                 " has no parent (the tree of the page ends before it)");
   }
   if (levels != info.level_count) {
     fail_at(path_, records_at + std::uint64_t{count} * rs - rs,
-            which + "the records form " + str(levels) + " levels, the page table says " +
+            which() + "the records form " + str(levels) + " levels, the page table says " +
                 str(info.level_count));
   }
   // The last level's interior nodes have their children in child pages.
-  out.last_level_begin = static_cast<std::uint32_t>(level_begin);
+  return static_cast<std::uint32_t>(level_begin);
+}
+
+void PtlV2File::decode_page(std::uint32_t page, PtlV2Page& out) const {
+  out.nodes.resize(pages_[page].node_count);
+  const DecodeTables tables;
+  out.last_level_begin = scan_page(
+      page, out.root_spheres, out.root_child_counts,
+      [&](std::uint32_t i, std::uint32_t rec, std::uint16_t color, PageParent parent,
+          bool first_child) {
+        Sphere ps;
+        if (parent.is_root) {
+          ps = out.root_spheres[parent.index];
+        } else {
+          SphereNode& pn = out.nodes[parent.index];
+          if (first_child) pn.first_child = i;
+          ps = {pn.center, pn.radius};
+        }
+        out.nodes[i] = decode_node(tables, rec, color, has_colors_, leaf_trim_, ps);
+      });
+}
+
+void PtlV2File::pack_page(std::uint32_t page, PackedPage& out) const {
+  const std::uint32_t count = pages_[page].node_count;
+  out.records.resize(count);
+  out.colors.resize(has_colors_ ? count : 0);
+  const bool wide = count > 0xffff;
+  out.link16.assign(wide ? 0 : count, 0);
+  out.link32.assign(wide ? count : 0, 0);
+  out.links.clear();
+  out.leaf_trim = leaf_trim_;
+  std::vector<Sphere> root_spheres;
+  std::vector<std::uint8_t> root_child_counts;
+  out.last_level_begin = scan_page(
+      page, root_spheres, root_child_counts,
+      [&](std::uint32_t i, std::uint32_t rec, std::uint16_t color, PageParent parent,
+          bool first_child) {
+        out.records[i] = rec;
+        if (has_colors_) out.colors[i] = color;
+        if (first_child && !parent.is_root) {
+          if (wide) {
+            out.link32[parent.index] = i - parent.index;
+          } else {
+            out.link16[parent.index] = static_cast<std::uint16_t>(i - parent.index);
+          }
+        }
+      });
+  out.root_parent = root_spheres[0];
+  const PtlV2PageInfo& info = pages_[page];
+  if (page == 0 && std::memcmp(&out.root_parent, &root_sphere_, sizeof(Sphere)) != 0) {
+    fail_at(path_, info.offset, "page 0's root sphere differs from the header's");
+  }
+  if (page == 0) return;
+  // The traversal reaches this page through its roots' records in the parent page, whose child
+  // counts must be the ones this page's first level was checked against.
+  const PtlV2PageInfo& parent = pages_[info.parent_page];
+  const auto* base = reinterpret_cast<const std::uint8_t*>(map_->bytes.view().data());
+  const std::uint64_t parent_records =
+      parent.offset + std::uint64_t{parent.root_count} * kRootEntrySize;
+  for (std::uint32_t r = 0; r < info.root_count; ++r) {
+    const std::uint64_t at = parent_records + std::uint64_t{info.first_root + r} * record_size_;
+    const std::uint32_t children = bits(load_u32(base + at), kChildShift, kChildBits);
+    if (children == 0 || children + 1 != root_child_counts[r]) {
+      fail_at(path_, info.offset + 16 * info.root_count + r,
+              "page " + str(page) + ": root " + str(r) + " has " + str(root_child_counts[r]) +
+                  " children, record " + str(info.first_root + r) + " of parent page " +
+                  str(info.parent_page) + " (byte " + str(at) + ") has " +
+                  str(children == 0 ? 0 : children + 1));
+    }
+  }
 }
 
 SphereTree PtlV2File::decode_all() const {

@@ -256,15 +256,20 @@ PtlV2WriteReport write_ptl_v2(const std::string& path, const SphereTree& tree,
     record[i] = std::uint64_t{code} << kSphereShift | children << kChildShift;
     if (nodes[i].child_count == 0) {
       // Leaves are drawn at their decoded radius: trim it as far as the true sphere allows.
+      const LeafTrim mode = options.leaf_trim;
       std::uint32_t trim = 0;
-      while (trim < kMaxLeafTrim &&
-             encloses({decoded[i].center, trimmed_leaf_radius(decoded[i].radius, trim + 1)},
+      while (trim < max_leaf_trim(mode) &&
+             encloses({decoded[i].center, trimmed_leaf_radius(decoded[i].radius, trim + 1, mode)},
                       target[i])) {
         ++trim;
       }
-      record[i] |= std::uint64_t{trim} << kConeShift;
+      record[i] |= mode == LeafTrim::Eighths
+                       ? std::uint64_t{trim} << kConeShift
+                       : std::uint64_t{trim >> 1} << kConeShift | std::uint64_t{trim & 1}
+                                                                      << kLowTrimShift;
       if (nodes[i].radius > 0) {
-        leaf_ratio_sum += double(trimmed_leaf_radius(decoded[i].radius, trim)) / nodes[i].radius;
+        leaf_ratio_sum +=
+            double(trimmed_leaf_radius(decoded[i].radius, trim, mode)) / nodes[i].radius;
         ++leaf_ratio_count;
       }
     }
@@ -337,7 +342,7 @@ PtlV2WriteReport write_ptl_v2(const std::string& path, const SphereTree& tree,
   store_vec(h + offset::kViewCenter, tree.view_sphere.center);
   store_f32(h + offset::kViewRadius, tree.view_sphere.radius);
   store_u32(h + offset::kPageBytes, options.page_bytes);
-  const Schema s = schema(colors);
+  const Schema s = schema(colors, options.leaf_trim);
   store_u32(h + offset::kAttributeCount, s.count);
   for (std::uint32_t a = 0; a < s.count; ++a) {
     std::uint8_t* e = h + offset::kAttributes + 8 * a;

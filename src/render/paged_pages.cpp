@@ -67,6 +67,9 @@ class InMemoryPages final : public PageSource {
   std::uint32_t page_node_count(std::uint32_t page) const override {
     return static_cast<std::uint32_t>(pages_.at(page).nodes.size());
   }
+  std::uint64_t page_memory_bytes(std::uint32_t page) const override {
+    return HierarchyPage::memory_bytes(pages_.at(page).nodes.size());
+  }
   std::uint64_t open_bytes() const override { return 0; }
   SphereTreeView summary() const override { return summary_; }
   void load(std::uint32_t page, const SphereNode*, HierarchyPage& out) const override {

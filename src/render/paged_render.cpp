@@ -22,12 +22,98 @@ namespace {
 
 using namespace render_detail;
 
-struct PagedPending {
-  std::uint32_t page, node;
-  std::uint8_t tests;
+using PageTable = std::vector<std::unique_ptr<HierarchyPage>>;
+
+// Where the children of a refined node are: nodes [first, first + child_count) of `page`, which
+// may not be resident.
+struct ChildRef {
+  std::uint32_t page, first;
+  bool resident;
+};
+
+// The traversal's view of decoded pages: nodes are used where they lie.
+class DecodedAccess {
+ public:
+  static constexpr bool kPacked = false;
+  struct Item {
+    std::uint32_t page, node;
+    std::uint8_t tests;
+  };
+  explicit DecodedAccess(const PageTable& pages) : pages_(pages) {}
+  Item root(std::uint8_t tests) const { return {0, 0, tests}; }
+  const SphereNode& node(const Item& p) const { return pages_[p.page]->nodes[p.node]; }
+  ChildRef children(const Item& p, const SphereNode& n) const {
+    const std::uint32_t cp = pages_[p.page]->child_page[p.node];
+    if (cp == kNoPage) return {p.page, n.first_child, true};
+    return {cp, n.first_child, pages_[cp] != nullptr};
+  }
+  // The children of `n`, which are at `c` (resident).
+  const SphereNode* load_children(ChildRef c, const SphereNode&, SphereNode*) const {
+    return pages_[c.page]->nodes.data() + c.first;
+  }
+  Item item(ChildRef c, std::uint32_t k, const SphereNode*, std::uint8_t tests) const {
+    return {c.page, c.first + k, tests};
+  }
+
+ private:
+  const PageTable& pages_;
+};
+
+// The traversal's view of packed pages: each node is decoded from its record against its
+// decoded parent when the parent is refined, and travels by value.
+class PackedAccess {
+ public:
+  static constexpr bool kPacked = true;
+  struct Item {
+    SphereNode node;
+    std::uint32_t page, index;
+    std::uint8_t tests;
+  };
+  PackedAccess(const PageTable& pages, bool has_colors)
+      : pages_(pages), has_colors_(has_colors) {}
+  Item root(std::uint8_t tests) const {
+    const PackedPage& pk = pages_[0]->packed;
+    return {decode(pk, 0, pk.root_parent), 0, 0, tests};
+  }
+  const SphereNode& node(const Item& p) const { return p.node; }
+  ChildRef children(const Item& p, const SphereNode&) const {
+    const PackedPage& pk = pages_[p.page]->packed;
+    const std::uint32_t link = pk.link(p.index);
+    if (p.index < pk.last_level_begin) return {p.page, p.index + link, true};
+    const PageLink& l = pk.links[link];
+    return {l.page, l.first, pages_[l.page] != nullptr};
+  }
+  const SphereNode* load_children(ChildRef c, const SphereNode& n, SphereNode* scratch) const {
+    const PackedPage& pk = pages_[c.page]->packed;
+    const Sphere parent{n.center, n.radius};
+    for (std::uint32_t k = 0; k < n.child_count; ++k) {
+      scratch[k] = decode(pk, c.first + k, parent);
+    }
+    return scratch;
+  }
+  Item item(ChildRef c, std::uint32_t k, const SphereNode* kids, std::uint8_t tests) const {
+    return {kids[k], c.page, c.first + k, tests};
+  }
+
+ private:
+  SphereNode decode(const PackedPage& pk, std::uint32_t i, const Sphere& parent) const {
+    return quant::decode_node(tables_, pk.records[i], has_colors_ ? pk.colors[i] : 0,
+                              has_colors_, pk.leaf_trim, parent);
+  }
+  const PageTable& pages_;
+  bool has_colors_;
+  quant::DecodeTables tables_;
 };
 
 }  // namespace
+
+struct PagedRenderer::Selection {
+  const ViewConstants& v;
+  std::uint8_t tests;  // tests of the root
+  bool with_colors;
+  SplatStream& stream;
+  Counters counters;
+};
 
 struct PagedRenderer::Loader {
   std::mutex mutex;
@@ -132,7 +218,7 @@ PagedRenderer::PagedRenderer(const PageSource& source, std::uint64_t memory_cap,
   in_flight_.assign(n, 0);
   stats_.bytes_read = source.open_bytes();
   if (n == 0) return;
-  const std::uint64_t first = HierarchyPage::memory_bytes(source.page_node_count(0));
+  const std::uint64_t first = source.page_memory_bytes(0);
   if (first > cap_) {
     throw OptionError("memory cap of " + std::to_string(cap_) + " bytes is smaller than the " +
                       "model's first page (" + std::to_string(first) +
@@ -163,139 +249,20 @@ void PagedRenderer::render(const Camera& camera, const RenderSettings& settings,
   stream.chunk_count = 0;
   const Shader shader(settings, cam);
   const ViewConstants v = make_view_constants(shader, cam, settings);
-  Counters counters;
+  Selection selection{
+      v,
+      static_cast<std::uint8_t>((settings.frustum_culling ? kTestFrustum : 0) |
+                                (settings.backface_culling ? kTestBackface : 0)),
+      with_colors, stream, {}};
   if (!pages_.empty() && pages_[0]) {
     last_used_[0] = frame_number_;
-    // Where the children of a refined node are: {page, first} or, when that page is not
-    // resident, page = the wanted page and resident = false.
-    struct Children {
-      std::uint32_t page, first;
-      bool resident;
-    };
-    const auto children_of = [&](const PagedPending& p, const SphereNode& n) {
-      const std::uint32_t cp = pages_[p.page]->child_page[p.node];
-      if (cp == kNoPage) return Children{p.page, n.first_child, true};
-      return Children{cp, n.first_child, pages_[cp] != nullptr};
-    };
-
-    // The top of the hierarchy expanded level by level (as the in-memory traversal does) into
-    // subtrees walked in parallel, each into its own chunk; chunks in order give the
-    // depth-first order whatever the thread count. A node is expanded here only when its
-    // children are resident; anything else is left for its task to visit.
-    std::vector<PagedPending> items{
-        {0, 0,
-         static_cast<std::uint8_t>((settings.frustum_culling ? kTestFrustum : 0) |
-                                   (settings.backface_culling ? kTestBackface : 0))}};
-    std::vector<PagedPending> next;
-    while (items.size() < kTargetTasks) {
-      bool expanded = false;
-      next.clear();
-      for (PagedPending p : items) {
-        const SphereNode& n = pages_[p.page]->nodes[p.node];
-        Counters trial;
-        Vec3f d;
-        float z;
-        std::uint8_t tests = p.tests;
-        const Decision decision = visit(n, v, tests, trial, d, z);
-        const Children c = decision == Decision::Refine ? children_of(p, n) : Children{};
-        if (decision == Decision::Cull || (decision == Decision::Refine && c.resident)) {
-          counters.visited += trial.visited;
-          counters.culled_frustum += trial.culled_frustum;
-          counters.culled_backface += trial.culled_backface;
-          if (decision == Decision::Cull) continue;
-          if (c.page != p.page) last_used_[c.page] = frame_number_;
-          for (std::uint32_t k = 0; k < n.child_count; ++k) {
-            next.push_back({c.page, c.first + k, tests});
-          }
-          expanded = true;
-        } else {
-          next.push_back(p);  // drawn, or a stand-in: its task visits it
-        }
-      }
-      items.swap(next);
-      if (!expanded) break;
-    }
-
-    if (stream.chunks.size() < items.size()) stream.chunks.resize(items.size());
-    stream.chunk_count = items.size();
-    if (task_out_.size() < items.size()) task_out_.resize(items.size());
-    std::vector<Counters> task_counters(items.size());
-    pool.run(items.size(), [&](std::size_t t) {
-      TaskOut& out = task_out_[t];
-      Counters task_count;  // local: the hot loop keeps it in registers
-      out.emitted.clear();
-      out.stand_ins.clear();
-      out.requests.clear();
-      out.touched.clear();
-      SplatChunk& chunk = stream.chunks[t];
-      chunk.count = 0;
-      chunk.reserve(kInitialChunkCapacity, with_colors);
-      {
-        Emitter emitter(chunk, with_colors);
-        const auto emit = [&](const SphereNode& n, Vec3f d, float z, bool stand_in) {
-          emitter.emit(n, static_cast<std::uint32_t>(out.emitted.size()), d, z, v, task_count,
-                       !stand_in);
-          // A stand-in is drawn even when its mean normal faces away (its subtree may hold
-          // surfaces facing the eye); it is then lit from the front, not drawn black.
-          if (stand_in && dot(d, n.normal) > 0) {
-            out.stand_ins.push_back(n);
-            out.stand_ins.back().normal = -n.normal;
-            out.emitted.push_back(&out.stand_ins.back());
-          } else {
-            out.emitted.push_back(&n);
-          }
-        };
-        std::vector<PagedPending> stack{items[t]};
-        while (!stack.empty()) {
-          const PagedPending p = stack.back();
-          stack.pop_back();
-          const SphereNode& n = pages_[p.page]->nodes[p.node];
-          Vec3f d;
-          float z;
-          std::uint8_t tests = p.tests;
-          const Decision decision = visit(n, v, tests, task_count, d, z);
-          if (decision == Decision::Draw) emit(n, d, z, false);
-          if (decision != Decision::Refine) continue;
-          const Children c = children_of(p, n);
-          if (!c.resident) {
-            // Not resident: this node stands in for its subtree, and the page is wanted.
-            emit(n, d, z, true);
-            out.requests.push_back({c.page, p.page, n, z > 0 ? n.radius / z : 0.0f});
-            continue;
-          }
-          if (c.page != p.page) out.touched.push_back(c.page);
-          // Leading leaf children are visited right here (most nodes near the bottom have only
-          // leaves), in order; the rest go on the stack last to first.
-          const SphereNode* kids = pages_[c.page]->nodes.data() + c.first;
-          std::uint32_t k = 0;
-          for (; k < n.child_count && kids[k].child_count == 0; ++k) {
-            std::uint8_t leaf_tests = tests;
-            if (visit(kids[k], v, leaf_tests, task_count, d, z) == Decision::Draw) {
-              emit(kids[k], d, z, false);
-            }
-          }
-          for (std::uint32_t j = n.child_count; j-- > k;) {
-            stack.push_back({c.page, c.first + j, tests});
-          }
-        }
-      }
-      finish_chunk([&](std::uint32_t i) -> const SphereNode& { return *out.emitted[i]; }, v,
-                   with_colors, chunk);
-      task_counters[t] = task_count;
-    });
-    for (std::size_t t = 0; t < items.size(); ++t) {
-      const TaskOut& out = task_out_[t];
-      counters.visited += task_counters[t].visited;
-      counters.culled_frustum += task_counters[t].culled_frustum;
-      counters.culled_backface += task_counters[t].culled_backface;
-      for (const std::uint32_t page : out.touched) last_used_[page] = frame_number_;
-      for (const Request& r : out.requests) {
-        if (requested_[r.page] || in_flight_[r.page]) continue;
-        requested_[r.page] = 1;
-        requests_.push_back(r);
-      }
+    if (pages_[0]->is_packed()) {
+      select(PackedAccess(pages_, with_colors), selection, pool);
+    } else {
+      select(DecodedAccess(pages_), selection, pool);
     }
   }
+  const Counters& counters = selection.counters;
   std::uint64_t splats = 0;
   for (std::size_t t = 0; t < stream.chunk_count; ++t) splats += stream.chunks[t].count;
   const auto selected = Clock::now();
@@ -306,6 +273,143 @@ void PagedRenderer::render(const Camera& camera, const RenderSettings& settings,
               .culled_backface = counters.culled_backface},
              cam, pool.thread_count(), start, selected, Clock::now());
   stats_.pages_requested = requests_.size();
+}
+
+template <class Access>
+void PagedRenderer::select(const Access& access, Selection& s, ThreadPool& pool) {
+  using Item = typename Access::Item;
+  const ViewConstants& v = s.v;
+  const bool with_colors = s.with_colors;
+  SplatStream& stream = s.stream;
+  Counters& counters = s.counters;
+
+  // The top of the hierarchy expanded level by level (as the in-memory traversal does) into
+  // subtrees walked in parallel, each into its own chunk; chunks in order give the depth-first
+  // order whatever the thread count. A node is expanded here only when its children are
+  // resident; anything else is left for its task to visit.
+  std::vector<Item> items{access.root(s.tests)};
+  std::vector<Item> next;
+  SphereNode scratch[4];
+  while (items.size() < kTargetTasks) {
+    bool expanded = false;
+    next.clear();
+    for (const Item& p : items) {
+      const SphereNode& n = access.node(p);
+      Counters trial;
+      Vec3f d;
+      float z;
+      std::uint8_t tests = p.tests;
+      const Decision decision = visit(n, v, tests, trial, d, z);
+      const ChildRef c = decision == Decision::Refine ? access.children(p, n) : ChildRef{};
+      if (decision == Decision::Cull || (decision == Decision::Refine && c.resident)) {
+        counters.visited += trial.visited;
+        counters.culled_frustum += trial.culled_frustum;
+        counters.culled_backface += trial.culled_backface;
+        if (decision == Decision::Cull) continue;
+        if (c.page != p.page) last_used_[c.page] = frame_number_;
+        const SphereNode* kids = access.load_children(c, n, scratch);
+        for (std::uint32_t k = 0; k < n.child_count; ++k) {
+          next.push_back(access.item(c, k, kids, tests));
+        }
+        expanded = true;
+      } else {
+        next.push_back(p);  // drawn, or a stand-in: its task visits it
+      }
+    }
+    items.swap(next);
+    if (!expanded) break;
+  }
+
+  if (stream.chunks.size() < items.size()) stream.chunks.resize(items.size());
+  stream.chunk_count = items.size();
+  if (task_out_.size() < items.size()) task_out_.resize(items.size());
+  std::vector<Counters> task_counters(items.size());
+  pool.run(items.size(), [&](std::size_t t) {
+    TaskOut& out = task_out_[t];
+    Counters task_count;  // local: the hot loop keeps it in registers
+    out.emitted.clear();
+    out.values.clear();
+    out.stand_ins.clear();
+    out.requests.clear();
+    out.touched.clear();
+    SplatChunk& chunk = stream.chunks[t];
+    chunk.count = 0;
+    chunk.reserve(kInitialChunkCapacity, with_colors);
+    {
+      Emitter emitter(chunk, with_colors);
+      std::uint32_t emitted = 0;
+      // A stand-in is drawn even when its mean normal faces away (its subtree may hold surfaces
+      // facing the eye); it is then lit from the front, not drawn black.
+      const auto emit = [&](const SphereNode& n, Vec3f d, float z, bool stand_in) {
+        emitter.emit(n, emitted++, d, z, v, task_count, !stand_in);
+        const bool flip = stand_in && dot(d, n.normal) > 0;
+        if constexpr (Access::kPacked) {
+          out.values.push_back(n);
+          if (flip) out.values.back().normal = -n.normal;
+        } else if (flip) {
+          out.stand_ins.push_back(n);
+          out.stand_ins.back().normal = -n.normal;
+          out.emitted.push_back(&out.stand_ins.back());
+        } else {
+          out.emitted.push_back(&n);
+        }
+      };
+      SphereNode kid_scratch[4];
+      std::vector<Item> stack{items[t]};
+      while (!stack.empty()) {
+        const Item p = stack.back();
+        stack.pop_back();
+        const SphereNode& n = access.node(p);
+        Vec3f d;
+        float z;
+        std::uint8_t tests = p.tests;
+        const Decision decision = visit(n, v, tests, task_count, d, z);
+        if (decision == Decision::Draw) emit(n, d, z, false);
+        if (decision != Decision::Refine) continue;
+        const ChildRef c = access.children(p, n);
+        if (!c.resident) {
+          // Not resident: this node stands in for its subtree, and the page is wanted.
+          emit(n, d, z, true);
+          out.requests.push_back({c.page, p.page, n, z > 0 ? n.radius / z : 0.0f});
+          continue;
+        }
+        if (c.page != p.page) out.touched.push_back(c.page);
+        // Leading leaf children are visited right here (most nodes near the bottom have only
+        // leaves), in order; the rest go on the stack last to first.
+        const SphereNode* kids = access.load_children(c, n, kid_scratch);
+        std::uint32_t k = 0;
+        for (; k < n.child_count && kids[k].child_count == 0; ++k) {
+          std::uint8_t leaf_tests = tests;
+          if (visit(kids[k], v, leaf_tests, task_count, d, z) == Decision::Draw) {
+            emit(kids[k], d, z, false);
+          }
+        }
+        for (std::uint32_t j = n.child_count; j-- > k;) {
+          stack.push_back(access.item(c, j, kids, tests));
+        }
+      }
+    }
+    if constexpr (Access::kPacked) {
+      finish_chunk([&](std::uint32_t i) -> const SphereNode& { return out.values[i]; }, v,
+                   with_colors, chunk);
+    } else {
+      finish_chunk([&](std::uint32_t i) -> const SphereNode& { return *out.emitted[i]; }, v,
+                   with_colors, chunk);
+    }
+    task_counters[t] = task_count;
+  });
+  for (std::size_t t = 0; t < items.size(); ++t) {
+    const TaskOut& out = task_out_[t];
+    counters.visited += task_counters[t].visited;
+    counters.culled_frustum += task_counters[t].culled_frustum;
+    counters.culled_backface += task_counters[t].culled_backface;
+    for (const std::uint32_t page : out.touched) last_used_[page] = frame_number_;
+    for (const Request& r : out.requests) {
+      if (requested_[r.page] || in_flight_[r.page]) continue;
+      requested_[r.page] = 1;
+      requests_.push_back(r);
+    }
+  }
 }
 
 bool PagedRenderer::make_room(std::uint64_t bytes) {
@@ -319,7 +423,7 @@ bool PagedRenderer::make_room(std::uint64_t bytes) {
       }
     }
     if (victim == kNoPage) return false;
-    stats_.resident_bytes -= HierarchyPage::memory_bytes(pages_[victim]->nodes.size());
+    stats_.resident_bytes -= source_.page_memory_bytes(victim);
     pages_[victim].reset();
     if (parent_[victim] != kNoPage) --resident_children_[parent_[victim]];
     parent_[victim] = kNoPage;
@@ -343,7 +447,7 @@ std::vector<PagedRenderer::Request> PagedRenderer::choose(std::size_t max_pages,
     const std::uint64_t read = source_.page_storage_bytes(r.page);
     if (!chosen.empty() && storage + read > max_storage_bytes) break;
     if (r.parent_page != kNoPage && !pages_[r.parent_page]) continue;
-    const std::uint64_t bytes = HierarchyPage::memory_bytes(source_.page_node_count(r.page));
+    const std::uint64_t bytes = source_.page_memory_bytes(r.page);
     if (!make_room(bytes)) continue;
     stats_.resident_bytes += bytes;
     // Keep the parent from being evicted while the page is on its way.
@@ -362,11 +466,15 @@ std::vector<PagedRenderer::Request> PagedRenderer::choose(std::size_t max_pages,
 }
 
 void PagedRenderer::adopt(const Request& r, std::unique_ptr<HierarchyPage> page) {
-  if (page->nodes.size() != source_.page_node_count(r.page) ||
-      page->child_page.size() != page->nodes.size()) {
-    throw FormatError("page " + std::to_string(r.page) + " decoded to " +
-                      std::to_string(page->nodes.size()) + " nodes where the page table says " +
-                      std::to_string(source_.page_node_count(r.page)) +
+  const bool packed = pages_[0] ? pages_[0]->is_packed() : page->is_packed();
+  if (page->node_count() != source_.page_node_count(r.page) ||
+      page->memory_bytes() != source_.page_memory_bytes(r.page) || page->is_packed() != packed ||
+      (!packed && page->child_page.size() != page->nodes.size())) {
+    throw FormatError("page " + std::to_string(r.page) + " loaded as " +
+                      std::to_string(page->node_count()) + " nodes in " +
+                      std::to_string(page->memory_bytes()) + " bytes where the page table says " +
+                      std::to_string(source_.page_node_count(r.page)) + " nodes in " +
+                      std::to_string(source_.page_memory_bytes(r.page)) +
                       "; the model file is corrupt (convert it again)");
   }
   pages_[r.page] = std::move(page);

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -168,14 +169,16 @@ std::vector<Candidate> spec_sphere_table() {
   return t;
 }
 
-TEST(PtlV2, LeavesGetTheSmallestEnclosingCodeInsideTheirParentThenTheLargestTrim) {
+// Checks every third leaf of a file written with `trim` leaf trims (steps of 1/steps).
+void expect_smallest_code_then_largest_trim(quant::LeafTrim trim, int steps, int max_trim) {
   const std::vector<Candidate> table = spec_sphere_table();
   ASSERT_EQ(table.size(), 7621u);
   TempDir dir;
   const SphereTree tree = scene_tree(5000, 50, false);
-  write_ptl_v2(dir.file("c.ptl"), tree, "");
+  write_ptl_v2(dir.file("c.ptl"), tree, "", {.leaf_trim = trim});
   const SphereTree d = PtlV2File::open(dir.file("c.ptl"))->decode_all();
   ASSERT_EQ(d.nodes.size(), tree.nodes.size());
+  const float step = 1.0f / float(steps);
   std::size_t checked = 0, trimmed = 0;
   for (std::size_t p = 0; p < d.nodes.size(); ++p) {
     const SphereNode& parent = d.nodes[p];
@@ -195,18 +198,18 @@ TEST(PtlV2, LeavesGetTheSmallestEnclosingCodeInsideTheirParentThenTheLargestTrim
           best = std::min(best, radius);
         }
       }
-      // The leaf is drawn at that radius trimmed by t/8 (t in 0..3): the largest trim whose
-      // sphere, around the decoded centre, still holds the true leaf.
+      // The leaf is drawn at that radius trimmed by t steps: the largest trim whose sphere,
+      // around the decoded centre, still holds the true leaf.
       const SphereNode& leaf = d.nodes[i];
       int t = -1;
-      for (int trim = 0; trim <= 3; ++trim) {
-        if (leaf.radius == best * (1.0f - 0.125f * float(trim))) t = trim;
+      for (int k_trim = 0; k_trim <= max_trim; ++k_trim) {
+        if (leaf.radius == best * (1.0f - step * float(k_trim))) t = k_trim;
       }
       ASSERT_GE(t, 0) << "leaf " << i << ": radius " << leaf.radius << " is no trim of " << best;
       const double need = dist(leaf.center, tree.nodes[i].center) + double(tree.nodes[i].radius);
       EXPECT_LE(need, double(leaf.radius)) << "leaf " << i;
-      if (t < 3) {
-        EXPECT_GT(need, double(best * (1.0f - 0.125f * float(t + 1)))) << "leaf " << i;
+      if (t < max_trim) {
+        EXPECT_GT(need, double(best * (1.0f - step * float(t + 1)))) << "leaf " << i;
       }
       trimmed += t > 0;
       ++checked;
@@ -214,6 +217,14 @@ TEST(PtlV2, LeavesGetTheSmallestEnclosingCodeInsideTheirParentThenTheLargestTrim
   }
   EXPECT_GT(checked, 1000u);
   EXPECT_GT(trimmed, checked / 10) << "the trim should shrink a good share of the leaves";
+}
+
+TEST(PtlV2, LeavesGetTheSmallestEnclosingCodeInsideTheirParentThenTheLargestTrim) {
+  expect_smallest_code_then_largest_trim(quant::LeafTrim::Sixteenths, 16, 7);
+}
+
+TEST(PtlV2, LeafTrimsInEighthsAsTheFirstVersion2FilesKeepThem) {
+  expect_smallest_code_then_largest_trim(quant::LeafTrim::Eighths, 8, 3);
 }
 
 TEST(PtlV2, EnclosesSpheresOfATreeThatDoesNotNest) {
@@ -430,7 +441,8 @@ TEST(PtlV2, PagesDecodeIndependentlyAndTogetherEqualTheTree) {
   expect_conservative(tree, all);
 }
 
-TEST(PtlV2, GoldenBytes) {
+// The golden file of GoldenBytes, written with `trim`; returns its bytes.
+Bytes golden_file(quant::LeafTrim trim) {
   // Root (0, 0, 0) r 2 over leaves (±1, 0, 0) r 1, no colour, one page.
   SphereTree t;
   t.nodes = {SphereNode{{0, 0, 0}, 2, {0, 0, 1}, 0.5f, 1, 2, {}},
@@ -441,8 +453,12 @@ TEST(PtlV2, GoldenBytes) {
   t.bounds = {{-1, 0, 0}, {1, 0, 0}};
   t.view_sphere = {{0, 0, 0}, 1};
   TempDir dir;
-  write_ptl_v2(dir.file("g.ptl"), t, "hi");
-  const Bytes b = read_bytes(dir.file("g.ptl"));
+  write_ptl_v2(dir.file("g.ptl"), t, "hi", {.leaf_trim = trim});
+  return read_bytes(dir.file("g.ptl"));
+}
+
+TEST(PtlV2, GoldenBytes) {
+  const Bytes b = golden_file(quant::LeafTrim::Sixteenths);
   // clang-format off
   const std::uint8_t head[] = {'P', 'T', 'L', 'S', 'P', 'L', 'A', 'T', 2, 0, 0, 0, 0, 1, 0, 0,
                                4, 3, 2, 1,   // endianness marker
@@ -457,12 +473,13 @@ TEST(PtlV2, GoldenBytes) {
                                0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0x34, 0x33, 0x13, 0x40};
   ASSERT_EQ(b.size(), 256u + 32 + 17 + 3 * 4 + 2);
   EXPECT_EQ(Bytes(b.begin(), b.begin() + sizeof head), Bytes(std::begin(head), std::end(head)));
-  // Schema: sphere bits 0-12, children 13-14, normal 16-29, cone 30-31.
+  // Schema: sphere bits 0-12, children 13-14, normal 16-29, cone 30-31, leaf trim low bit 15.
   const Bytes schema = {1, 0, 1, 0, 0, 13, 0, 0, 2, 0, 1, 0, 13, 2, 0, 0,
-                        3, 0, 1, 0, 16, 14, 0, 0, 4, 0, 1, 0, 30, 2, 0, 0};
+                        3, 0, 1, 0, 16, 14, 0, 0, 4, 0, 1, 0, 30, 2, 0, 0,
+                        6, 0, 1, 0, 15, 1, 0, 0};
   // clang-format on
-  EXPECT_EQ(get_u32(b, 140), 4u);
-  EXPECT_EQ(Bytes(b.begin() + 144, b.begin() + 176), schema);
+  EXPECT_EQ(get_u32(b, 140), 5u);
+  EXPECT_EQ(Bytes(b.begin() + 144, b.begin() + 184), schema);
   // Page table: page 0 at 288, 29 bytes, 3 records, no parent, 1 root, 2 levels.
   EXPECT_EQ(get_u64(b, 256), 288u);
   EXPECT_EQ(get_u32(b, 264), 29u);
@@ -483,14 +500,33 @@ TEST(PtlV2, GoldenBytes) {
   // Leaves, same normal: the left one (centre -1/2.3 in parent units) gets
   // 6861 = (m 7; x 0, y 3, z 3): radius 7/13 of the parent, centre -6/13, the smallest
   // enclosing cube. Its mirror image (x 6) sticks out of the parent by a float rounding, so the
-  // right one gets 7607 = (m 11; x 2, y 1, z 1). Both then take trim 1 in their cone bits: the
-  // left one needs 1 + |-1 - (-6/13)·2.3| = 1.0615 of its 7/13·2.3 = 1.2385 (7/8 of it, 1.0837,
-  // holds; 6/8 does not), the right one 1 + |1 - (2/13)·2.3| = 1.6462 of 11/13·2.3 = 1.9462
-  // (7/8: 1.7029 holds; 6/8: 1.4596 does not).
+  // right one gets 7607 = (m 11; x 2, y 1, z 1). Both then take trim 2/16 (cone bits 1, bit 15
+  // clear): the left one needs 1 + |-1 - (-6/13)·2.3| = 1.0615 of its 7/13·2.3 = 1.2385 (14/16
+  // of it, 1.0837, holds; 13/16, 1.0063, does not), the right one 1 + |1 - (2/13)·2.3| = 1.6462
+  // of 11/13·2.3 = 1.9462 (14/16: 1.7029 holds; 13/16: 1.5813 does not).
   const Bytes records(b.begin() + 305, b.begin() + 317);
   EXPECT_EQ(records,
             (Bytes{0xc4, 0x3d, 0xa2, 0xaf, 0xcd, 0x1a, 0xa2, 0x6f, 0xb7, 0x1d, 0xa2, 0x6f}));
   EXPECT_EQ(std::string(b.end() - 2, b.end()), "hi");
+}
+
+TEST(PtlV2, GoldenBytesWithLeafTrimsInEighths) {
+  // The first version 2 layout: four attributes, and trims of 1/8 in the cone bits (here 1/8,
+  // the same bits as 2/16 above), so the files differ only in the schema.
+  const Bytes b = golden_file(quant::LeafTrim::Eighths);
+  const Bytes sixteenths = golden_file(quant::LeafTrim::Sixteenths);
+  ASSERT_EQ(b.size(), sixteenths.size());
+  EXPECT_EQ(get_u32(b, 140), 4u);
+  EXPECT_EQ(Bytes(b.begin() + 176, b.begin() + 184), Bytes(8, 0));
+  EXPECT_EQ(Bytes(b.begin() + 184, b.end()), Bytes(sixteenths.begin() + 184, sixteenths.end()));
+  TempDir dir;
+  write_bytes(dir.file("e.ptl"), b);
+  const auto file = PtlV2File::open(dir.file("e.ptl"));
+  EXPECT_EQ(file->leaf_trim(), quant::LeafTrim::Eighths);
+  const float header_radius = std::bit_cast<float>(get_u32(b, 92));
+  const SphereTree d = file->decode_all();
+  EXPECT_EQ(d.nodes[0].radius, header_radius);  // code 7620: the parent's own sphere
+  EXPECT_EQ(d.nodes[1].radius, header_radius * quant::sphere_table()[6861].r * 0.875f);
 }
 
 // Message of the FormatError that opening and decoding `bytes` (written to `path`) throws.

@@ -13,9 +13,12 @@
 #include <vector>
 
 #include "pointillist/core/math.hpp"
+#include "pointillist/lod/quantization.hpp"
 #include "pointillist/lod/sphere_tree.hpp"
 
 namespace pointillist {
+
+struct PackedPage;  // render/paged.hpp
 
 constexpr std::uint32_t kPtlV2Version = 2;
 
@@ -30,6 +33,10 @@ struct PtlV2WriteOptions {
   // mean finer-grained loading and a slightly larger page table; the top page holds as many
   // whole coarse levels as fit.
   std::uint32_t page_bytes = 32 * 1024;
+  // How leaves keep their radius trim: in sixteenths of the decoded radius (default; leaves
+  // 1.24x their true radius on the dragon), or in eighths (1.28x), the encoding of the first
+  // version 2 files, which Pointillist before 2026-11-24 reads.
+  quant::LeafTrim leaf_trim = quant::LeafTrim::Sixteenths;
 };
 
 // What write_ptl_v2 did.
@@ -113,6 +120,12 @@ class PtlV2File {
   // Reuses `out`'s buffers. Throws FormatError naming the file and byte offset.
   void decode_page(std::uint32_t page, PtlV2Page& out) const;
 
+  // Copies page `page`'s records into `out` in their packed form (decoded later, during the
+  // traversal), with the first-child links of the nodes whose children are in the page and
+  // last_level_begin, root_parent (page 0) and leaf_trim; out.links is left empty for the
+  // caller, who knows the child pages. Validates the page as decode_page does.
+  void pack_page(std::uint32_t page, PackedPage& out) const;
+
   // The whole hierarchy, breadth-first, node i being node i of the tree that was written:
   // decoded spheres (each enclosing the written sphere and its decoded children), decoded
   // normals, cone_sin ((k + 1)/4)² for cone codes k < 3, 2 (no bound) for 3, 0 for leaves,
@@ -121,6 +134,8 @@ class PtlV2File {
   SphereTree decode_all() const;
 
   bool has_colors() const { return has_colors_; }
+  // How the leaves keep their radius trim (from the attribute schema).
+  quant::LeafTrim leaf_trim() const { return leaf_trim_; }
   std::uint64_t node_count() const { return node_count_; }
   std::uint64_t leaf_count() const { return leaf_count_; }
   std::uint32_t depth() const { return depth_; }
@@ -132,12 +147,25 @@ class PtlV2File {
 
  private:
   struct Mapping;
+  // The parent of a record in its page: root `index` of the page's root table, or record `index`.
+  struct PageParent {
+    bool is_root = false;
+    std::uint32_t index = 0;
+  };
   PtlV2File() = default;
+  // Validates page `page` (root table, then each record and the level structure) and calls
+  // on_record(index, record bits 0..31, RGB 565 or 0, parent, is_first_child) for each record in
+  // order. Returns the index of the first record of the last level.
+  template <class OnRecord>
+  std::uint32_t scan_page(std::uint32_t page, std::vector<Sphere>& root_spheres,
+                          std::vector<std::uint8_t>& root_child_counts,
+                          OnRecord&& on_record) const;
   std::string path_;
   std::unique_ptr<Mapping> map_;
   std::uint64_t size_ = 0;
   std::uint32_t record_size_ = 4;
   bool has_colors_ = false;
+  quant::LeafTrim leaf_trim_ = quant::LeafTrim::Eighths;
   std::uint64_t node_count_ = 0, leaf_count_ = 0;
   std::uint32_t depth_ = 0;
   Sphere root_sphere_;

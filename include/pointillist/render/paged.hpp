@@ -12,6 +12,7 @@
 
 #include "pointillist/core/camera.hpp"
 #include "pointillist/core/thread_pool.hpp"
+#include "pointillist/lod/quantization.hpp"
 #include "pointillist/lod/sphere_tree.hpp"
 #include "pointillist/render/render.hpp"
 
@@ -19,18 +20,65 @@ namespace pointillist {
 
 inline constexpr std::uint32_t kNoPage = 0xffffffffu;
 
-// One page: a connected part of the hierarchy. Page 0 holds the root (nodes[0]) and the levels
-// below it; any other page holds the children of one or more nodes of another page (its
-// anchors), then their descendants. A node's children are nodes[first_child ..
-// first_child + child_count) of its own page when child_page[i] is kNoPage, and of page
-// child_page[i] otherwise.
+// Where the children of a node are when another page holds them: nodes [first, first +
+// child_count) of page `page`.
+struct PageLink {
+  std::uint32_t page = kNoPage;
+  std::uint32_t first = 0;
+};
+
+// A page kept in the packed form of a quantized model file (lod/quantization.hpp) and decoded
+// during the traversal, each node against its decoded parent: 4 bytes a node (6 with colour)
+// and a 2-byte link, where decoded nodes take 44.
+struct PackedPage {
+  std::vector<std::uint32_t> records;  // packed node records, breadth-first over the page
+  std::vector<std::uint16_t> colors;   // RGB 565, one per record, when the model has colours
+  // Per node with children: for i < last_level_begin, its first child is node i + link(i) of
+  // this page; for i >= last_level_begin, links[link(i)] says where its children are. 0 for
+  // leaves. link16 for pages of up to 65,535 nodes, link32 (and link16 empty) for larger ones.
+  std::vector<std::uint16_t> link16;
+  std::vector<std::uint32_t> link32;
+  std::vector<PageLink> links;
+  std::uint32_t last_level_begin = 0;
+  // Page 0: the sphere its first record (the root) decodes against.
+  Sphere root_parent;
+  quant::LeafTrim leaf_trim = quant::LeafTrim::Eighths;
+
+  std::uint32_t link(std::uint32_t i) const { return link16.empty() ? link32[i] : link16[i]; }
+  // Bytes of memory a packed page of `node_count` nodes and `link_count` links takes.
+  static std::uint64_t memory_bytes(std::uint64_t node_count, std::uint64_t link_count,
+                                    bool has_colors) {
+    return node_count * (sizeof(std::uint32_t) + (has_colors ? sizeof(std::uint16_t) : 0) +
+                         (node_count > 0xffff ? sizeof(std::uint32_t) : sizeof(std::uint16_t))) +
+           link_count * sizeof(PageLink);
+  }
+};
+
+// One page: a connected part of the hierarchy. Page 0 holds the root and the levels below it;
+// any other page holds the children of one or more nodes of another page (its anchors), then
+// their descendants.
+//
+// Decoded form (`nodes` not empty): a node's children are nodes[first_child .. first_child +
+// child_count) of its own page when child_page[i] is kNoPage, and of page child_page[i]
+// otherwise. Packed form (`nodes` empty): see PackedPage.
 struct HierarchyPage {
   std::vector<SphereNode> nodes;
   std::vector<std::uint32_t> child_page;  // one per node; kNoPage: children (if any) are here
+  PackedPage packed;
 
-  // What a page of `node_count` nodes costs in memory while it is resident.
+  bool is_packed() const { return nodes.empty(); }
+  std::uint32_t node_count() const {
+    return static_cast<std::uint32_t>(is_packed() ? packed.records.size() : nodes.size());
+  }
+  // What a decoded page of `node_count` nodes costs in memory while it is resident.
   static std::uint64_t memory_bytes(std::uint64_t node_count) {
     return node_count * (sizeof(SphereNode) + sizeof(std::uint32_t));
+  }
+  // What this page costs in memory while it is resident.
+  std::uint64_t memory_bytes() const {
+    return is_packed() ? PackedPage::memory_bytes(packed.records.size(), packed.links.size(),
+                                                  !packed.colors.empty())
+                       : memory_bytes(nodes.size());
   }
 };
 
@@ -41,15 +89,17 @@ class PageSource {
   virtual std::uint32_t page_count() const = 0;
   // Bytes read from storage to load the page.
   virtual std::uint64_t page_storage_bytes(std::uint32_t page) const = 0;
-  // Nodes in the page (what it will cost in memory: HierarchyPage::memory_bytes of that many).
+  // Nodes in the page.
   virtual std::uint32_t page_node_count(std::uint32_t page) const = 0;
+  // Memory the loaded page takes while resident (HierarchyPage::memory_bytes()).
+  virtual std::uint64_t page_memory_bytes(std::uint32_t page) const = 0;
   // Bytes read to open the model (header, page table), before any page.
   virtual std::uint64_t open_bytes() const = 0;
   // Counts and boxes of the whole model (nodes stays empty): leaf_count, depth, bounds,
   // view_sphere (for the camera) and has_colors.
   virtual SphereTreeView summary() const = 0;
-  // Loads page `page` into `out`. `anchor` is the page's anchor node as the parent page gave it
-  // (null for page 0); a quantized format decodes the page's spheres relative to it. Safe to
+  // Loads page `page` into `out`, decoded or packed (every page of a source in the same form).
+  // `anchor` is the page's anchor node as the parent page gave it (null for page 0). Safe to
   // call concurrently for different pages. Throws FormatError or IoError.
   virtual void load(std::uint32_t page, const SphereNode* anchor, HierarchyPage& out) const = 0;
 };
@@ -125,6 +175,10 @@ class PagedRenderer {
     SphereNode anchor;
     float priority;  // the anchor's projected radius: larger first
   };
+  struct Selection;
+  // The traversal over decoded or packed pages (Access: see paged_render.cpp).
+  template <class Access>
+  void select(const Access& access, Selection& selection, ThreadPool& pool);
   bool make_room(std::uint64_t bytes);
   // Chooses requests to load (see load_requested), reserving their memory; clears requests_.
   std::vector<Request> choose(std::size_t max_pages, std::uint64_t max_storage_bytes);
@@ -146,6 +200,7 @@ class PagedRenderer {
   // What each selection task produced in the last frame.
   struct TaskOut {
     std::vector<const SphereNode*> emitted;  // the nodes of its splats, in its chunk's order
+    std::vector<SphereNode> values;          // the same for packed pages: decoded copies
     std::deque<SphereNode> stand_ins;        // copies of stand-ins lit from the front
     std::vector<Request> requests;     // pages it wanted, in traversal order
     std::vector<std::uint32_t> touched;  // resident pages it used below the top

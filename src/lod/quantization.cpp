@@ -1,0 +1,142 @@
+// QSplat's code tables (Rusinkiewicz & Levoy, SIGGRAPH 2000), generated as
+// ../shared/specs/qsplat-qs-format.md §4.1 and §5.1 describe. The float32 expressions follow the
+// spec's order of operations exactly: the .qs writer must reproduce QSplat 1.0's bits (§8.6).
+#include "pointillist/lod/quantization.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+namespace pointillist::quant {
+namespace {
+
+struct SphereTables {
+  std::array<SphereCandidate, kSphereCodeCount> entries;
+  // code[((m * 13 + x) * 13 + y) * 13 + z], -1 where the cube is not in the table.
+  std::vector<std::int16_t> code;
+};
+
+SphereTables make_sphere_tables() {
+  SphereTables t;
+  t.code.assign(std::size_t{14} * 13 * 13 * 13, -1);
+  // The table is float32 throughout (1/13 as a float32 constant): it matches QSplat 1.0's bit
+  // for bit, which the writer needs because it encodes children against decoded parents.
+  const float c = 1.0f / 13.0f;
+  const double sqrt3 = std::numbers::sqrt3;
+  std::uint32_t next = 0;
+  for (int m = 1; m <= kSphereGrid; ++m) {
+    for (int x = 0; x <= kSphereGrid - m; ++x) {
+      for (int y = 0; y <= kSphereGrid - m; ++y) {
+        for (int z = 0; z <= kSphereGrid - m; ++z) {
+          SphereCandidate s;
+          s.x = float(m + 2 * x) * c - 1.0f;
+          s.y = float(m + 2 * y) * c - 1.0f;
+          s.z = float(m + 2 * z) * c - 1.0f;
+          s.r = float(m) * c;
+          // Keep cubes whose circumscribed sphere (radius √3·R) reaches the unit ball; no
+          // candidate is within 1e-4 of this boundary, so double or float decide alike.
+          const double d2 = double(s.x) * s.x + double(s.y) * s.y + double(s.z) * s.z;
+          const double reach = 1.0 + sqrt3 * s.r;
+          if (d2 > reach * reach) continue;
+          t.entries[next] = s;
+          t.code[((std::size_t(m) * 13 + x) * 13 + y) * 13 + z] = static_cast<std::int16_t>(next);
+          ++next;
+        }
+      }
+    }
+  }
+  return t;
+}
+
+const SphereTables& sphere_tables() {
+  static const SphereTables tables = make_sphere_tables();
+  return tables;
+}
+
+// Decoded normals of all 16224 codes (spec §5.1).
+std::vector<Vec3f> make_normal_table() {
+  std::array<float, kNormalGrid> g{};
+  for (int i = 0; i < kNormalGrid; ++i) {
+    const double t = ((i + 0.5) * 2.0 / kNormalGrid - 1.0) * std::numbers::pi / 4.0;
+    g[i] = float(std::tan(t));
+  }
+  std::vector<Vec3f> table(kNormalCodeCount);
+  for (std::uint32_t q = 0; q < kNormalCodeCount; ++q) {
+    const std::uint32_t a = q / (kNormalGrid * kNormalGrid);
+    const float u = g[(q / kNormalGrid) % kNormalGrid], v = g[q % kNormalGrid];
+    const float w2 = 1.0f - u * u - v * v;
+    // Grid corners off the sphere (never written by an encoder): put them on the cube face's
+    // edge instead of QSplat 1.0's NaN.
+    const float w = w2 > 0 ? std::sqrt(w2) : 0.0f;
+    Vec3f n;
+    switch (a) {
+      case 0: n = {w, u, v}; break;
+      case 1: n = {-w, u, v}; break;
+      case 2: n = {v, w, u}; break;
+      case 3: n = {v, -w, u}; break;
+      case 4: n = {u, v, w}; break;
+      default: n = {u, v, -w}; break;
+    }
+    table[q] = w2 > 0 ? n : normalized(n);
+  }
+  return table;
+}
+
+// Floor of a finite or non-finite float, clamped to [lo, hi] (NaN gives lo).
+int clamped_floor(float f, int lo, int hi) {
+  f = std::floor(f);
+  if (!(f >= float(lo))) return lo;
+  if (f > float(hi)) return hi;
+  return int(f);
+}
+
+// Cell 0..51 of one raw normal component on the atan-warped face grid (spec §5.2): atan(t)·4 in
+// float32, the division by π in double, then rounded to float32.
+int normal_cell(float t) {
+  const float warped = std::atan(t) * 4.0f;
+  float w = float(double(warped) / std::numbers::pi);
+  w = std::clamp(w, -1.0f, 1.0f);
+  return clamped_floor((w + 1.0f) * 0.5f * float(kNormalGrid), 0, kNormalGrid - 1);
+}
+
+}  // namespace
+
+std::span<const SphereCandidate, kSphereCodeCount> sphere_table() {
+  return sphere_tables().entries;
+}
+
+int sphere_code(int m, int x, int y, int z) {
+  if (m < 1 || m > kSphereGrid) return -1;
+  const int last = kSphereGrid - m;
+  if (x < 0 || y < 0 || z < 0 || x > last || y > last || z > last) return -1;
+  return sphere_tables().code[((std::size_t(m) * 13 + x) * 13 + y) * 13 + z];
+}
+
+std::span<const Vec3f, kNormalCodeCount> normal_table() {
+  static const std::vector<Vec3f> table = make_normal_table();
+  return std::span<const Vec3f, kNormalCodeCount>(table.data(), kNormalCodeCount);
+}
+
+std::uint32_t encode_normal(Vec3f n) {
+  const float ax = std::fabs(n.x), ay = std::fabs(n.y), az = std::fabs(n.z);
+  // Ties go to the later axis (y over x, z over either), as QSplat 1.0 decides.
+  std::uint32_t face;
+  if (ax > ay) {
+    face = (ax > az) ? (n.x > 0 ? 0 : 1) : (n.z > 0 ? 4 : 5);
+  } else {
+    face = (ay > az) ? (n.y > 0 ? 2 : 3) : (n.z > 0 ? 4 : 5);
+  }
+  float u, v;
+  if (face < 2) {
+    u = n.y, v = n.z;
+  } else if (face < 4) {
+    u = n.z, v = n.x;
+  } else {
+    u = n.x, v = n.y;
+  }
+  return (face * kNormalGrid + std::uint32_t(normal_cell(u))) * kNormalGrid +
+         std::uint32_t(normal_cell(v));
+}
+
+}  // namespace pointillist::quant
