@@ -54,7 +54,7 @@ class PtlV2Pages final : public PageSource {
     PackedPage& packed = out.packed;
     file_.pack_page(page, packed);
     const auto corrupt = [&](std::uint32_t node, const std::string& what) {
-      throw FormatError("page " + str(page) + ", node " + str(node) + ": " + what +
+      throw FormatError(file_.path() + ": page " + str(page) + ", node " + str(node) + ": " + what +
                         "; the model file is corrupt (convert it again)");
     };
     // Link the last level's interior nodes to the child pages that hold their children.

@@ -16,6 +16,7 @@
 #include <random>
 #include <vector>
 
+#include "format/format_test_support.hpp"
 #include "lod/sphere_points.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/format/ptl.hpp"
@@ -30,58 +31,12 @@ namespace pointillist {
 namespace {
 
 using testing::TempDir;
-using Bytes = std::vector<std::uint8_t>;
+using namespace format_test;  // NOLINT(google-build-using-namespace)
 
 // Layout constants from docs/ptl-format.md, written out so a layout change fails the tests.
 constexpr std::size_t kPageTableAt = 256;
 constexpr std::size_t kPageEntryBytes = 32;
 constexpr std::size_t kRootEntryBytes = 17;
-
-Bytes read_bytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-void write_bytes(const std::string& path, const Bytes& bytes) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
-}
-
-std::uint32_t get_u32(const Bytes& b, std::size_t at) {
-  std::uint32_t v = 0;
-  for (std::size_t i = 0; i < 4; ++i) v |= std::uint32_t{b.at(at + i)} << (8 * i);
-  return v;
-}
-std::uint64_t get_u64(const Bytes& b, std::size_t at) {
-  return get_u32(b, at) | std::uint64_t{get_u32(b, at + 4)} << 32;
-}
-void put_u32(Bytes& b, std::size_t at, std::uint32_t v) {
-  for (std::size_t i = 0; i < 4; ++i) b.at(at + i) = std::uint8_t(v >> (8 * i));
-}
-
-// Samples of the demo scene (sphere, torus, cube) with exact normals, radii from prepare_splats
-// (5-nearest-neighbour spacing), colours from the position when asked.
-PointSet scene_points(std::size_t count, std::uint64_t seed, bool colors,
-                      const AnalyticScene& scene = demo_scene()) {
-  SurfaceSamples s = sample_scene(scene, count, seed);
-  PointSet p = std::move(s.points);
-  p.normals = std::move(s.true_normals);
-  if (colors) {
-    for (const Vec3f& x : p.positions) {
-      p.colors.push_back({std::uint8_t(int(std::abs(x.x) * 97) % 256),
-                          std::uint8_t(int(std::abs(x.y) * 131) % 256),
-                          std::uint8_t(int(std::abs(x.z) * 53) % 256)});
-    }
-  }
-  ThreadPool pool(2);
-  prepare_splats(p, pool, Progress::none(), {.normals = NormalSource::Keep});
-  return p;
-}
-
-SphereTree scene_tree(std::size_t count, std::uint64_t seed, bool colors) {
-  ThreadPool pool(2);
-  return build_sphere_tree(scene_points(count, seed, colors), pool);
-}
 
 double dist(Vec3f a, Vec3f b) {
   const double dx = double(a.x) - b.x, dy = double(a.y) - b.y, dz = double(a.z) - b.z;

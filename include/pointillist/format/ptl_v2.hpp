@@ -144,6 +144,7 @@ class PtlV2File {
   const Sphere& view_sphere() const { return view_sphere_; }
   const std::string& metadata() const { return metadata_; }
   std::uint64_t file_size() const { return size_; }
+  const std::string& path() const { return path_; }
 
  private:
   struct Mapping;

@@ -1,0 +1,200 @@
+// Paged rendering straight from .ptl version 2 files: pages stay packed and are decoded during
+// the traversal. The reference is the in-memory renderer over the whole decoded model
+// (PtlV2File::decode_all), whose decoder is separate code.
+#include "pointillist/format/ptl_v2_pages.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+#include <string>
+#include <vector>
+
+#include "format/format_test_support.hpp"
+#include "pointillist/core/error.hpp"
+#include "pointillist/format/ptl_v2.hpp"
+#include "pointillist/render/paged.hpp"
+#include "pointillist/render/render.hpp"
+#include "testing/testing.hpp"
+
+using namespace pointillist;
+using namespace pointillist::format_test;  // NOLINT(google-build-using-namespace)
+using pointillist::testing::TempDir;
+
+namespace {
+
+constexpr std::size_t kPageTableAt = 256, kPageEntryBytes = 32, kRootEntryBytes = 17;
+
+// Renders until nothing more is wanted (every page the view needs is resident).
+void render_settled(PagedRenderer& r, const Camera& cam, const RenderSettings& settings,
+                    ThreadPool& pool, Frame& frame) {
+  for (int i = 0; i < 500; ++i) {
+    r.render(cam, settings, pool, frame);
+    if (r.complete() || r.load_requested(pool) == 0) return;
+  }
+  FAIL() << "did not settle";
+}
+
+struct Variant {
+  bool colors;
+  quant::LeafTrim trim;
+};
+
+}  // namespace
+
+TEST(PtlV2Pages, FullyResidentFramesAreBitIdenticalToTheDecodedModel) {
+  ThreadPool pool(2);
+  TempDir dir;
+  for (const Variant variant : {Variant{false, quant::LeafTrim::Sixteenths},
+                                Variant{true, quant::LeafTrim::Sixteenths},
+                                Variant{true, quant::LeafTrim::Eighths}}) {
+    SCOPED_TRACE(std::string(variant.colors ? "colours, " : "no colours, ") +
+                 (variant.trim == quant::LeafTrim::Eighths ? "eighths" : "sixteenths"));
+    const std::string path = dir.file("m.ptl");
+    write_ptl_v2(path, scene_tree(20000, 61, variant.colors), "",
+                 {.page_bytes = 1024, .leaf_trim = variant.trim});
+    const auto file = PtlV2File::open(path);
+    ASSERT_GT(file->page_count(), 20u);
+    const SphereTree decoded = file->decode_all();
+    const auto source = ptl_v2_page_source(*file);
+    PagedRenderer paged(*source, UINT64_MAX, pool);
+    for (const float azimuth : {0.0f, 130.0f}) {
+      for (const bool backface : {true, false}) {
+        const Camera cam = orbit_camera(file->view_sphere(),
+                                        {.azimuth_deg = azimuth, .elevation_deg = 25,
+                                         .distance = 1.6f, .width = 240, .height = 180});
+        RenderSettings settings;
+        settings.backface_culling = backface;
+        Frame expected, frame;
+        render(decoded.view(), cam, settings, pool, expected);
+        render_settled(paged, cam, settings, pool, frame);
+        EXPECT_EQ(frame.stats.splats, expected.stats.splats) << "azimuth " << azimuth;
+        EXPECT_EQ(frame.stats.nodes_visited, expected.stats.nodes_visited);
+        EXPECT_TRUE(frame.color == expected.color) << "azimuth " << azimuth;
+        EXPECT_TRUE(frame.depth == expected.depth) << "azimuth " << azimuth;
+      }
+    }
+  }
+}
+
+TEST(PtlV2Pages, ResidentPagesTakeAboutTheFilesBytesNotTheDecodedNodes) {
+  ThreadPool pool(2);
+  TempDir dir;
+  for (const bool colors : {false, true}) {
+    const std::string path = dir.file("m.ptl");
+    const PtlV2WriteReport report =
+        write_ptl_v2(path, scene_tree(20000, 62, colors), "", {.page_bytes = 4096});
+    const auto file = PtlV2File::open(path);
+    const auto source = ptl_v2_page_source(*file);
+    PagedRenderer paged(*source, UINT64_MAX, pool);
+    const Camera cam = orbit_camera(file->view_sphere(), {.width = 320, .height = 240});
+    Frame frame;
+    render_settled(paged, cam, RenderSettings{}, pool, frame);
+    // Every node as its record (4 bytes, 6 with colour) and a 2-byte link; every child page's
+    // root as an 8-byte link.
+    std::uint64_t resident_nodes = 0, links = 0;
+    for (std::uint32_t p = 0; p < file->page_count(); ++p) {
+      links += p > 0 ? file->page_info(p).root_count : 0;
+    }
+    for (std::uint32_t p = 0; p < file->page_count(); ++p) {
+      resident_nodes += file->page_info(p).node_count;
+    }
+    ASSERT_EQ(paged.stats().resident_pages, file->page_count()) << "a whole view of the model";
+    const std::uint64_t per_node = colors ? 8 : 6;
+    EXPECT_EQ(paged.stats().resident_bytes, resident_nodes * per_node + links * 8);
+    // Against the file's records: 1.5 times them (1.33 with colours) plus the links.
+    EXPECT_LE(double(paged.stats().resident_bytes), 1.6 * double(report.record_bytes));
+    // Decoded, the same nodes would take 44 bytes each.
+    EXPECT_LT(paged.stats().resident_bytes * 5, HierarchyPage::memory_bytes(resident_nodes));
+  }
+}
+
+TEST(PtlV2Pages, ChildPageWhoseRootsDisagreeWithTheParentRecordIsRejectedOnLoad) {
+  ThreadPool pool(2);
+  TempDir dir;
+  const std::string path = dir.file("m.ptl");
+  write_ptl_v2(path, scene_tree(6000, 63, false), "", {.page_bytes = 1024});
+  Bytes b = read_bytes(path);
+  ASSERT_GT(get_u32(b, 52), 2u);
+  // Page 1's first root claims one child fewer or more than its record in page 0 says.
+  const std::size_t entry1 = kPageTableAt + kPageEntryBytes;
+  const std::size_t page1 = get_u64(b, entry1);
+  const std::uint32_t roots = get_u32(b, entry1 + 24);
+  const std::size_t count_at = page1 + 16 * roots;
+  ASSERT_GE(b[count_at], 2);
+  ASSERT_LE(b[count_at], 4);
+  b[count_at] = b[count_at] == 4 ? 3 : b[count_at] + 1;
+  write_bytes(path, b);
+  const auto file = PtlV2File::open(path);
+  const auto source = ptl_v2_page_source(*file);
+  HierarchyPage page;
+  try {
+    source->load(1, nullptr, page);
+    ADD_FAILURE() << "no error";
+  } catch (const FormatError& e) {
+    const std::string m = e.what();
+    // Either the page's own levels no longer add up, or its root disagrees with the record.
+    EXPECT_NE(m.find(path + ": byte "), std::string::npos) << m;
+    EXPECT_NE(m.find("page 1"), std::string::npos) << m;
+  }
+}
+
+TEST(PtlV2Pages, Bit15IsALeafTrimBitOnlyWhereTheSchemaSaysSo) {
+  TempDir dir;
+  for (const auto trim : {quant::LeafTrim::Eighths, quant::LeafTrim::Sixteenths}) {
+    const std::string path = dir.file("m.ptl");
+    write_ptl_v2(path, scene_tree(3000, 64, false), "", {.page_bytes = 1024, .leaf_trim = trim});
+    const Bytes good = read_bytes(path);
+    const std::size_t page0 = get_u64(good, kPageTableAt);
+    const std::size_t root_record = page0 + kRootEntryBytes;  // page 0 has one root entry
+    // The root is an interior node: bit 15 set is an error in either layout.
+    Bytes b = good;
+    b[root_record + 1] |= 0x80;
+    write_bytes(path, b);
+    const auto file = PtlV2File::open(path);
+    const auto source = ptl_v2_page_source(*file);
+    HierarchyPage page;
+    try {
+      source->load(0, nullptr, page);
+      ADD_FAILURE() << "no error";
+    } catch (const FormatError& e) {
+      EXPECT_NE(std::string(e.what()).find("reserved bit 15"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(": byte " + std::to_string(root_record + 1)),
+                std::string::npos)
+          << e.what();
+    }
+  }
+}
+
+TEST(PtlV2Pages, RandomCorruptionIsRejectedOrRenderedNeverMisread) {
+  // Seeded random byte flips in the pages, then a paged render of every page the view wants:
+  // loading either succeeds (a flipped code is still a valid code) or throws FormatError; under
+  // ASan this also checks that the traversal never reads outside a page.
+  ThreadPool pool(2);
+  TempDir dir;
+  const std::string path = dir.file("fuzz.ptl");
+  write_ptl_v2(path, scene_tree(4000, 65, true), "meta", {.page_bytes = 1024});
+  const Bytes good = read_bytes(path);
+  const std::size_t pages_at = get_u64(good, kPageTableAt);
+  std::mt19937 rng(66);
+  std::size_t rejected = 0;
+  for (int trial = 0; trial < 150; ++trial) {
+    Bytes b = good;
+    for (int k = 0; k < 1 + trial % 4; ++k) {
+      b[pages_at + rng() % (b.size() - pages_at)] ^= std::uint8_t(1u << (rng() % 8));
+    }
+    write_bytes(path, b);
+    try {
+      const auto file = PtlV2File::open(path);
+      const auto source = ptl_v2_page_source(*file);
+      PagedRenderer paged(*source, UINT64_MAX, pool);
+      const Camera cam = orbit_camera(file->view_sphere(),
+                                      {.azimuth_deg = float(trial * 7), .width = 96, .height = 72});
+      Frame frame;
+      render_settled(paged, cam, RenderSettings{}, pool, frame);
+    } catch (const FormatError& e) {
+      ++rejected;
+      EXPECT_NE(std::string(e.what()).find("page "), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_GT(rejected, 10u);  // most flips in records give other valid codes
+}
