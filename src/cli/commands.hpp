@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "pointillist/core/camera.hpp"
+#include "pointillist/lod/quantization.hpp"
 #include "pointillist/prep/prepare.hpp"
 #include "pointillist/render/quality.hpp"
 #include "pointillist/render/render.hpp"
@@ -20,6 +21,9 @@ struct ConvertOptions {
   std::string columns;  // --columns for text inputs (empty = detect)
   bool ascii = false;  // .ply output only
   unsigned ptl_version = 2;  // --ptl-version: 2 (quantized, paged) or 1 (float nodes)
+  // --leaf-trim: how .ptl v2 leaves keep their radius trim (sixteenths; eighths for readers
+  // older than 2026-11-24). Unset: the default, allowed with any output.
+  std::optional<quant::LeafTrim> leaf_trim;
   unsigned threads = 0;
   bool quiet = false;
 };

@@ -47,6 +47,9 @@ int run_convert(const ConvertOptions& o) {
     throw OptionError("convert: --ptl-version " + std::to_string(o.ptl_version) +
                       " does not exist; use 2 (compact, the default) or 1 (float nodes)");
   }
+  if (o.leaf_trim && !(to_ptl && o.ptl_version == 2)) {
+    throw OptionError("convert: --leaf-trim applies only to .ptl version 2 output; drop it");
+  }
   const auto start = std::chrono::steady_clock::now();
   ThreadPool pool(o.threads);
   TerminalProgress progress(!o.quiet && TerminalProgress::stderr_is_terminal());
@@ -75,7 +78,9 @@ int run_convert(const ConvertOptions& o) {
     if (o.ptl_version == 1) {
       write_ptl(o.output, tree, meta.str());
     } else {
-      write_ptl_v2(o.output, tree, meta.str());
+      PtlV2WriteOptions v2;
+      if (o.leaf_trim) v2.leaf_trim = *o.leaf_trim;
+      write_ptl_v2(o.output, tree, meta.str(), v2);
     }
   } else {
     ProgressPhase phase(progress, "write", 0);

@@ -161,6 +161,15 @@ int main(int argc, char** argv) {
                           ".ptl version to write: 2 (quantized, paged; the default) or 1 (float "
                           "nodes, 40 bytes each)")
       ->default_val(2);
+  const std::map<std::string, pointillist::quant::LeafTrim> trims{
+      {"sixteenths", pointillist::quant::LeafTrim::Sixteenths},
+      {"eighths", pointillist::quant::LeafTrim::Eighths}};
+  convert_cmd
+      ->add_option("--leaf-trim", convert.leaf_trim,
+                   ".ptl v2: steps in which leaves keep their radius trim: sixteenths (the "
+                   "default, tighter splats) or eighths (files that Pointillist before "
+                   "2026-11-24 reads)")
+      ->transform(CLI::CheckedTransformer(trims, CLI::ignore_case));
   add_threads(convert_cmd, convert.threads);
   convert_cmd->add_flag("-q,--quiet", convert.quiet, "No progress bars and no summary");
 

@@ -51,12 +51,14 @@ bool encloses(const Sphere& outer, const Sphere& inner) {
          double(outer.radius);
 }
 
-std::uint32_t encode_enclosing_sphere(const Sphere& parent, const Sphere& target, bool* exact) {
+namespace {
+
+// The search of encode_enclosing_sphere and encode_enclosing_leaf: for each cube size m from
+// the smallest that can hold `target`, every code whose decoded sphere holds `target` and lies
+// inside `parent` is offered to `offer(code, decoded, m)`, which returns false to stop.
+template <class Offer>
+void search_enclosing(const Sphere& parent, const Sphere& target, Offer&& offer) {
   const double rho = parent.radius;
-  if (!(rho > 0) || !std::isfinite(rho)) {
-    *exact = encloses(parent, target);
-    return kParentCode;
-  }
   // Target in parent units; a candidate of size m has radius R = m/13 and centre coordinates
   // X = (m + 2x)/13 - 1 (spec §4.1). It can only qualify when every |X - t| <= R - s (encloses)
   // and |X| <= 1 - R (inside), which bounds x, y, z; the exact test runs on the decoded floats.
@@ -80,8 +82,6 @@ std::uint32_t encode_enclosing_sphere(const Sphere& parent, const Sphere& target
       empty = x_lo > x_hi || lo[a] > hi[a];
     }
     if (empty) continue;
-    int best = -1;
-    double best_distance = std::numeric_limits<double>::infinity();
     for (int x = lo[0]; x <= hi[0]; ++x) {
       for (int y = lo[1]; y <= hi[1]; ++y) {
         for (int z = lo[2]; z <= hi[2]; ++z) {
@@ -89,18 +89,68 @@ std::uint32_t encode_enclosing_sphere(const Sphere& parent, const Sphere& target
           if (code < 0) continue;
           const Sphere d = qs_detail::decode_sphere(parent, std::uint32_t(code));
           if (!encloses(d, target) || !encloses(parent, d)) continue;
-          const double dist = distance_squared(d.center, target.center);
-          if (dist < best_distance) best = code, best_distance = dist;  // ties: lower code
+          if (!offer(std::uint32_t(code), d, m)) return;
         }
       }
     }
-    if (best >= 0) {
-      *exact = true;
-      return std::uint32_t(best);
-    }
+  }
+}
+
+}  // namespace
+
+std::uint32_t encode_enclosing_sphere(const Sphere& parent, const Sphere& target, bool* exact) {
+  if (!(parent.radius > 0) || !std::isfinite(parent.radius)) {
+    *exact = encloses(parent, target);
+    return kParentCode;
+  }
+  // The smallest size with a qualifying code, then the code nearest the target's centre (ties:
+  // the lower code, the order of the search).
+  int best = -1, best_m = 0;
+  double best_distance = std::numeric_limits<double>::infinity();
+  search_enclosing(parent, target, [&](std::uint32_t code, const Sphere& d, int m) {
+    if (best >= 0 && m > best_m) return false;
+    const double dist = distance_squared(d.center, target.center);
+    if (dist < best_distance) best = int(code), best_m = m, best_distance = dist;
+    return true;
+  });
+  if (best >= 0) {
+    *exact = true;
+    return std::uint32_t(best);
   }
   *exact = encloses(parent, target);
   return kParentCode;
+}
+
+LeafCode encode_enclosing_leaf(const Sphere& parent, const Sphere& target, LeafTrim mode) {
+  const auto trimmed = [&](std::uint32_t code, const Sphere& d) {
+    // The largest trim whose sphere around the decoded centre still holds the target.
+    std::uint32_t t = 0;
+    while (t < max_leaf_trim(mode) &&
+           encloses({d.center, trimmed_leaf_radius(d.radius, t + 1, mode)}, target)) {
+      ++t;
+    }
+    return LeafCode{code, t, trimmed_leaf_radius(d.radius, t, mode), true};
+  };
+  if (!(parent.radius > 0) || !std::isfinite(parent.radius)) {
+    LeafCode c = trimmed(kParentCode, parent);
+    c.exact = encloses(parent, target);
+    return c;
+  }
+  // Over all sizes that might still win: the smallest drawn (trimmed) radius, ties to the lower
+  // code. A larger cube can win when its centre lies nearer the target's and the trim takes more
+  // of it; none can once even its largest trim is above the best.
+  LeafCode best{kParentCode, 0, std::numeric_limits<float>::infinity(), false};
+  const float most_trimmed = trimmed_leaf_radius(1.0f, max_leaf_trim(mode), mode);
+  search_enclosing(parent, target, [&](std::uint32_t code, const Sphere& d, int) {
+    if (d.radius * most_trimmed > best.radius) return false;
+    const LeafCode c = trimmed(code, d);
+    if (c.radius < best.radius) best = c;
+    return true;
+  });
+  if (best.exact) return best;
+  LeafCode c = trimmed(kParentCode, parent);
+  c.exact = encloses(parent, target);
+  return c;
 }
 
 std::uint32_t encode_normal_nearest(Vec3f n) {

@@ -19,6 +19,18 @@ namespace pointillist::ptl2 {
 // sphere (code 7620). `*exact` says whether the returned code passed both checks.
 std::uint32_t encode_enclosing_sphere(const Sphere& parent, const Sphere& target, bool* exact);
 
+// A leaf's sphere code and radius trim (see trimmed_leaf_radius), and the radius it is drawn at.
+struct LeafCode {
+  std::uint32_t code = 0;
+  std::uint32_t trim = 0;
+  float radius = 0;
+  bool exact = false;  // the decoded sphere holds the target and lies inside the parent
+};
+// For a leaf: among the codes of encode_enclosing_sphere's search (decoded sphere holds `target`,
+// lies inside `parent`), the one whose largest trim that still holds `target` gives the smallest
+// drawn radius; ties to the lower code. Falls back to the parent's sphere as that function does.
+LeafCode encode_enclosing_leaf(const Sphere& parent, const Sphere& target, LeafTrim mode);
+
 // True when `outer` holds `inner`: |c_o - c_i| + r_i <= r_o, in double.
 bool encloses(const Sphere& outer, const Sphere& inner);
 

@@ -248,28 +248,28 @@ PtlV2WriteReport write_ptl_v2(const std::string& path, const SphereTree& tree,
     // `exact` could only miss by a double rounding of the triangle inequality).
     bool exact = false;
     std::uint32_t code = qs_detail::kSphereCodeCount - 1;
-    if (nodes[i].child_count > 0) code = encode_enclosing_sphere(p, grown(target[i]), &exact);
-    if (!exact) code = encode_enclosing_sphere(p, target[i], &exact);
+    const LeafTrim mode = options.leaf_trim;
+    LeafCode leaf;
+    if (nodes[i].child_count > 0) {
+      code = encode_enclosing_sphere(p, grown(target[i]), &exact);
+      if (!exact) code = encode_enclosing_sphere(p, target[i], &exact);
+    } else {
+      // Leaves are drawn at their trimmed radius: the code and trim that draw them smallest.
+      leaf = encode_enclosing_leaf(p, target[i], mode);
+      code = leaf.code;
+    }
     decoded[i] = qs_detail::decode_sphere(p, code);
     if (i > 0 && code == qs_detail::kSphereCodeCount - 1) ++report.parent_fallbacks;
     const std::uint64_t children = nodes[i].child_count == 0 ? 0 : nodes[i].child_count - 1u;
     record[i] = std::uint64_t{code} << kSphereShift | children << kChildShift;
     if (nodes[i].child_count == 0) {
-      // Leaves are drawn at their decoded radius: trim it as far as the true sphere allows.
-      const LeafTrim mode = options.leaf_trim;
-      std::uint32_t trim = 0;
-      while (trim < max_leaf_trim(mode) &&
-             encloses({decoded[i].center, trimmed_leaf_radius(decoded[i].radius, trim + 1, mode)},
-                      target[i])) {
-        ++trim;
-      }
+      const std::uint32_t trim = leaf.trim;
       record[i] |= mode == LeafTrim::Eighths
                        ? std::uint64_t{trim} << kConeShift
                        : std::uint64_t{trim >> 1} << kConeShift | std::uint64_t{trim & 1}
                                                                       << kLowTrimShift;
       if (nodes[i].radius > 0) {
-        leaf_ratio_sum +=
-            double(trimmed_leaf_radius(decoded[i].radius, trim, mode)) / nodes[i].radius;
+        leaf_ratio_sum += double(leaf.radius) / nodes[i].radius;
         ++leaf_ratio_count;
       }
     }

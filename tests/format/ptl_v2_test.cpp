@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -125,7 +126,7 @@ std::vector<Candidate> spec_sphere_table() {
 }
 
 // Checks every third leaf of a file written with `trim` leaf trims (steps of 1/steps).
-void expect_smallest_code_then_largest_trim(quant::LeafTrim trim, int steps, int max_trim) {
+void expect_smallest_drawn_leaves(quant::LeafTrim trim, int steps, int max_trim) {
   const std::vector<Candidate> table = spec_sphere_table();
   ASSERT_EQ(table.size(), 7621u);
   TempDir dir;
@@ -140,32 +141,34 @@ void expect_smallest_code_then_largest_trim(quant::LeafTrim trim, int steps, int
     for (std::uint32_t k = 0; k < parent.child_count; ++k) {
       const std::uint32_t i = parent.first_child + k;
       if (tree.nodes[i].child_count != 0 || i % 3 != 0) continue;  // every third leaf
-      // Brute force: the smallest decoded radius over all codes that hold the true leaf and
-      // stay inside the decoded parent (exact tests in double on the float32 decode).
-      float best = parent.radius;
+      // Brute force over all codes whose decoded sphere holds the true leaf and stays inside the
+      // decoded parent (exact tests in double on the float32 decode): each is drawn at its
+      // largest trim of t steps that still holds the true leaf around the decoded centre; the
+      // leaf must be drawn at the smallest of these radii.
+      const SphereNode& truth = tree.nodes[i];
+      float best = std::numeric_limits<float>::infinity();
+      int best_trim = -1;
       for (const Candidate& c : table) {
         const Vec3f centre{parent.center.x + parent.radius * c.x,
                            parent.center.y + parent.radius * c.y,
                            parent.center.z + parent.radius * c.z};
         const float radius = parent.radius * c.r;
-        if (dist(centre, tree.nodes[i].center) + double(tree.nodes[i].radius) <= double(radius) &&
-            dist(centre, parent.center) + double(radius) <= double(parent.radius)) {
-          best = std::min(best, radius);
+        const double need = dist(centre, truth.center) + double(truth.radius);
+        if (need > double(radius) || dist(centre, parent.center) + double(radius) >
+                                         double(parent.radius)) {
+          continue;
         }
+        int t = 0;
+        while (t < max_trim && need <= double(radius * (1.0f - step * float(t + 1)))) ++t;
+        const float drawn = radius * (1.0f - step * float(t));
+        if (drawn < best) best = drawn, best_trim = t;
       }
-      // The leaf is drawn at that radius trimmed by t steps: the largest trim whose sphere,
-      // around the decoded centre, still holds the true leaf.
       const SphereNode& leaf = d.nodes[i];
-      int t = -1;
-      for (int k_trim = 0; k_trim <= max_trim; ++k_trim) {
-        if (leaf.radius == best * (1.0f - step * float(k_trim))) t = k_trim;
-      }
-      ASSERT_GE(t, 0) << "leaf " << i << ": radius " << leaf.radius << " is no trim of " << best;
-      const double need = dist(leaf.center, tree.nodes[i].center) + double(tree.nodes[i].radius);
-      EXPECT_LE(need, double(leaf.radius)) << "leaf " << i;
-      if (t < max_trim) {
-        EXPECT_GT(need, double(best * (1.0f - step * float(t + 1)))) << "leaf " << i;
-      }
+      ASSERT_GE(best_trim, 0) << "leaf " << i << ": no code holds it";
+      EXPECT_EQ(leaf.radius, best) << "leaf " << i;
+      const int t = best_trim;
+      EXPECT_LE(dist(leaf.center, truth.center) + double(truth.radius), double(leaf.radius))
+          << "leaf " << i;
       trimmed += t > 0;
       ++checked;
     }
@@ -174,12 +177,12 @@ void expect_smallest_code_then_largest_trim(quant::LeafTrim trim, int steps, int
   EXPECT_GT(trimmed, checked / 10) << "the trim should shrink a good share of the leaves";
 }
 
-TEST(PtlV2, LeavesGetTheSmallestEnclosingCodeInsideTheirParentThenTheLargestTrim) {
-  expect_smallest_code_then_largest_trim(quant::LeafTrim::Sixteenths, 16, 7);
+TEST(PtlV2, LeavesGetTheCodeAndTrimThatDrawThemSmallestWhileHoldingTheTrueSphere) {
+  expect_smallest_drawn_leaves(quant::LeafTrim::Sixteenths, 16, 7);
 }
 
 TEST(PtlV2, LeafTrimsInEighthsAsTheFirstVersion2FilesKeepThem) {
-  expect_smallest_code_then_largest_trim(quant::LeafTrim::Eighths, 8, 3);
+  expect_smallest_drawn_leaves(quant::LeafTrim::Eighths, 8, 3);
 }
 
 TEST(PtlV2, EnclosesSpheresOfATreeThatDoesNotNest) {
