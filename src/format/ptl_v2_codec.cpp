@@ -55,9 +55,13 @@ namespace {
 
 // The search of encode_enclosing_sphere and encode_enclosing_leaf: for each cube size m from
 // the smallest that can hold `target`, every code whose decoded sphere holds `target` and lies
-// inside `parent` is offered to `offer(code, decoded, m)`, which returns false to stop.
-template <class Offer>
-void search_enclosing(const Sphere& parent, const Sphere& target, Offer&& offer) {
+// inside `parent` is offered to `offer(code, decoded, m)`, which returns false to stop. Only
+// centres within `max_distance()` of the target's (parent units; asked at each size) are
+// considered, and codes for which `wanted(distance, radius)` (the candidate's centre distance
+// to the target's and its radius, parent units, double) is false are skipped undecoded.
+template <class MaxDistance, class Wanted, class Offer>
+void search_enclosing(const Sphere& parent, const Sphere& target, MaxDistance&& max_distance,
+                      Wanted&& wanted, Offer&& offer) {
   const double rho = parent.radius;
   // Target in parent units; a candidate of size m has radius R = m/13 and centre coordinates
   // X = (m + 2x)/13 - 1 (spec §4.1). It can only qualify when every |X - t| <= R - s (encloses)
@@ -70,7 +74,8 @@ void search_enclosing(const Sphere& parent, const Sphere& target, Offer&& offer)
   const int m_first = std::clamp(int(std::floor(kSphereGrid * s)), 1, kSphereGrid);
   for (int m = m_first; m <= kSphereGrid; ++m) {
     const double radius = double(m) / kSphereGrid;
-    const double reach = radius - s + kSlack, room = 1 - radius + kSlack;
+    const double reach = std::min(radius - s, max_distance()) + kSlack;
+    const double room = 1 - radius + kSlack;
     if (reach < 0) continue;
     int lo[3], hi[3];
     bool empty = false;
@@ -82,9 +87,16 @@ void search_enclosing(const Sphere& parent, const Sphere& target, Offer&& offer)
       empty = x_lo > x_hi || lo[a] > hi[a];
     }
     if (empty) continue;
+    const auto offset = [&](int a, int cell) {  // candidate centre minus target, axis a
+      return (m + 2.0 * cell) / kSphereGrid - 1 - t[a];
+    };
     for (int x = lo[0]; x <= hi[0]; ++x) {
+      const double ex = offset(0, x);
       for (int y = lo[1]; y <= hi[1]; ++y) {
+        const double ey = offset(1, y);
         for (int z = lo[2]; z <= hi[2]; ++z) {
+          const double ez = offset(2, z);
+          if (!wanted(std::sqrt(ex * ex + ey * ey + ez * ez), radius)) continue;
           const int code = qs_detail::sphere_code(m, x, y, z);
           if (code < 0) continue;
           const Sphere d = qs_detail::decode_sphere(parent, std::uint32_t(code));
@@ -107,7 +119,9 @@ std::uint32_t encode_enclosing_sphere(const Sphere& parent, const Sphere& target
   // the lower code, the order of the search).
   int best = -1, best_m = 0;
   double best_distance = std::numeric_limits<double>::infinity();
-  search_enclosing(parent, target, [&](std::uint32_t code, const Sphere& d, int m) {
+  const auto any = [](double, double) { return true; };
+  const auto unlimited = [] { return std::numeric_limits<double>::infinity(); };
+  search_enclosing(parent, target, unlimited, any, [&](std::uint32_t code, const Sphere& d, int m) {
     if (best >= 0 && m > best_m) return false;
     const double dist = distance_squared(d.center, target.center);
     if (dist < best_distance) best = int(code), best_m = m, best_distance = dist;
@@ -141,7 +155,20 @@ LeafCode encode_enclosing_leaf(const Sphere& parent, const Sphere& target, LeafT
   // of it; none can once even its largest trim is above the best.
   LeafCode best{kParentCode, 0, std::numeric_limits<float>::infinity(), false};
   const float most_trimmed = trimmed_leaf_radius(1.0f, max_leaf_trim(mode), mode);
-  search_enclosing(parent, target, [&](std::uint32_t code, const Sphere& d, int) {
+  // A candidate whose drawn radius, estimated in double, is clearly above the best so far is not
+  // decoded (the estimate is within 1e-6 of the float result; the margin is 1e-5).
+  const double s = double(target.radius) / parent.radius;
+  const double step = 1.0 - double(trimmed_leaf_radius(1.0f, 1, mode));
+  const auto promising = [&](double distance, double radius) {
+    const double need = distance + s;
+    if (need > radius * (1 + 1e-5)) return false;
+    const double t = std::min(double(max_leaf_trim(mode)),
+                              std::floor(std::max(0.0, 1.0 - need / radius) / step));
+    return radius * (1.0 - t * step) * parent.radius <= double(best.radius) * (1 + 1e-5);
+  };
+  // The target's centre lies within best - s of any code that could draw it at best or less.
+  const auto within = [&] { return double(best.radius) / parent.radius * (1 + 1e-5) - s; };
+  search_enclosing(parent, target, within, promising, [&](std::uint32_t code, const Sphere& d, int) {
     if (d.radius * most_trimmed > best.radius) return false;
     const LeafCode c = trimmed(code, d);
     if (c.radius < best.radius) best = c;
