@@ -41,8 +41,9 @@ int run_info(const InfoOptions& o) {
   if (v2) {
     const std::uint64_t records = v2->node_count();
     std::printf("format:      Pointillist model (.ptl) version 2: quantized %s-byte nodes in %u "
-                "pages, memory-mapped%s\n",
+                "pages, leaf trims in %s, memory-mapped%s\n",
                 v2->has_colors() ? "6" : "4", v2->page_count(),
+                v2->leaf_trim() == quant::LeafTrim::Sixteenths ? "sixteenths" : "eighths",
                 model.pages() ? ", too large to decode whole (rendered page by page)" : "");
     if (t.nodes.empty()) {
       std::printf("points:      %llu (leaves)\n", static_cast<unsigned long long>(t.leaf_count));

@@ -461,3 +461,38 @@ TEST(PtlCli, ConvertWritesVersion2ByDefaultAndVersion1OnRequestAndBothRender) {
                 .exit_code,
             0);
 }
+
+TEST(PtlCli, LeafTrimChoosesTheLayoutAndAppliesOnlyToVersion2) {
+  TempDir dir;
+  const std::string ply = dir.file("scene.ply");
+  ASSERT_EQ(run_cli("generate --scene sphere --points 5000 -o " + ply).exit_code, 0);
+  ASSERT_EQ(run_cli("convert -q " + ply + " -o " + dir.file("e.ptl") + " --leaf-trim eighths")
+                .exit_code,
+            0);
+  ASSERT_EQ(run_cli("convert -q " + ply + " -o " + dir.file("s.ptl")).exit_code, 0);
+  // The schema's attribute count (header byte 140, docs/ptl-format.md): 4 with eighths, 5 with
+  // the leaf-trim attribute.
+  const auto attribute_count = [](const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    in.seekg(140);
+    unsigned char b[4] = {};
+    in.read(reinterpret_cast<char*>(b), 4);
+    return b[0] | b[1] << 8 | b[2] << 16 | b[3] << 24;
+  };
+  EXPECT_EQ(attribute_count(dir.file("e.ptl")), 4);
+  EXPECT_EQ(attribute_count(dir.file("s.ptl")), 5);
+  EXPECT_THAT(run_cli("info " + dir.file("e.ptl")).output, HasSubstr("leaf trims in eighths"));
+  EXPECT_THAT(run_cli("info " + dir.file("s.ptl")).output, HasSubstr("leaf trims in sixteenths"));
+  for (const std::string& bad : {std::string(" -o ") + dir.file("x.qs") + " --leaf-trim eighths",
+                                 std::string(" -o ") + dir.file("x.ptl") +
+                                     " --ptl-version 1 --leaf-trim eighths"}) {
+    const CliResult r = run_cli("convert -q " + ply + bad);
+    EXPECT_NE(r.exit_code, 0) << bad;
+    EXPECT_THAT(r.output, HasSubstr("--leaf-trim applies only to .ptl version 2")) << bad;
+  }
+  EXPECT_FALSE(fs::exists(dir.file("x.qs")));
+  EXPECT_FALSE(fs::exists(dir.file("x.ptl")));
+  EXPECT_NE(run_cli("convert -q " + ply + " -o " + dir.file("y.ptl") + " --leaf-trim halves")
+                .exit_code,
+            0);
+}
