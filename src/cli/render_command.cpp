@@ -170,12 +170,17 @@ class FrameRenderer {
   }
   // After a frame has been recorded: loads the pages it asked for (paged models). Returns the
   // number of pages loaded.
-  // --progressive loads between frames (deterministic frames); a camera path hands the pages
-  // to the loader thread, as a viewer does, and the frames show what has arrived.
+  // --progressive has the loader thread read between frames and waits for it (deterministic
+  // frames); a camera path hands the pages to the loader thread, as a viewer does, and the
+  // frames show what has arrived.
   std::size_t after_frame() {
     if (!paged_) return 0;
     if (o_.progressive_frames > 0) {
-      return paged_->load_requested(pool_, SIZE_MAX, o_.read_per_frame);
+      // The loader thread reads the pages, as a viewer's does; waiting for it keeps the frames
+      // reproducible (each shows exactly --read-per-frame more of the model).
+      const std::size_t handed = paged_->request_in_background(SIZE_MAX, o_.read_per_frame);
+      paged_->wait_for_loader();
+      return handed;
     }
     if (o_.orbit_frames > 0 || o_.refine_frames > 0) return paged_->request_in_background();
     return paged_->load_requested(pool_);

@@ -405,6 +405,17 @@ TEST(PagedCli, ProgressiveFramesReadMoreEachFrameAndEndAtTheFullImage) {
   // The last frame is the image rendered from the whole model.
   EXPECT_EQ(read_png_rgb8(dir.file("last.png")).pixels, read_png_rgb8(dir.file("full.png")).pixels);
   EXPECT_TRUE(fs::exists(dir.file("frames") + "/frame_00039.png"));
+  // The loader thread reads between frames, and the program waits for it: a second run shows the
+  // same frames.
+  const CliResult again = run_cli("render " + ptl + " -o " + dir.file("again.png") + common +
+                                  " --progressive 6 --read-per-frame 200K --frames-out " +
+                                  dir.file("frames2"));
+  ASSERT_EQ(again.exit_code, 0) << again.output;
+  for (const char* f : {"/frame_00001.png", "/frame_00003.png", "/frame_00005.png"}) {
+    EXPECT_EQ(read_png_rgb8(dir.file("frames2") + f).pixels,
+              read_png_rgb8(dir.file("frames") + f).pixels)
+        << f;
+  }
 }
 
 TEST(PagedCli, MemoryCapIsHeldAndReported) {
