@@ -3,7 +3,7 @@
 # (leaf trims in sixteenths, and in eighths as the first v2 files), to QSplat's .qs and to
 # .ptl version 1 (float nodes, no quantization), each rendered with circle and ellipse splats
 # at two views and compared with the mesh's own triangles (render --mode reference).
-#   bash bench/quality.sh [WORKDIR]
+#   bash bench/quality.sh [WORKDIR]          (VIEWS="AZ,EL ...": other views; default 0,0 135,20)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cli=build/release/pointillist
@@ -22,7 +22,7 @@ metric() {  # metric NAME JSON
   sed -n "s/.*\"$1\": \([0-9.e+-]*\).*/\1/p" "$2" | head -1
 }
 printf '%-9s %-8s %-26s %8s %8s %8s\n' view splat model "PSNR dB" SSIM IoU
-for view in 0,0 135,20; do
+for view in ${VIEWS:-0,0 135,20}; do
   "$cli" render -q "$dragon" --mode reference --view "$view" -o "$work/ref.png"
   for splat in circle ellipse; do
     for m in v1.ptl v2.ptl v2e.ptl d.qs; do

@@ -427,8 +427,8 @@ TEST(PtlV2, GoldenBytes) {
                                1, 0, 0, 0, 1, 0, 0, 0,                          // depth, pages
                                0, 1, 0, 0, 0, 0, 0, 0,                          // page table 256
                                0x3d, 1, 0, 0, 0, 0, 0, 0, 2, 0, 0, 0, 0, 0, 0, 0,  // metadata 317
-                               // header sphere: the root's grown by 15% (2.3, rounded up)
-                               0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0x34, 0x33, 0x13, 0x40};
+                               // header sphere: the root's grown by 20% (2.4, rounded up)
+                               0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0x9a, 0x99, 0x19, 0x40};
   ASSERT_EQ(b.size(), 256u + 32 + 17 + 3 * 4 + 2);
   EXPECT_EQ(Bytes(b.begin(), b.begin() + sizeof head), Bytes(std::begin(head), std::end(head)));
   // Schema: sphere bits 0-12, children 13-14, normal 16-29, cone 30-31, leaf trim low bit 15.
@@ -449,28 +449,29 @@ TEST(PtlV2, GoldenBytes) {
   // child code 1 (2 children), normal (0, 0, 1) = code (4·52 + 26)·52 + 26 = 12194, cone code 2
   // (30° plus the 1.2° normal error fits the 34.2° cone of 9/16); then the leaves.
   EXPECT_EQ(Bytes(b.begin() + 288, b.begin() + 305),
-            (Bytes{0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0x34, 0x33, 0x13, 0x40, 1}));
+            (Bytes{0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0x9a, 0x99, 0x19, 0x40, 1}));
   const std::uint32_t root_record = get_u32(b, 305);
   EXPECT_EQ(root_record & 0x1fff, 7620u);
   EXPECT_EQ((root_record >> 13) & 3, 1u);
   EXPECT_EQ((root_record >> 16) & 0x3fff, 12194u);
   EXPECT_EQ(root_record >> 30, 2u);
-  // Leaves, same normal: the left one (centre -1/2.3 in parent units) gets
-  // 6861 = (m 7; x 0, y 3, z 3): radius 7/13 of the parent, centre -6/13, the smallest
-  // enclosing cube. Its mirror image (x 6) sticks out of the parent by a float rounding, so the
-  // right one gets 7607 = (m 11; x 2, y 1, z 1). Both then take trim 2/16 (cone bits 1, bit 15
-  // clear): the left one needs 1 + |-1 - (-6/13)·2.3| = 1.0615 of its 7/13·2.3 = 1.2385 (14/16
-  // of it, 1.0837, holds; 13/16, 1.0063, does not), the right one 1 + |1 - (2/13)·2.3| = 1.6462
-  // of 11/13·2.3 = 1.9462 (14/16: 1.7029 holds; 13/16: 1.5813 does not).
+  // Leaves, same normal, parent radius ρ = 2.4: each takes the code and trim that draw it
+  // smallest while holding it. The left one gets 6861 = (m 7; x 0, y 3, z 3): radius 7/13·ρ =
+  // 1.2923, centre -6/13·ρ = -1.1077, so it needs 1 + 0.1077 = 1.1077; trim 2/16 (cone bits 1,
+  // bit 15 clear) draws it at 14/16 of its radius, 1.1308 (3/16: 1.0500, too small). The right
+  // one's mirror image (x 6) sticks out of the parent by a float rounding; it gets 7106 = (m 7;
+  // x 5, y 3, z 3): centre 4/13·ρ = 0.7385, needs 1 + 0.2615 = 1.2615 of 1.2923, trim 0 (1/16:
+  // 1.2115, too small). No other code draws either smaller (checked by brute force in
+  // LeavesGetTheCodeAndTrimThatDrawThemSmallestWhileHoldingTheTrueSphere).
   const Bytes records(b.begin() + 305, b.begin() + 317);
   EXPECT_EQ(records,
-            (Bytes{0xc4, 0x3d, 0xa2, 0xaf, 0xcd, 0x1a, 0xa2, 0x6f, 0xb7, 0x1d, 0xa2, 0x6f}));
+            (Bytes{0xc4, 0x3d, 0xa2, 0xaf, 0xcd, 0x1a, 0xa2, 0x6f, 0xc2, 0x1b, 0xa2, 0x2f}));
   EXPECT_EQ(std::string(b.end() - 2, b.end()), "hi");
 }
 
 TEST(PtlV2, GoldenBytesWithLeafTrimsInEighths) {
-  // The first version 2 layout: four attributes, and trims of 1/8 in the cone bits (here 1/8,
-  // the same bits as 2/16 above), so the files differ only in the schema.
+  // The first version 2 layout: four attributes, and trims of 1/8 in the cone bits (here 1/8 and
+  // 0, the same bits as 2/16 and 0 above), so the files differ only in the schema.
   const Bytes b = golden_file(quant::LeafTrim::Eighths);
   const Bytes sixteenths = golden_file(quant::LeafTrim::Sixteenths);
   ASSERT_EQ(b.size(), sixteenths.size());

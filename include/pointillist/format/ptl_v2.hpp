@@ -61,7 +61,7 @@ struct PtlV2WriteReport {
 // atomically (temporary file in the same folder, then rename), with `metadata` (free text)
 // after the pages. Spheres are quantized top-down against the decoded parents, each code the
 // smallest decoded sphere that holds the written sphere and lies inside the decoded parent
-// (interior nodes first try for 15% spare room, so their children fit tightly); the header keeps
+// (interior nodes first try for 20% spare room, so their children fit tightly); the header keeps
 // the sphere the root is decoded against (float32), bounds and view sphere. Single-threaded:
 // about 200 ms for the 437k-leaf dragon. Leaves come out 1.2-1.28 times their written radius
 // on average (the grid is 1/13 of the parent; a 2-bit trim in the leaf's cone bits recovers
