@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Opening and streaming models: bytes per point, time to the first frame and to full detail,
-# and the cost of rendering page by page (decoded on load) against the whole hierarchy in
-# memory, on the dragon and on a generated 20-million-point cloud.
+# and the cost of rendering page by page (records decoded during the traversal) against the
+# whole decoded hierarchy in memory, on the dragon and on a generated 20-million-point cloud.
 #   bash bench/paged.sh [WORKDIR]      (BENCH_QUICK=1: the dragon only)
 # Wall times of whole `pointillist` runs (process start to PNG written), so they include opening
 # the file; the baseline of each row is stated in it.
