@@ -60,6 +60,7 @@ class PtlV2Pages final : public PageSource {
     // Link the last level's interior nodes to the child pages that hold their children.
     const auto count = static_cast<std::uint32_t>(packed.records.size());
     std::vector<std::uint8_t> linked(count - packed.last_level_begin, 0);
+    std::uint32_t previous = 0;
     for (const std::uint32_t q : children_[page]) {
       const PtlV2PageInfo& info = file_.page_info(q);
       std::uint32_t offset = 0;
@@ -74,12 +75,10 @@ class PtlV2Pages final : public PageSource {
         if (linked[node - packed.last_level_begin]++) {
           corrupt(node, "two pages continue it");
         }
-        const auto index = static_cast<std::uint32_t>(packed.links.size());
-        if (packed.link16.empty()) {
-          packed.link32[node] = index;
-        } else {
-          packed.link16[node] = static_cast<std::uint16_t>(index);
-        }
+        // Child pages come by first root, so links follow the last level's interior nodes in
+        // order: links[k] belongs to the k-th (PackedPage::link).
+        if (!packed.links.empty() && node <= previous) corrupt(node, "child pages overlap");
+        previous = node;
         packed.links.push_back({q, offset});
         offset += children + 1;
       }

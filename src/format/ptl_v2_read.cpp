@@ -353,27 +353,19 @@ void PtlV2File::pack_page(std::uint32_t page, PackedPage& out) const {
   const std::uint32_t count = pages_[page].node_count;
   out.records.resize(count);
   out.colors.resize(has_colors_ ? count : 0);
-  const bool wide = count > 0xffff;
-  out.link16.assign(wide ? 0 : count, 0);
-  out.link32.assign(wide ? count : 0, 0);
   out.links.clear();
   out.leaf_trim = leaf_trim_;
   std::vector<Sphere> root_spheres;
   std::vector<std::uint8_t> root_child_counts;
   out.last_level_begin = scan_page(
       page, root_spheres, root_child_counts,
-      [&](std::uint32_t i, std::uint32_t rec, std::uint16_t color, PageParent parent,
-          bool first_child) {
+      [&](std::uint32_t i, std::uint32_t rec, std::uint16_t color, PageParent, bool) {
         out.records[i] = rec;
         if (has_colors_) out.colors[i] = color;
-        if (first_child && !parent.is_root) {
-          if (wide) {
-            out.link32[parent.index] = i - parent.index;
-          } else {
-            out.link16[parent.index] = static_cast<std::uint16_t>(i - parent.index);
-          }
-        }
       });
+  std::uint32_t first_level = 0;
+  for (const std::uint8_t k : root_child_counts) first_level += k;
+  out.index_links(first_level);
   out.root_parent = root_spheres[0];
   const PtlV2PageInfo& info = pages_[page];
   if (page == 0 && std::memcmp(&out.root_parent, &root_sphere_, sizeof(Sphere)) != 0) {

@@ -1,5 +1,6 @@
 // An in-memory hierarchy cut into pages (paginate): the page layout of paged model files, for
 // tests and for models held in memory.
+#include <cassert>
 #include <memory>
 #include <string>
 #include <vector>
@@ -82,6 +83,33 @@ class InMemoryPages final : public PageSource {
 };
 
 }  // namespace
+
+void PackedPage::index_links(std::uint32_t first_level_count) {
+  const auto count = static_cast<std::uint32_t>(records.size());
+  assert(last_level_begin <= count);
+  // Blocks below last_level_begin, then blocks from it; the +2 of memory_bytes covers the
+  // partial block on either side.
+  link_base.assign((count >> kBlockShift) + 2, 0);
+  link_step.assign(count, 0);
+  std::uint32_t value = first_level_count, base = 0;
+  const std::uint32_t mask = (1u << kBlockShift) - 1;
+  for (std::uint32_t i = 0; i < count; ++i) {
+    if (i == last_level_begin) value = 0;  // link indices count the last level's interior nodes
+    const std::uint32_t k = i - (i < last_level_begin ? 0 : last_level_begin);
+    if ((k & mask) == 0) {
+      base = value;
+      link_base[i < last_level_begin ? k >> kBlockShift
+                                     : first_last_level_block() + (k >> kBlockShift)] = base;
+    }
+    link_step[i] = static_cast<std::uint8_t>(value - base);  // at most 4 · 63
+    const std::uint32_t children = quant::bits(records[i], quant::kChildShift, quant::kChildBits);
+    if (i < last_level_begin) {
+      value += children == 0 ? 0 : children + 1;
+    } else {
+      value += children != 0;
+    }
+  }
+}
 
 std::unique_ptr<PageSource> paginate(const SphereTreeView& tree, std::uint64_t page_bytes,
                                      std::uint32_t max_levels) {

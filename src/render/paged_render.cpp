@@ -83,7 +83,7 @@ class PackedAccess {
   ChildRef children(const Item& p, const SphereNode&) const {
     const PackedPage& pk = pages_[p.page]->packed;
     const std::uint32_t link = pk.link(p.index);
-    if (p.index < pk.last_level_begin) return {p.page, p.index + link, true};
+    if (p.index < pk.last_level_begin) return {p.page, link, true};
     const PageLink& l = pk.links[link];
     return {l.page, l.first, pages_[l.page] != nullptr};
   }

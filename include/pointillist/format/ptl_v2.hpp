@@ -121,9 +121,9 @@ class PtlV2File {
   void decode_page(std::uint32_t page, PtlV2Page& out) const;
 
   // Copies page `page`'s records into `out` in their packed form (decoded later, during the
-  // traversal), with the first-child links of the nodes whose children are in the page and
-  // last_level_begin, root_parent (page 0) and leaf_trim; out.links is left empty for the
-  // caller, who knows the child pages. Validates the page as decode_page does.
+  // traversal), with last_level_begin, the link index (PackedPage::index_links), root_parent
+  // (page 0) and leaf_trim; out.links is left empty for the caller, who knows the child pages.
+  // Validates the page as decode_page does.
   void pack_page(std::uint32_t page, PackedPage& out) const;
 
   // The whole hierarchy, breadth-first, node i being node i of the tree that was written:

@@ -1,7 +1,7 @@
 // A .ptl version 2 file as the page source of the paged renderer (render/paged.hpp): each file
-// page is one HierarchyPage kept in its packed form (the file's records, a 2-byte link a node)
-// and decoded during the traversal, so a model larger than memory renders with only the pages it
-// needs resident, at about 6 bytes a node (8 with colour).
+// page is one HierarchyPage kept in its packed form (the file's records and about a byte of links
+// a node) and decoded during the traversal, so a model larger than memory renders with only the
+// pages it needs resident, at about 5.1 bytes a node (7.1 with colour).
 #pragma once
 
 #include <memory>

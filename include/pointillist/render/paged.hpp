@@ -29,27 +29,45 @@ struct PageLink {
 
 // A page kept in the packed form of a quantized model file (lod/quantization.hpp) and decoded
 // during the traversal, each node against its decoded parent: 4 bytes a node (6 with colour)
-// and a 2-byte link, where decoded nodes take 44.
+// and about 1.06 bytes of links, where decoded nodes take 44.
 struct PackedPage {
+  static constexpr unsigned kBlockShift = 6;  // links are stored as 64-node blocks
   std::vector<std::uint32_t> records;  // packed node records, breadth-first over the page
   std::vector<std::uint16_t> colors;   // RGB 565, one per record, when the model has colours
-  // Per node with children: for i < last_level_begin, its first child is node i + link(i) of
-  // this page; for i >= last_level_begin, links[link(i)] says where its children are. 0 for
-  // leaves. link16 for pages of up to 65,535 nodes, link32 (and link16 empty) for larger ones.
-  std::vector<std::uint16_t> link16;
-  std::vector<std::uint32_t> link32;
-  std::vector<PageLink> links;
+  // Records [0, last_level_begin) have their children (if any) in this page; the interior
+  // records of the last level have theirs in child pages, links[k] for the k-th of them.
   std::uint32_t last_level_begin = 0;
+  std::vector<PageLink> links;
   // Page 0: the sphere its first record (the root) decodes against.
   Sphere root_parent;
   quant::LeafTrim leaf_trim = quant::LeafTrim::Eighths;
+  // link(i) for an interior record i: its first child's index in this page (i <
+  // last_level_begin: the first level's size plus the children of the records before it, by
+  // breadth-first order), or its index in `links` (i >= last_level_begin). Stored as a 32-bit
+  // base per block of 64 records (blocks start afresh at last_level_begin) plus an 8-bit step
+  // per record: within a block the value grows by at most 4 a record.
+  std::vector<std::uint32_t> link_base;
+  std::vector<std::uint8_t> link_step;
 
-  std::uint32_t link(std::uint32_t i) const { return link16.empty() ? link32[i] : link16[i]; }
+  std::uint32_t link(std::uint32_t i) const {
+    const std::uint32_t block =
+        i < last_level_begin ? i >> kBlockShift
+                             : first_last_level_block() + ((i - last_level_begin) >> kBlockShift);
+    return link_base[block] + link_step[i];
+  }
+  std::uint32_t first_last_level_block() const {
+    return (last_level_begin + (1u << kBlockShift) - 1) >> kBlockShift;
+  }
+  // Fills link_base and link_step from the records, last_level_begin and the number of records
+  // in the page's first level (the children of its roots).
+  void index_links(std::uint32_t first_level_count);
+
   // Bytes of memory a packed page of `node_count` nodes and `link_count` links takes.
   static std::uint64_t memory_bytes(std::uint64_t node_count, std::uint64_t link_count,
                                     bool has_colors) {
     return node_count * (sizeof(std::uint32_t) + (has_colors ? sizeof(std::uint16_t) : 0) +
-                         (node_count > 0xffff ? sizeof(std::uint32_t) : sizeof(std::uint16_t))) +
+                         sizeof(std::uint8_t)) +
+           ((node_count >> kBlockShift) + 2) * sizeof(std::uint32_t) +
            link_count * sizeof(PageLink);
   }
 };
