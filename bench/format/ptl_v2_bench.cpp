@@ -58,13 +58,14 @@ const SphereTree* input(bool dragon, benchmark::State& state, bool colors = fals
   return &t;
 }
 
-void BM_EncodePtlV2(benchmark::State& state, bool dragon, bool colors) {
+void BM_EncodePtlV2(benchmark::State& state, bool dragon, bool colors, unsigned threads = 1) {
   const SphereTree* tree = input(dragon, state, colors);
   if (!tree) return;
   TempPath file("encode.ptl");
   PtlV2WriteReport r;
+  ThreadPool pool(threads);
   for (auto _ : state) {
-    r = write_ptl_v2(file.path, *tree, "", {.write_colors = colors});
+    r = write_ptl_v2(file.path, *tree, "", {.write_colors = colors}, pool);
     benchmark::DoNotOptimize(r);
   }
   state.SetItemsProcessed(state.iterations() * std::int64_t(tree->leaf_count));
@@ -139,6 +140,9 @@ BENCHMARK_CAPTURE(BM_EncodePtlV2, Small, false, false)->Unit(benchmark::kMillise
 BENCHMARK_CAPTURE(BM_DecodeAllPtlV2, Small, false)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_EncodePtlV2, Dragon, true, false)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_EncodePtlV2, DragonColor, true, true)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_EncodePtlV2, Dragon2Threads, true, false, 2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK_CAPTURE(BM_DecodeAllPtlV2, Dragon, true)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_PackAllPagesPtlV2, Dragon, true)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_BaselineWritePtlV1, Dragon, true)->Unit(benchmark::kMillisecond);

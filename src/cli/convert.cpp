@@ -80,7 +80,7 @@ int run_convert(const ConvertOptions& o) {
     } else {
       PtlV2WriteOptions v2;
       if (o.leaf_trim) v2.leaf_trim = *o.leaf_trim;
-      write_ptl_v2(o.output, tree, meta.str(), v2);
+      write_ptl_v2(o.output, tree, meta.str(), v2, pool);
     }
   } else {
     ProgressPhase phase(progress, "write", 0);

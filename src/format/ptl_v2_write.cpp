@@ -199,6 +199,13 @@ std::vector<PagePlan> plan_pages(const SphereTree& tree, std::uint32_t record_si
 
 PtlV2WriteReport write_ptl_v2(const std::string& path, const SphereTree& tree,
                               const std::string& metadata, const PtlV2WriteOptions& options) {
+  ThreadPool pool(1);
+  return write_ptl_v2(path, tree, metadata, options, pool);
+}
+
+PtlV2WriteReport write_ptl_v2(const std::string& path, const SphereTree& tree,
+                              const std::string& metadata, const PtlV2WriteOptions& options,
+                              ThreadPool& pool) {
   if (options.page_bytes < kMinPageBytes) {
     throw OptionError("page_bytes " + std::to_string(options.page_bytes) +
                       " is below the minimum " + std::to_string(kMinPageBytes));
@@ -242,9 +249,14 @@ PtlV2WriteReport write_ptl_v2(const std::string& path, const SphereTree& tree,
   const Sphere header_sphere = nodes[0].child_count > 0 ? grown(target[0]) : target[0];
   std::vector<Sphere> decoded(n);
   std::vector<std::uint64_t> record(n, 0);
-  double leaf_ratio_sum = 0;
-  std::uint64_t leaf_ratio_count = 0;
-  for (std::size_t i = 0; i < n; ++i) {
+  // Level by level (breadth-first order keeps each level contiguous): a node depends only on
+  // its decoded parent, so a level's nodes are encoded in parallel, in fixed chunks whose
+  // statistics are summed in order (the same file and report for any thread count).
+  struct ChunkStats {
+    double leaf_ratio_sum = 0;
+    std::uint64_t leaf_ratio_count = 0, parent_fallbacks = 0;
+  };
+  const auto encode_node = [&](std::size_t i, ChunkStats& stats) {
     const Sphere& p = i == 0 ? header_sphere : decoded[parent[i]];
     // Targets nest, so some code always qualifies (at worst the parent's own sphere, which
     // `exact` could only miss by a double rounding of the triangle inequality).
@@ -261,7 +273,7 @@ PtlV2WriteReport write_ptl_v2(const std::string& path, const SphereTree& tree,
       code = leaf.code;
     }
     decoded[i] = qs_detail::decode_sphere(p, code);
-    if (i > 0 && code == qs_detail::kSphereCodeCount - 1) ++report.parent_fallbacks;
+    if (i > 0 && code == qs_detail::kSphereCodeCount - 1) ++stats.parent_fallbacks;
     const std::uint64_t children = nodes[i].child_count == 0 ? 0 : nodes[i].child_count - 1u;
     record[i] = std::uint64_t{code} << kSphereShift | children << kChildShift;
     if (nodes[i].child_count == 0) {
@@ -271,10 +283,33 @@ PtlV2WriteReport write_ptl_v2(const std::string& path, const SphereTree& tree,
                        : std::uint64_t{trim >> 1} << kConeShift | std::uint64_t{trim & 1}
                                                                       << kLowTrimShift;
       if (nodes[i].radius > 0) {
-        leaf_ratio_sum += double(leaf.radius) / nodes[i].radius;
-        ++leaf_ratio_count;
+        stats.leaf_ratio_sum += double(leaf.radius) / nodes[i].radius;
+        ++stats.leaf_ratio_count;
       }
     }
+  };
+  constexpr std::size_t kChunk = 4096;
+  double leaf_ratio_sum = 0;
+  std::uint64_t leaf_ratio_count = 0;
+  std::vector<ChunkStats> chunk_stats;
+  for (std::size_t begin = 0, end = 1; begin < n;) {
+    std::size_t next_end = end;  // the next level ends after the last child of this one
+    for (std::size_t i = begin; i < end; ++i) {
+      if (nodes[i].child_count > 0) next_end = nodes[i].first_child + nodes[i].child_count;
+    }
+    const std::size_t chunks = (end - begin + kChunk - 1) / kChunk;
+    chunk_stats.assign(chunks, {});
+    pool.run(chunks, [&](std::size_t c) {
+      const std::size_t first = begin + c * kChunk, last = std::min(end, first + kChunk);
+      for (std::size_t i = first; i < last; ++i) encode_node(i, chunk_stats[c]);
+    });
+    for (const ChunkStats& c : chunk_stats) {
+      leaf_ratio_sum += c.leaf_ratio_sum;
+      leaf_ratio_count += c.leaf_ratio_count;
+      report.parent_fallbacks += c.parent_fallbacks;
+    }
+    begin = end;
+    end = next_end;
   }
   report.mean_leaf_radius_ratio = leaf_ratio_count ? leaf_ratio_sum / double(leaf_ratio_count) : 1;
 
