@@ -14,8 +14,11 @@ bool smoke_mode() { return std::getenv("POINTILLIST_BENCH_SMOKE") != nullptr; }
 
 std::string dragon_path() {
   std::filesystem::path dir;
+  // As scripts/fetch-models.sh and the tests: $POINTILLIST_MODELS, else the XDG cache.
   if (const char* env = std::getenv("POINTILLIST_MODELS"); env && *env) {
     dir = env;
+  } else if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) {
+    dir = std::filesystem::path(xdg) / "pointillist" / "models";
   } else if (const char* home = std::getenv("HOME"); home && *home) {
     dir = std::filesystem::path(home) / ".cache" / "pointillist" / "models";
   }

@@ -60,7 +60,15 @@ int run_convert(const ConvertOptions& o) {
   const std::size_t point_count = points.size();
   // A mesh goes to write_qs as read: like qsplat_make, it computes normals and radii from the
   // faces itself (that is what makes the file byte-identical to the original tool's).
-  if (!(to_qs && points.is_mesh())) prepare_splats(points, pool, progress, o.prepare);
+  if (!(to_qs && points.is_mesh())) {
+    prepare_splats(points, pool, progress, o.prepare);
+  } else if (o.prepare.normals != NormalSource::Auto || o.prepare.radius_scale != 1.0f ||
+             o.prepare.k != PrepareOptions{}.k) {
+    std::fprintf(stderr,
+                 "pointillist convert: warning: --normals, --k and --radius-scale are ignored for "
+                 ".qs output of a mesh: its normals and radii follow qsplat_make's rules, which "
+                 "make the file byte-identical to QSplat's (convert to .ply first to apply them)\n");
+  }
 
   if (to_qs) {
     ProgressPhase phase(progress, "write", 0);

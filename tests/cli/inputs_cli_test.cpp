@@ -92,6 +92,17 @@ TEST(QsCli, ConvertToQsWritesTheBytesQsplatMakeWrote) {
   }
 }
 
+TEST(QsCli, SplatOptionsAreIgnoredWithAWarningForAMeshWrittenAsQs) {
+  POINTILLIST_REQUIRE_SHARED_TESTDATA();
+  TempDir dir;
+  const std::string out = dir.file("scaled.qs");
+  const CliResult conv = run_cli("convert -q " + qsplat_sample("dragon_vrip_res4.bbe.ply") +
+                                 " -o " + out + " --radius-scale 2");
+  ASSERT_EQ(conv.exit_code, 0) << conv.output;
+  EXPECT_THAT(conv.output, HasSubstr("--radius-scale are ignored for .qs output of a mesh"));
+  EXPECT_EQ(file_bytes(out), file_bytes(qsplat_sample("dragon_vrip_res4.strict.qs")));
+}
+
 TEST(QsCli, AQsModelIsNotAnInputToConvert) {
   POINTILLIST_REQUIRE_SHARED_TESTDATA();
   TempDir dir;
