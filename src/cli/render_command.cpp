@@ -128,9 +128,12 @@ class FrameRenderer {
     }
     if (o.mode == RenderMode::Quality) validate_quality_settings(o.quality);
     if (model.pages() || o.memory_cap > 0 || o.progressive_frames > 0) {
-      if (o.lod == LodScheme::Spt || o.mode != RenderMode::Fast) {
-        throw OptionError("--memory and --progressive render the QSplat hierarchy page by page in "
-                          "the fast mode; drop --lod spt and --mode");
+      if (o.lod == LodScheme::Spt || o.mode == RenderMode::Reference) {
+        throw OptionError(std::string(model.pages() ? o.input + " is rendered page by page"
+                                                    : "--memory and --progressive render page "
+                                                      "by page") +
+                          ": the QSplat hierarchy in the fast or quality mode; drop " +
+                          (o.lod == LodScheme::Spt ? "--lod spt" : "--mode reference"));
       }
       const PageSource* source = model.pages();
       if (!source) {
@@ -157,7 +160,11 @@ class FrameRenderer {
                  &spt_stats_);
     } else if (paged_) {
       settings.threshold_px = detail;
-      paged_->render(camera, settings, pool_, frame);
+      if (o_.mode == RenderMode::Quality) {
+        paged_->render_quality(camera, settings, o_.quality, pool_, frame, quality_scratch_);
+      } else {
+        paged_->render(camera, settings, pool_, frame);
+      }
     } else if (o_.mode == RenderMode::Reference) {
       render_mesh_reference(mesh_, camera, settings, frame);
     } else if (o_.mode == RenderMode::Quality) {
@@ -187,6 +194,18 @@ class FrameRenderer {
   }
   // Draws the view until a paged model has loaded all it needs (or all the cap allows).
   void draw_settled(const Camera& camera, float detail, Frame& frame) {
+    if (paged_ && o_.mode == RenderMode::Quality) {
+      // Load with fast frames (the same selection, so the same pages), then draw the quality
+      // image once.
+      RenderSettings settings = o_.settings;
+      settings.threshold_px = detail;
+      for (int round = 0; round < kMaxSettleRounds; ++round) {
+        paged_->render(camera, settings, pool_, frame);
+        if (paged_->complete() || after_frame() == 0) break;
+      }
+      draw(camera, detail, frame);
+      return;
+    }
     for (int round = 0; round < kMaxSettleRounds; ++round) {
       draw(camera, detail, frame);
       if (!paged_ || paged_->complete() || after_frame() == 0) return;
@@ -210,11 +229,12 @@ class FrameRenderer {
       }
       char buf[768];
       std::snprintf(buf, sizeof buf,
-                    "  \"lod\": \"qsplat\",\n  \"mode\": \"fast\",\n  \"paged\": true,\n"
+                    "  \"lod\": \"qsplat\",\n  \"mode\": \"%s\",\n  \"paged\": true,\n"
                     "  \"pages\": %u,\n  \"model_bytes\": %llu,\n  \"memory_cap\": %llu,\n"
                     "  \"bytes_read\": %llu,\n  \"resident_bytes\": %llu,\n"
                     "  \"resident_bytes_peak\": %llu,\n  \"pages_loaded\": %llu,\n"
                     "  \"pages_evicted\": %llu,\n  \"complete\": %s,\n",
+                    o_.mode == RenderMode::Quality ? "quality" : "fast",
                     page_source_->page_count(), static_cast<unsigned long long>(file_bytes),
                     static_cast<unsigned long long>(o_.memory_cap),
                     static_cast<unsigned long long>(p.bytes_read),

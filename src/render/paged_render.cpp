@@ -270,6 +270,19 @@ PagedRenderer::PagedRenderer(const PageSource& source, std::uint64_t memory_cap,
 
 void PagedRenderer::render(const Camera& camera, const RenderSettings& settings, ThreadPool& pool,
                            Frame& frame) {
+  render_frame(camera, settings, nullptr, nullptr, pool, frame);
+}
+
+void PagedRenderer::render_quality(const Camera& camera, const RenderSettings& settings,
+                                   const QualitySettings& quality, ThreadPool& pool, Frame& frame,
+                                   QualityScratch& scratch) {
+  validate_quality_settings(quality);
+  render_frame(camera, settings, &quality, &scratch, pool, frame);
+}
+
+void PagedRenderer::render_frame(const Camera& camera, const RenderSettings& settings,
+                                 const QualitySettings* quality, QualityScratch* scratch,
+                                 ThreadPool& pool, Frame& frame) {
   if (!(settings.threshold_px > 0.0f) || !std::isfinite(settings.threshold_px)) {
     throw OptionError("splat size threshold " + std::to_string(settings.threshold_px) +
                       " px is invalid; give a positive number of pixels (1 draws every detail)");
@@ -306,7 +319,28 @@ void PagedRenderer::render(const Camera& camera, const RenderSettings& settings,
   std::uint64_t splats = 0;
   for (std::size_t t = 0; t < stream.chunk_count; ++t) splats += stream.chunks[t].count;
   const auto selected = Clock::now();
-  rasterize_splats(stream, cam, settings, pool, frame.scratch, frame.color, frame.depth);
+  if (quality) {
+    // The quality rasterizer reads each splat's node through the stream's node index: gather
+    // the frame's nodes (decoded copies, stand-ins as drawn) in stream order and index them.
+    gathered_.clear();
+    gathered_.reserve(splats);
+    for (std::size_t t = 0; t < stream.chunk_count; ++t) {
+      SplatChunk& chunk = stream.chunks[t];
+      const TaskOut& out = task_out_[t];
+      const bool packed = pages_[0]->is_packed();
+      for (std::size_t i = 0; i < chunk.count; ++i) {
+        const std::uint32_t local = chunk.node[i];
+        gathered_.push_back(packed ? out.values[local] : *out.emitted[local]);
+        chunk.node[i] = static_cast<std::uint32_t>(gathered_.size() - 1);
+      }
+    }
+    SphereTreeView nodes = summary_;
+    nodes.nodes = gathered_;
+    rasterize_quality(stream, nodes, cam, settings, *quality, pool, *scratch, frame.color,
+                      frame.depth);
+  } else {
+    rasterize_splats(stream, cam, settings, pool, frame.scratch, frame.color, frame.depth);
+  }
   fill_stats(frame,
              {.splats = splats, .nodes_visited = counters.visited,
               .culled_frustum = counters.culled_frustum,

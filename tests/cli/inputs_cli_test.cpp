@@ -429,6 +429,28 @@ TEST(PagedCli, ProgressiveFramesReadMoreEachFrameAndEndAtTheFullImage) {
   }
 }
 
+TEST(PagedCli, QualityModeRendersPageByPageAndSptIsRefusedWithAReason) {
+  TempDir dir;
+  const std::string ply = dir.file("scene.ply"), ptl = dir.file("scene.ptl");
+  ASSERT_EQ(run_cli("generate --points 50000 -o " + ply).exit_code, 0);
+  ASSERT_EQ(run_cli("convert -q " + ply + " -o " + ptl).exit_code, 0);
+  const std::string common = " --size 160x120 --view 30,20 --mode quality";
+  ASSERT_EQ(run_cli("render " + ptl + " -o " + dir.file("whole.png") + common).exit_code, 0);
+  const CliResult paged = run_cli("render " + ptl + " -o " + dir.file("paged.png") + common +
+                                  " --memory 1G --stats -");
+  ASSERT_EQ(paged.exit_code, 0) << paged.output;
+  EXPECT_THAT(paged.output, HasSubstr("\"mode\": \"quality\""));
+  EXPECT_THAT(paged.output, HasSubstr("\"complete\": true"));
+  // With every page the view needs, the paged quality image is the whole model's.
+  EXPECT_EQ(read_png_rgb8(dir.file("paged.png")).pixels,
+            read_png_rgb8(dir.file("whole.png")).pixels);
+  const CliResult spt =
+      run_cli("render " + ptl + " -o " + dir.file("spt.png") + " --lod spt --memory 1G");
+  EXPECT_NE(spt.exit_code, 0);
+  EXPECT_THAT(spt.output, HasSubstr("drop --lod spt"));
+  EXPECT_FALSE(fs::exists(dir.file("spt.png")));
+}
+
 TEST(PagedCli, MemoryCapIsHeldAndReported) {
   TempDir dir;
   const std::string ply = dir.file("scene.ply"), ptl = dir.file("scene.ptl");

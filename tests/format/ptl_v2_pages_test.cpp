@@ -13,6 +13,7 @@
 #include "pointillist/core/error.hpp"
 #include "pointillist/format/ptl_v2.hpp"
 #include "pointillist/render/paged.hpp"
+#include "pointillist/render/quality.hpp"
 #include "pointillist/render/render.hpp"
 #include "testing/testing.hpp"
 
@@ -76,6 +77,13 @@ TEST(PtlV2Pages, FullyResidentFramesAreBitIdenticalToTheDecodedModel) {
         EXPECT_EQ(frame.stats.nodes_visited, expected.stats.nodes_visited);
         EXPECT_TRUE(frame.color == expected.color) << "azimuth " << azimuth;
         EXPECT_TRUE(frame.depth == expected.depth) << "azimuth " << azimuth;
+        // The quality mode draws the same selection: the same image as on the decoded model.
+        Frame expected_quality, quality_frame;
+        QualityScratch scratch;
+        render_quality(decoded.view(), cam, settings, QualitySettings{}, pool, expected_quality);
+        paged.render_quality(cam, settings, QualitySettings{}, pool, quality_frame, scratch);
+        EXPECT_TRUE(quality_frame.color == expected_quality.color) << "azimuth " << azimuth;
+        EXPECT_TRUE(quality_frame.depth == expected_quality.depth) << "azimuth " << azimuth;
       }
     }
   }

@@ -12,6 +12,7 @@
 #include "pointillist/lod/sphere_tree.hpp"
 #include "pointillist/render/image_compare.hpp"
 #include "pointillist/render/paged.hpp"
+#include "pointillist/render/quality.hpp"
 #include "pointillist/render/render.hpp"
 #include "pointillist/scene/analytic.hpp"
 #include "render_test_util.hpp"
@@ -113,6 +114,48 @@ TEST(PagedRender, WithEveryPageResidentTheImageIsRendersBitForBit) {
     EXPECT_EQ(frame.color, expected.color) << "azimuth " << az;
     EXPECT_EQ(frame.depth, expected.depth) << "azimuth " << az;
   }
+}
+
+TEST(PagedRender, QualityModeWithEveryPageResidentIsRenderQualityBitForBit) {
+  ThreadPool pool(2);
+  const SphereTree& tree = demo_tree();
+  const auto source = paginate(tree.view(), 8192);
+  PagedRenderer paged(*source, UINT64_MAX, pool);
+  QualityScratch scratch;
+  for (const Reconstruction rule : {Reconstruction::ZRange, Reconstruction::ZThreshold}) {
+    const QualitySettings quality{.reconstruction = rule};
+    const Camera cam = view(70);
+    Frame expected, frame;
+    render_quality(tree.view(), cam, RenderSettings{}, quality, pool, expected);
+    render_until_settled(paged, cam, pool, frame);  // loads the pages in the fast mode
+    ASSERT_TRUE(paged.complete());
+    paged.render_quality(cam, RenderSettings{}, quality, pool, frame, scratch);
+    EXPECT_EQ(frame.stats.splats, expected.stats.splats);
+    EXPECT_EQ(frame.color, expected.color);
+    EXPECT_EQ(frame.depth, expected.depth);
+  }
+}
+
+TEST(PagedRender, QualityModeUnderACapDrawsItsStandInsWithoutHoles) {
+  // A cap that holds only the top pages: stand-ins enclose their subtrees, so the quality image
+  // covers what the full quality image covers.
+  ThreadPool pool(2);
+  const SphereTree& tree = demo_tree();
+  const auto source = paginate(tree.view(), 4096);
+  std::uint64_t total = 0;
+  for (std::uint32_t p = 0; p < source->page_count(); ++p) total += source->page_memory_bytes(p);
+  PagedRenderer capped(*source, total / 6, pool);
+  const Camera cam = view(20);
+  Frame full, frame;
+  render_quality(tree.view(), cam, RenderSettings{}, QualitySettings{}, pool, full);
+  render_until_settled(capped, cam, pool, frame);
+  QualityScratch scratch;
+  capped.render_quality(cam, RenderSettings{}, QualitySettings{}, pool, frame, scratch);
+  EXPECT_LE(capped.stats().resident_bytes_peak, total / 6);
+  EXPECT_LT(frame.stats.splats, full.stats.splats);
+  const ImageComparison c = compare(full, frame);
+  EXPECT_GT(c.interior_count, 1000u);
+  EXPECT_EQ(c.hole_count, 0u);
 }
 
 TEST(PagedRender, FirstFrameFromTheFirstPageAloneHasNoHoles) {

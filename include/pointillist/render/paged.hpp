@@ -14,6 +14,7 @@
 #include "pointillist/core/thread_pool.hpp"
 #include "pointillist/lod/quantization.hpp"
 #include "pointillist/lod/sphere_tree.hpp"
+#include "pointillist/render/quality.hpp"
 #include "pointillist/render/render.hpp"
 
 namespace pointillist {
@@ -159,6 +160,13 @@ class PagedRenderer {
   // and rasterization run on the pool; the image does not depend on the thread count.
   void render(const Camera& camera, const RenderSettings& settings, ThreadPool& pool,
               Frame& frame);
+  // The same selection drawn by the quality rasterizer (rasterize_quality: Gaussian surface
+  // splatting, per-pixel shading), so models larger than memory render in the quality mode too.
+  // With every page the view needs resident, the image is render_quality's on the whole
+  // hierarchy. Throws OptionError for invalid settings.
+  void render_quality(const Camera& camera, const RenderSettings& settings,
+                      const QualitySettings& quality, ThreadPool& pool, Frame& frame,
+                      QualityScratch& scratch);
 
   // Loads the pages the last render requested, largest on screen first, at most `max_pages` of
   // them and at most `max_storage_bytes` read (at least one page is always loaded when one
@@ -193,6 +201,9 @@ class PagedRenderer {
     SphereNode anchor;
     float priority;  // the anchor's projected radius: larger first
   };
+  void render_frame(const Camera& camera, const RenderSettings& settings,
+                    const QualitySettings* quality, QualityScratch* scratch, ThreadPool& pool,
+                    Frame& frame);
   struct Selection;
   // The traversal over decoded or packed pages (Access: see paged_render.cpp).
   template <class Access>
@@ -224,6 +235,7 @@ class PagedRenderer {
     std::vector<std::uint32_t> touched;  // resident pages it used below the top
   };
   std::vector<TaskOut> task_out_;
+  std::vector<SphereNode> gathered_;  // quality mode: the last frame's nodes in stream order
   std::vector<std::uint8_t> in_flight_;                // per page: handed to the loader
   std::size_t in_flight_count_ = 0;
   std::uint64_t frame_number_ = 0;
