@@ -384,11 +384,17 @@ TEST(QualityCli, ReferenceModeDrawsTheTrianglesAndCompareMeasuresSplatsAgainstTh
   EXPECT_THAT(bad.output, HasSubstr("is a splat model"));
 }
 
+// The demo scene sampled with `points` points and converted to .ptl in `dir`.
+std::string demo_model(const TempDir& dir, int points) {
+  const std::string ply = dir.file("scene.ply"), ptl = dir.file("scene.ptl");
+  EXPECT_EQ(run_cli("generate --points " + std::to_string(points) + " -o " + ply).exit_code, 0);
+  EXPECT_EQ(run_cli("convert -q " + ply + " -o " + ptl).exit_code, 0);
+  return ptl;
+}
+
 TEST(PagedCli, ProgressiveFramesReadMoreEachFrameAndEndAtTheFullImage) {
   TempDir dir;
-  const std::string ply = dir.file("scene.ply"), ptl = dir.file("scene.ptl");
-  ASSERT_EQ(run_cli("generate --points 100000 -o " + ply).exit_code, 0);
-  ASSERT_EQ(run_cli("convert -q " + ply + " -o " + ptl).exit_code, 0);
+  const std::string ptl = demo_model(dir, 100000);
   const std::string common = " --size 200x150 --view 30,20";
   ASSERT_EQ(run_cli("render " + ptl + " -o " + dir.file("full.png") + common).exit_code, 0);
   const CliResult r = run_cli("render " + ptl + " -o " + dir.file("last.png") + common +
@@ -431,9 +437,7 @@ TEST(PagedCli, ProgressiveFramesReadMoreEachFrameAndEndAtTheFullImage) {
 
 TEST(PagedCli, QualityModeRendersPageByPageAndSptIsRefusedWithAReason) {
   TempDir dir;
-  const std::string ply = dir.file("scene.ply"), ptl = dir.file("scene.ptl");
-  ASSERT_EQ(run_cli("generate --points 50000 -o " + ply).exit_code, 0);
-  ASSERT_EQ(run_cli("convert -q " + ply + " -o " + ptl).exit_code, 0);
+  const std::string ptl = demo_model(dir, 50000);
   const std::string common = " --size 160x120 --view 30,20 --mode quality";
   ASSERT_EQ(run_cli("render " + ptl + " -o " + dir.file("whole.png") + common).exit_code, 0);
   const CliResult paged = run_cli("render " + ptl + " -o " + dir.file("paged.png") + common +
@@ -453,9 +457,7 @@ TEST(PagedCli, QualityModeRendersPageByPageAndSptIsRefusedWithAReason) {
 
 TEST(PagedCli, MemoryCapIsHeldAndReported) {
   TempDir dir;
-  const std::string ply = dir.file("scene.ply"), ptl = dir.file("scene.ptl");
-  ASSERT_EQ(run_cli("generate --points 100000 -o " + ply).exit_code, 0);
-  ASSERT_EQ(run_cli("convert -q " + ply + " -o " + ptl).exit_code, 0);
+  const std::string ptl = demo_model(dir, 100000);
   const CliResult r = run_cli("render " + ptl + " -o " + dir.file("capped.png") +
                               " --size 200x150 --memory 600K --stats -");
   ASSERT_EQ(r.exit_code, 0) << r.output;
