@@ -62,10 +62,14 @@ int run_convert(const ConvertOptions& o) {
   // faces itself (that is what makes the file byte-identical to the original tool's).
   if (!(to_qs && points.is_mesh())) {
     prepare_splats(points, pool, progress, o.prepare);
+    if (o.prepare.drop_outliers && !o.quiet) {
+      std::printf("dropped %zu outliers of %zu points\n", point_count - points.size(), point_count);
+    }
   } else if (o.prepare.normals != NormalSource::Auto || o.prepare.radius_scale != 1.0f ||
-             o.prepare.k != PrepareOptions{}.k) {
+             o.prepare.k != PrepareOptions{}.k || o.prepare.drop_outliers) {
     std::fprintf(stderr,
-                 "pointillist convert: warning: --normals, --k and --radius-scale are ignored for "
+                 "pointillist convert: warning: --normals, --k, --radius-scale and "
+                 "--drop-outliers are ignored for "
                  ".qs output of a mesh: its normals and radii follow qsplat_make's rules, which "
                  "make the file byte-identical to QSplat's (convert to .ply first to apply them)\n");
   }

@@ -134,6 +134,13 @@ void add_prepare_options(CLI::App* app, pointillist::PrepareOptions& p) {
   app->add_option("--radius-scale", p.radius_scale, "Multiply every splat radius by S")
       ->default_val(1.0f)
       ->check(CLI::PositiveNumber);
+  app->add_flag("--drop-outliers", p.drop_outliers,
+                "Point clouds: drop stray points, whose neighbours are much farther than usual");
+  app->add_option("--outlier-ratio", p.outlier_ratio_drop,
+                  "With --drop-outliers: how many times farther than its neighbours' a point's "
+                  "neighbours must be (lower drops more)")
+      ->default_val(3.0f)
+      ->check(CLI::Range(1.0001f, 1e6f));
 }
 
 }  // namespace

@@ -2,9 +2,10 @@
 // Duchamp, McDonald, Stuetzle, "Surface reconstruction from unorganized points", SIGGRAPH 1992,
 // section 3.3. The graph is the symmetrized k-nearest-neighbour graph with edge weight
 // 1 - |n_i·n_j|, so the tree follows the smoothest paths and crosses creases last. Each connected
-// component is seeded at its point farthest from the centroid of the whole cloud, whose normal
-// is made to point away from the centroid (Hoppe seeds at the largest z instead; the farthest
-// point lies on the convex hull and works for any rotation).
+// component is seeded at its point farthest from the centroid of the whole cloud (Hoppe seeds
+// at the largest z instead; the farthest point lies on the convex hull and works for any
+// rotation); then the component's points vote whether its normals point away from the centroid,
+// and the whole component is flipped when they mostly do not.
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -219,12 +220,15 @@ void orient_normals_ordered(const OrderedCloud& cloud, std::uint32_t graph_k,
     }
   };
   const auto in_tree = [&](std::size_t i) { return nodes[i].slot == kInTree; };
+  std::vector<std::uint32_t> members;
   const auto grow_tree = [&](std::uint32_t seed) {
     if (dot(nodes[seed].normal, p[seed] - c) < 0.0f) nodes[seed].normal = -nodes[seed].normal;
     nodes[seed].key = 0.0f;
     heap.push(seed);
+    members.clear();
     while (!heap.empty()) {
       const std::uint32_t u = heap.pop();
+      members.push_back(u);
       Node& node = nodes[u];
       if (node.parent != kNone && dot(node.normal, nodes[node.parent].normal) < 0.0f) {
         node.normal = -node.normal;
@@ -234,6 +238,15 @@ void orient_normals_ordered(const OrderedCloud& cloud, std::uint32_t graph_k,
         relax(node, u, reverse.from[e]);
       }
       if (++joined % 65536 == 0) phase.advance(65536);
+    }
+    // The component's points vote: normals are made to point away from the centroid where,
+    // summed over the component, they most do (each point weighted by how squarely its normal
+    // faces away from or toward the centroid). One seed alone can sit where "away" is
+    // ambiguous (the edge of a ground plane) and turn a whole scan inside out.
+    double vote = 0;
+    for (const std::uint32_t u : members) vote += double(dot(nodes[u].normal, p[u] - c));
+    if (vote < 0) {
+      for (const std::uint32_t u : members) nodes[u].normal = -nodes[u].normal;
     }
   };
 

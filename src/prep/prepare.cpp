@@ -6,6 +6,7 @@
 
 #include "pointillist/core/error.hpp"
 #include "pointillist/prep/normals.hpp"
+#include "pointillist/prep/outliers.hpp"
 #include "prep/ordered_cloud.hpp"
 
 namespace pointillist {
@@ -21,6 +22,10 @@ void check_options(const PrepareOptions& o) {
   if (!(o.radius_scale > 0.0f) || !std::isfinite(o.radius_scale)) {
     throw OptionError("prepare: radius scale " + std::to_string(o.radius_scale) +
                       " must be a positive number (1 keeps the computed radii)");
+  }
+  if (!(o.outlier_ratio_drop > 1.0f) || !std::isfinite(o.outlier_ratio_drop)) {
+    throw OptionError("prepare: outlier ratio " + std::to_string(o.outlier_ratio_drop) +
+                      " is invalid; give a number above 1 (3 is usual)");
   }
   if (!(o.coverage > 0.0f) || !std::isfinite(o.coverage)) {
     throw OptionError("prepare: coverage " + std::to_string(o.coverage) +
@@ -67,29 +72,11 @@ void check_points(const PointSet& p, const std::string& name) {
 // QSplat drops vertices that no face uses: they are usually scanner noise or leftovers of
 // editing, and mesh radii are undefined for them.
 void drop_unreferenced_vertices(PointSet& p) {
-  const std::size_t n = p.size();
-  std::vector<std::uint32_t> new_index(n, 0);
+  std::vector<std::uint8_t> used(p.size(), 0);
   for (const auto& t : p.triangles) {
-    for (const std::uint32_t v : t) new_index[v] = 1;
+    for (const std::uint32_t v : t) used[v] = 1;
   }
-  std::uint32_t kept = 0;
-  for (std::size_t i = 0; i < n; ++i) new_index[i] = new_index[i] ? kept++ : UINT32_MAX;
-  if (kept == n) return;
-  const auto compact = [&](auto& values) {
-    if (values.empty()) return;
-    for (std::size_t i = 0; i < n; ++i) {
-      if (new_index[i] != UINT32_MAX) values[new_index[i]] = values[i];
-    }
-    values.resize(kept);
-    values.shrink_to_fit();
-  };
-  compact(p.positions);
-  compact(p.normals);
-  compact(p.colors);
-  compact(p.radii);
-  for (auto& t : p.triangles) {
-    for (std::uint32_t& v : t) v = new_index[v];
-  }
+  keep_points(p, used);
 }
 
 void normalize_in_place(std::vector<Vec3f>& normals, ThreadPool& pool) {
@@ -106,6 +93,13 @@ void prepare_splats(PointSet& points, ThreadPool& pool, Progress& progress,
   const std::string& name = options.input_name;
   check_points(points, name);
   if (points.is_mesh()) drop_unreferenced_vertices(points);
+  if (options.drop_outliers) {
+    if (points.is_mesh()) {
+      throw OptionError(name + " is a mesh: outlier removal applies to point clouds (a mesh's "
+                        "faces define its surface; drop the option)");
+    }
+    remove_outliers(points, pool, progress, {.ratio = options.outlier_ratio_drop});
+  }
   const std::size_t n = points.size();
 
   NormalSource source = options.normals;

@@ -99,7 +99,7 @@ TEST(QsCli, SplatOptionsAreIgnoredWithAWarningForAMeshWrittenAsQs) {
   const CliResult conv = run_cli("convert -q " + qsplat_sample("dragon_vrip_res4.bbe.ply") +
                                  " -o " + out + " --radius-scale 2");
   ASSERT_EQ(conv.exit_code, 0) << conv.output;
-  EXPECT_THAT(conv.output, HasSubstr("--radius-scale are ignored for .qs output of a mesh"));
+  EXPECT_THAT(conv.output, HasSubstr("are ignored for .qs output of a mesh"));
   EXPECT_EQ(file_bytes(out), file_bytes(qsplat_sample("dragon_vrip_res4.strict.qs")));
 }
 
@@ -139,6 +139,42 @@ TEST(InputsCli, ConvertMergesSeveralTextFiles) {
   EXPECT_NEAR(box[0], 0.0, 1e-5);
   EXPECT_NEAR(box[3], 3.9, 1e-5);
   EXPECT_NEAR(box[4], 3.9, 1e-5);
+}
+
+TEST(InputsCli, DropOutliersRemovesStraysAboveAGridAndKeepsTheGrid) {
+  TempDir dir;
+  // A 60 × 60 grid in z = 0 (spacing 0.1) and 4 strays 1 to 2.5 above it, far apart.
+  std::string text;
+  char line[64];
+  for (int j = 0; j < 60; ++j) {
+    for (int i = 0; i < 60; ++i) {
+      std::snprintf(line, sizeof line, "%g %g 0\n", i * 0.1, j * 0.1);
+      text += line;
+    }
+  }
+  for (int k = 0; k < 4; ++k) {
+    std::snprintf(line, sizeof line, "%g %g %g\n", 1.0 + 4.0 * (k % 2), 1.0 + 4.0 * (k / 2),
+                  1.0 + 0.5 * k);
+    text += line;
+  }
+  write_text_file(dir.file("scan.xyz"), text);
+  const std::string ptl = dir.file("scan.ptl");
+  const CliResult conv =
+      run_cli("convert " + dir.file("scan.xyz") + " -o " + ptl + " --drop-outliers");
+  ASSERT_EQ(conv.exit_code, 0) << conv.output;
+  EXPECT_THAT(conv.output, HasSubstr("dropped 4 outliers of 3604 points"));
+  const CliResult info = run_cli("info " + ptl);
+  EXPECT_THAT(info.output, HasSubstr("points:      3600"));
+  EXPECT_NEAR(info_bounds(info.output)[5], 0.0, 1e-6) << "nothing above the grid is left";
+  // Without the option every point stays; a mesh refuses the option and writes nothing.
+  ASSERT_EQ(run_cli("convert -q " + dir.file("scan.xyz") + " -o " + ptl).exit_code, 0);
+  EXPECT_THAT(run_cli("info " + ptl).output, HasSubstr("points:      3604"));
+  write_text_file(dir.file("tri.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  const CliResult mesh = run_cli("convert " + dir.file("tri.obj") + " -o " +
+                                 dir.file("tri.ptl") + " --drop-outliers");
+  EXPECT_NE(mesh.exit_code, 0);
+  EXPECT_THAT(mesh.output, HasSubstr("outlier removal applies to point clouds"));
+  EXPECT_FALSE(fs::exists(dir.file("tri.ptl")));
 }
 
 TEST(InputsCli, GeoreferencedLasTilesLineUpWhenMerged) {

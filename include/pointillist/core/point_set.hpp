@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,11 @@ struct PointSet {
   bool has_radii() const { return !radii.empty(); }
   bool is_mesh() const { return !triangles.empty(); }
 };
+
+// Keeps the points i with keep[i] != 0 (keep.size() == points.size()), in order, with their
+// normals, colors and radii; triangles are renumbered and those using a removed point dropped.
+// Returns the number kept.
+std::size_t keep_points(PointSet& points, std::span<const std::uint8_t> keep);
 
 // Box around all positions (empty box for an empty set).
 Aabb bounding_box(const std::vector<Vec3f>& positions);

@@ -29,18 +29,24 @@ struct PrepareOptions {
   float coverage = kDefaultCloudCoverage;
   // Cap on an isolated point's radius relative to its neighbours' (CloudRadiusOptions); 0 = off.
   float outlier_ratio = kDefaultOutlierRatio;
+  // First drop a point cloud's outliers (remove_outliers, outliers.hpp): points whose neighbours
+  // are on average more than outlier_ratio times as far as theirs are (> 1; lower drops more).
+  // Off by default: it removes data. Not for meshes.
+  bool drop_outliers = false;
+  float outlier_ratio_drop = 3.0f;
   // Names the input in error messages (e.g. the file path).
   std::string input_name = "the input";
 };
 
-// Fills points.normals (unit length) and points.radii (world units):
+// Fills points.normals (unit length) and points.radii (world units), after dropping a cloud's
+// outliers when drop_outliers is set:
 //  - normals as chosen by options.normals (NormalSource);
 //  - radii: the file's radii × radius_scale when present, else mesh_radii for a mesh, else
 //    cloud_radii.
 // For a mesh, vertices used by no face are removed first (as QSplat does) together with their
 // normals, colors and radii, and the faces are renumbered; a point set with no faces at all is a
 // point cloud and keeps every point. Comments are kept.
-// Throws OptionError for bad options, and Error (saying what to do) when the input has no points,
+// Throws OptionError for bad options (outlier removal asked for a mesh among them), and Error (saying what to do) when the input has no points,
 // a non-finite coordinate, an attribute array of the wrong length or a face index out of range,
 // or when the requested normal source is impossible: Keep without normals in the input, Mesh
 // without faces, Pca (or Auto needing PCA) with fewer than 3 points.
