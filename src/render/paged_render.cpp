@@ -1,14 +1,9 @@
-// The paged QSplat traversal and its page cache (see paged.hpp).
+// The paged QSplat traversal over decoded or packed pages (see paged.hpp); the page cache and
+// loader are in paged_cache.cpp.
 #include <algorithm>
 #include <bit>
 #include <cstddef>
 #include <cstring>
-#include <condition_variable>
-#include <deque>
-#include <exception>
-#include <mutex>
-#include <thread>
-#include <utility>
 #include <chrono>
 #include <cmath>
 #include <string>
@@ -154,119 +149,6 @@ struct PagedRenderer::Selection {
   SplatStream& stream;
   Counters counters;
 };
-
-struct PagedRenderer::Loader {
-  std::mutex mutex;
-  std::condition_variable wake, idle;
-  std::deque<Request> queue;  // handed over, not yet decoded
-  std::vector<std::pair<Request, std::unique_ptr<HierarchyPage>>> ready;
-  std::exception_ptr error;
-  std::size_t busy = 0;  // pages being decoded now
-  bool stopping = false;
-  std::thread thread;
-};
-
-PagedRenderer::~PagedRenderer() {
-  if (!loader_) return;
-  {
-    std::lock_guard<std::mutex> lock(loader_->mutex);
-    loader_->stopping = true;
-  }
-  loader_->wake.notify_all();
-  loader_->thread.join();
-}
-
-void PagedRenderer::loader_loop() {
-  Loader& l = *loader_;
-  std::unique_lock<std::mutex> lock(l.mutex);
-  for (;;) {
-    l.wake.wait(lock, [&] { return l.stopping || !l.queue.empty(); });
-    if (l.stopping) return;
-    const Request r = l.queue.front();
-    l.queue.pop_front();
-    ++l.busy;
-    lock.unlock();
-    auto page = std::make_unique<HierarchyPage>();
-    std::exception_ptr error;
-    try {
-      source_.load(r.page, r.parent_page == kNoPage ? nullptr : &r.anchor, *page);
-    } catch (...) {
-      error = std::current_exception();
-    }
-    lock.lock();
-    --l.busy;
-    if (error) {
-      if (!l.error) l.error = error;
-    } else {
-      l.ready.emplace_back(r, std::move(page));
-    }
-    if (l.queue.empty() && l.busy == 0) l.idle.notify_all();
-  }
-}
-
-std::size_t PagedRenderer::request_in_background(std::size_t max_pages,
-                                                 std::uint64_t max_storage_bytes) {
-  std::vector<Request> chosen = choose(max_pages, max_storage_bytes);
-  if (chosen.empty()) return 0;
-  if (!loader_) {
-    loader_ = std::make_unique<Loader>();
-    loader_->thread = std::thread([this] { loader_loop(); });
-  }
-  {
-    std::lock_guard<std::mutex> lock(loader_->mutex);
-    for (const Request& r : chosen) {
-      in_flight_[r.page] = 1;
-      loader_->queue.push_back(r);
-    }
-    in_flight_count_ += chosen.size();
-  }
-  loader_->wake.notify_all();
-  return chosen.size();
-}
-
-void PagedRenderer::wait_for_loader() {
-  if (!loader_) return;
-  std::unique_lock<std::mutex> lock(loader_->mutex);
-  loader_->idle.wait(lock, [&] { return loader_->queue.empty() && loader_->busy == 0; });
-  if (loader_->error) std::rethrow_exception(loader_->error);
-}
-
-void PagedRenderer::take_ready() {
-  if (!loader_) return;
-  std::vector<std::pair<Request, std::unique_ptr<HierarchyPage>>> ready;
-  {
-    std::lock_guard<std::mutex> lock(loader_->mutex);
-    if (loader_->error) std::rethrow_exception(loader_->error);
-    ready.swap(loader_->ready);
-  }
-  for (auto& [r, page] : ready) {
-    in_flight_[r.page] = 0;
-    --in_flight_count_;
-    adopt(r, std::move(page));
-  }
-  stats_.resident_bytes_peak = std::max(stats_.resident_bytes_peak, stats_.resident_bytes);
-}
-
-PagedRenderer::PagedRenderer(const PageSource& source, std::uint64_t memory_cap, ThreadPool& pool)
-    : source_(source), cap_(memory_cap), summary_(source.summary()) {
-  const std::uint32_t n = source.page_count();
-  pages_.resize(n);
-  parent_.assign(n, kNoPage);
-  resident_children_.assign(n, 0);
-  last_used_.assign(n, 0);
-  requested_.assign(n, 0);
-  in_flight_.assign(n, 0);
-  stats_.bytes_read = source.open_bytes();
-  if (n == 0) return;
-  const std::uint64_t first = source.page_memory_bytes(0);
-  if (first > cap_) {
-    throw OptionError("memory cap of " + std::to_string(cap_) + " bytes is smaller than the " +
-                      "model's first page (" + std::to_string(first) +
-                      " bytes in memory); give at least that much");
-  }
-  requests_.push_back({0, kNoPage, SphereNode{}, 0.0f});
-  load_requested(pool);
-}
 
 void PagedRenderer::render(const Camera& camera, const RenderSettings& settings, ThreadPool& pool,
                            Frame& frame) {
@@ -484,93 +366,6 @@ void PagedRenderer::select(const Access& access, Selection& s, ThreadPool& pool)
       requests_.push_back(r);
     }
   }
-}
-
-bool PagedRenderer::make_room(std::uint64_t bytes) {
-  while (stats_.resident_bytes + bytes > cap_) {
-    std::uint32_t victim = kNoPage;
-    for (std::uint32_t p = 1; p < pages_.size(); ++p) {
-      if (!pages_[p] || resident_children_[p] != 0 || last_used_[p] >= frame_number_) continue;
-      if (victim == kNoPage || last_used_[p] < last_used_[victim] ||
-          (last_used_[p] == last_used_[victim] && p > victim)) {
-        victim = p;
-      }
-    }
-    if (victim == kNoPage) return false;
-    stats_.resident_bytes -= source_.page_memory_bytes(victim);
-    pages_[victim].reset();
-    if (parent_[victim] != kNoPage) --resident_children_[parent_[victim]];
-    parent_[victim] = kNoPage;
-    --stats_.resident_pages;
-    ++stats_.pages_evicted;
-  }
-  return true;
-}
-
-std::vector<PagedRenderer::Request> PagedRenderer::choose(std::size_t max_pages,
-                                                          std::uint64_t max_storage_bytes) {
-  std::stable_sort(requests_.begin(), requests_.end(),
-                   [](const Request& a, const Request& b) { return a.priority > b.priority; });
-  // Choose what fits, reserving its memory (pages chosen now are marked used in this frame, so
-  // they are not evicted for each other).
-  std::vector<Request> chosen;
-  std::uint64_t storage = 0;
-  for (const Request& r : requests_) {
-    if (chosen.size() >= max_pages) break;
-    if (pages_[r.page] || in_flight_[r.page]) continue;
-    const std::uint64_t read = source_.page_storage_bytes(r.page);
-    if (!chosen.empty() && storage + read > max_storage_bytes) break;
-    if (r.parent_page != kNoPage && !pages_[r.parent_page]) continue;
-    const std::uint64_t bytes = source_.page_memory_bytes(r.page);
-    if (!make_room(bytes)) continue;
-    stats_.resident_bytes += bytes;
-    // Keep the parent from being evicted while the page is on its way.
-    if (r.parent_page != kNoPage) {
-      ++resident_children_[r.parent_page];
-      last_used_[r.parent_page] = std::max(last_used_[r.parent_page], frame_number_);
-    }
-    last_used_[r.page] = frame_number_;
-    storage += read;
-    chosen.push_back(r);
-  }
-  for (const Request& r : requests_) requested_[r.page] = 0;
-  requests_.clear();
-  stats_.resident_bytes_peak = std::max(stats_.resident_bytes_peak, stats_.resident_bytes);
-  return chosen;
-}
-
-void PagedRenderer::adopt(const Request& r, std::unique_ptr<HierarchyPage> page) {
-  const bool packed = pages_[0] ? pages_[0]->is_packed() : page->is_packed();
-  if (page->node_count() != source_.page_node_count(r.page) ||
-      page->memory_bytes() != source_.page_memory_bytes(r.page) || page->is_packed() != packed ||
-      (!packed && page->child_page.size() != page->nodes.size())) {
-    throw FormatError("page " + std::to_string(r.page) + " loaded as " +
-                      std::to_string(page->node_count()) + " nodes in " +
-                      std::to_string(page->memory_bytes()) + " bytes where the page table says " +
-                      std::to_string(source_.page_node_count(r.page)) + " nodes in " +
-                      std::to_string(source_.page_memory_bytes(r.page)) +
-                      "; the model file is corrupt (convert it again)");
-  }
-  pages_[r.page] = std::move(page);
-  parent_[r.page] = r.parent_page;
-  last_used_[r.page] = std::max(last_used_[r.page], frame_number_);
-  stats_.bytes_read += source_.page_storage_bytes(r.page);
-  ++stats_.pages_loaded;
-  ++stats_.resident_pages;
-}
-
-std::size_t PagedRenderer::load_requested(ThreadPool& pool, std::size_t max_pages,
-                                          std::uint64_t max_storage_bytes) {
-  const std::vector<Request> chosen = choose(max_pages, max_storage_bytes);
-  std::vector<std::unique_ptr<HierarchyPage>> loaded(chosen.size());
-  pool.run(chosen.size(), [&](std::size_t i) {
-    auto page = std::make_unique<HierarchyPage>();
-    const Request& r = chosen[i];
-    source_.load(r.page, r.parent_page == kNoPage ? nullptr : &r.anchor, *page);
-    loaded[i] = std::move(page);
-  });
-  for (std::size_t i = 0; i < chosen.size(); ++i) adopt(chosen[i], std::move(loaded[i]));
-  return chosen.size();
 }
 
 }  // namespace pointillist
