@@ -89,7 +89,9 @@ summary() {
       rate("hierarchy build, 10M points (points/s)", "BM_BuildSphereTree/10000000", "BM_BaselineSortFloats/10000000", 1e6, "M/s", "items")
       time("hierarchy build, dragon (vs sorting 437k floats)", "BM_BuildSphereTreeDragon", "BM_BaselineSortFloats/437645")
       time("ptl v2 encode+write, dragon (vs v1 write)", "BM_EncodePtlV2/Dragon", "BM_BaselineWritePtlV1/Dragon")
+      time("ptl v2 encode+write, dragon, 2 threads (vs 1)", "BM_EncodePtlV2/Dragon2Threads/real_time", "BM_EncodePtlV2/Dragon")
       time("ptl v2 open+decode_all, dragon (vs v1 read)", "BM_DecodeAllPtlV2/Dragon", "BM_BaselineReadPtlV1/Dragon")
+      time("ptl v2 load every page packed (vs decode_all)", "BM_PackAllPagesPtlV2/Dragon", "BM_DecodeAllPtlV2/Dragon")
       b = "BM_BaselineProjectDragonPoints"
       for (th = 1; th <= 4; th *= 2) {
         n = "BM_RenderDragon/" th "/real_time"
