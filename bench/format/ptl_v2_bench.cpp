@@ -89,7 +89,7 @@ void BM_PackAllPagesPtlV2(benchmark::State& state, bool dragon) {
   for (auto _ : state) {
     resident = 0;
     for (std::uint32_t p = 0; p < source->page_count(); ++p) {
-      source->load(p, nullptr, page);
+      source->load(p, page);
       resident += page.memory_bytes();
     }
     benchmark::DoNotOptimize(resident);

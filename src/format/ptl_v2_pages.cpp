@@ -48,7 +48,7 @@ class PtlV2Pages final : public PageSource {
   std::uint64_t open_bytes() const override { return open_bytes_; }
   SphereTreeView summary() const override { return summary_; }
 
-  void load(std::uint32_t page, const SphereNode*, HierarchyPage& out) const override {
+  void load(std::uint32_t page, HierarchyPage& out) const override {
     out.nodes.clear();
     out.child_page.clear();
     PackedPage& packed = out.packed;

@@ -49,7 +49,7 @@ void PagedRenderer::loader_loop() {
     auto page = std::make_unique<HierarchyPage>();
     std::exception_ptr error;
     try {
-      source_.load(r.page, r.parent_page == kNoPage ? nullptr : &r.anchor, *page);
+      source_.load(r.page, *page);
     } catch (...) {
       error = std::current_exception();
     }
@@ -124,7 +124,7 @@ PagedRenderer::PagedRenderer(const PageSource& source, std::uint64_t memory_cap,
                       "model's first page (" + std::to_string(first) +
                       " bytes in memory); give at least that much");
   }
-  requests_.push_back({0, kNoPage, SphereNode{}, 0.0f});
+  requests_.push_back({0, kNoPage, 0.0f});
   load_requested(pool);
 }
 
@@ -208,7 +208,7 @@ std::size_t PagedRenderer::load_requested(ThreadPool& pool, std::size_t max_page
   pool.run(chosen.size(), [&](std::size_t i) {
     auto page = std::make_unique<HierarchyPage>();
     const Request& r = chosen[i];
-    source_.load(r.page, r.parent_page == kNoPage ? nullptr : &r.anchor, *page);
+    source_.load(r.page, *page);
     loaded[i] = std::move(page);
   });
   for (std::size_t i = 0; i < chosen.size(); ++i) adopt(chosen[i], std::move(loaded[i]));

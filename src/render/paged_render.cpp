@@ -206,10 +206,10 @@ void PagedRenderer::render_frame(const Camera& camera, const RenderSettings& set
     // the frame's nodes (decoded copies, stand-ins as drawn) in stream order and index them.
     gathered_.clear();
     gathered_.reserve(splats);
+    const bool packed = !pages_.empty() && pages_[0] && pages_[0]->is_packed();
     for (std::size_t t = 0; t < stream.chunk_count; ++t) {
       SplatChunk& chunk = stream.chunks[t];
       const TaskOut& out = task_out_[t];
-      const bool packed = pages_[0]->is_packed();
       for (std::size_t i = 0; i < chunk.count; ++i) {
         const std::uint32_t local = chunk.node[i];
         gathered_.push_back(packed ? out.values[local] : *out.emitted[local]);
@@ -326,7 +326,7 @@ void PagedRenderer::select(const Access& access, Selection& s, ThreadPool& pool)
         if (!c.resident) {
           // Not resident: this node stands in for its subtree, and the page is wanted.
           emit(n, d, z, true);
-          out.requests.push_back({c.page, p.page, n, z > 0 ? n.radius / z : 0.0f});
+          out.requests.push_back({c.page, p.page, z > 0 ? n.radius / z : 0.0f});
           continue;
         }
         if (c.page != p.page) out.touched.push_back(c.page);

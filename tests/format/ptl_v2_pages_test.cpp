@@ -141,7 +141,7 @@ TEST(PtlV2Pages, ChildPageWhoseRootsDisagreeWithTheParentRecordIsRejectedOnLoad)
   const auto source = ptl_v2_page_source(*file);
   HierarchyPage page;
   try {
-    source->load(1, nullptr, page);
+    source->load(1, page);
     ADD_FAILURE() << "no error";
   } catch (const FormatError& e) {
     const std::string m = e.what();
@@ -167,7 +167,7 @@ TEST(PtlV2Pages, Bit15IsALeafTrimBitOnlyWhereTheSchemaSaysSo) {
     const auto source = ptl_v2_page_source(*file);
     HierarchyPage page;
     try {
-      source->load(0, nullptr, page);
+      source->load(0, page);
       ADD_FAILURE() << "no error";
     } catch (const FormatError& e) {
       EXPECT_NE(std::string(e.what()).find("reserved bit 15"), std::string::npos) << e.what();

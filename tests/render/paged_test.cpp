@@ -67,7 +67,7 @@ TEST(Paginate, EveryNodeIsInExactlyOnePageAndPagesRespectTheirSize) {
   };
   std::vector<HierarchyPage> pages(source->page_count());
   for (std::uint32_t p = 0; p < source->page_count(); ++p) {
-    source->load(p, nullptr, pages[p]);
+    source->load(p, pages[p]);
     EXPECT_LE(pages[p].nodes.size() * sizeof(SphereNode), page_bytes) << "page " << p;
     EXPECT_EQ(pages[p].nodes.size(), source->page_node_count(p));
     nodes += pages[p].nodes.size();

@@ -118,9 +118,8 @@ class PageSource {
   // view_sphere (for the camera) and has_colors.
   virtual SphereTreeView summary() const = 0;
   // Loads page `page` into `out`, decoded or packed (every page of a source in the same form).
-  // `anchor` is the page's anchor node as the parent page gave it (null for page 0). Safe to
-  // call concurrently for different pages. Throws FormatError or IoError.
-  virtual void load(std::uint32_t page, const SphereNode* anchor, HierarchyPage& out) const = 0;
+  // Safe to call concurrently for different pages. Throws FormatError or IoError.
+  virtual void load(std::uint32_t page, HierarchyPage& out) const = 0;
 };
 
 // `tree` cut into pages: page 0 takes the root and then whole sibling groups breadth-first while
@@ -198,8 +197,7 @@ class PagedRenderer {
   struct Request {
     std::uint32_t page;
     std::uint32_t parent_page;
-    SphereNode anchor;
-    float priority;  // the anchor's projected radius: larger first
+    float priority;  // the projected radius of the node standing in for it: larger first
   };
   void render_frame(const Camera& camera, const RenderSettings& settings,
                     const QualitySettings* quality, QualityScratch* scratch, ThreadPool& pool,
