@@ -152,7 +152,8 @@ class FrameRenderer {
   float initial_detail() const {
     return o_.lod == LodScheme::Spt ? o_.epsilon_px : o_.settings.threshold_px;
   }
-  void draw(const Camera& camera, float detail, Frame& frame) {
+  // `fast_only`: a paged model in the quality mode draws a fast frame (the same selection).
+  void draw(const Camera& camera, float detail, Frame& frame, bool fast_only = false) {
     RenderSettings settings = o_.settings;
     if (o_.lod == LodScheme::Spt) {
       render_spt(spt_, camera, settings,
@@ -160,7 +161,7 @@ class FrameRenderer {
                  &spt_stats_);
     } else if (paged_) {
       settings.threshold_px = detail;
-      if (o_.mode == RenderMode::Quality) {
+      if (o_.mode == RenderMode::Quality && !fast_only) {
         paged_->render_quality(camera, settings, o_.quality, pool_, frame, quality_scratch_);
       } else {
         paged_->render(camera, settings, pool_, frame);
@@ -194,22 +195,14 @@ class FrameRenderer {
   }
   // Draws the view until a paged model has loaded all it needs (or all the cap allows).
   void draw_settled(const Camera& camera, float detail, Frame& frame) {
-    if (paged_ && o_.mode == RenderMode::Quality) {
-      // Load with fast frames (the same selection, so the same pages), then draw the quality
-      // image once.
-      RenderSettings settings = o_.settings;
-      settings.threshold_px = detail;
-      for (int round = 0; round < kMaxSettleRounds; ++round) {
-        paged_->render(camera, settings, pool_, frame);
-        if (paged_->complete() || after_frame() == 0) break;
-      }
-      draw(camera, detail, frame);
-      return;
-    }
+    // A paged quality image loads its pages with fast frames (the same selection, so the same
+    // pages) and is drawn once at the end.
+    const bool quality_last = paged_ && o_.mode == RenderMode::Quality;
     for (int round = 0; round < kMaxSettleRounds; ++round) {
-      draw(camera, detail, frame);
-      if (!paged_ || paged_->complete() || after_frame() == 0) return;
+      draw(camera, detail, frame, quality_last);
+      if (!paged_ || paged_->complete() || after_frame() == 0) break;
     }
+    if (quality_last) draw(camera, detail, frame);
   }
   bool paged() const { return paged_.has_value(); }
   // Fills the paged-model fields of a frame record.

@@ -66,8 +66,7 @@ class PtlV2Pages final : public PageSource {
       std::uint32_t offset = 0;
       for (std::uint32_t j = 0; j < info.root_count; ++j) {
         const std::uint32_t node = info.first_root + j;
-        const std::uint32_t children =
-            quant::bits(packed.records[node], quant::kChildShift, quant::kChildBits);
+        const std::uint32_t children = quant::record_child_count(packed.records[node]);
         if (node < packed.last_level_begin || children == 0) {
           corrupt(node, "page " + str(q) + " continues it, but it is not an interior node of the "
                             "page's last level");
@@ -80,11 +79,11 @@ class PtlV2Pages final : public PageSource {
         if (!packed.links.empty() && node <= previous) corrupt(node, "child pages overlap");
         previous = node;
         packed.links.push_back({q, offset});
-        offset += children + 1;
+        offset += children;
       }
     }
     for (std::uint32_t i = packed.last_level_begin; i < count; ++i) {
-      if (quant::bits(packed.records[i], quant::kChildShift, quant::kChildBits) != 0 &&
+      if (quant::record_child_count(packed.records[i]) != 0 &&
           !linked[i - packed.last_level_begin]) {
         corrupt(i, "has children but no page holds them");
       }

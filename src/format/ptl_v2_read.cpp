@@ -251,6 +251,9 @@ std::uint32_t PtlV2File::scan_page(std::uint32_t page, std::vector<Sphere>& root
     root_spheres[r] = sphere;
     root_child_counts[r] = k;
   }
+  if (page == 0 && std::memcmp(&root_spheres[0], &root_sphere_, sizeof(Sphere)) != 0) {
+    fail_at(path_, info.offset, "page 0's root sphere differs from the header's");
+  }
   const std::uint64_t records_at = info.offset + std::uint64_t{roots} * kRootEntrySize;
   const std::uint32_t count = info.node_count, rs = record_size_;
   const bool trim_low_bit = leaf_trim_ == LeafTrim::Sixteenths;
@@ -293,7 +296,7 @@ std::uint32_t PtlV2File::scan_page(std::uint32_t page, std::vector<Sphere>& root
         const std::uint32_t rec = load_u32(r);
         const std::uint16_t color = rs == 6 ? load_u16(r + 4) : 0;
         const std::uint32_t code = bits(rec, kSphereShift, kSphereBits);
-        const std::uint32_t children = bits(rec, kChildShift, kChildBits);
+        const std::uint32_t children = record_child_count(rec);
         const std::uint32_t normal = bits(rec, kNormalShift, kNormalBits);
         if (code >= kSphereCodeCount) {
           fail_at(path_, at,
@@ -310,7 +313,7 @@ std::uint32_t PtlV2File::scan_page(std::uint32_t page, std::vector<Sphere>& root
                   which() + "record " + str(i) + ": normal code " + str(normal) +
                       " is outside the table (0.." + str(kNormalCodeCount - 1) + ")");
         }
-        child_counts[i] = static_cast<std::uint8_t>(children == 0 ? 0 : children + 1);
+        child_counts[i] = static_cast<std::uint8_t>(children);
         need += child_counts[i];
         on_record(static_cast<std::uint32_t>(i), rec, color, parent, c == 0);
       }
@@ -337,15 +340,14 @@ void PtlV2File::decode_page(std::uint32_t page, PtlV2Page& out) const {
       page, out.root_spheres, out.root_child_counts,
       [&](std::uint32_t i, std::uint32_t rec, std::uint16_t color, PageParent parent,
           bool first_child) {
-        Sphere ps;
         if (parent.is_root) {
-          ps = out.root_spheres[parent.index];
+          decode_node_into(tables, rec, color, has_colors_, leaf_trim_,
+                           out.root_spheres[parent.index], out.nodes[i]);
         } else {
           SphereNode& pn = out.nodes[parent.index];
           if (first_child) pn.first_child = i;
-          ps = {pn.center, pn.radius};
+          decode_node_into(tables, rec, color, has_colors_, leaf_trim_, pn, out.nodes[i]);
         }
-        out.nodes[i] = decode_node(tables, rec, color, has_colors_, leaf_trim_, ps);
       });
 }
 
@@ -367,11 +369,8 @@ void PtlV2File::pack_page(std::uint32_t page, PackedPage& out) const {
   for (const std::uint8_t k : root_child_counts) first_level += k;
   out.index_links(first_level);
   out.root_parent = root_spheres[0];
-  const PtlV2PageInfo& info = pages_[page];
-  if (page == 0 && std::memcmp(&out.root_parent, &root_sphere_, sizeof(Sphere)) != 0) {
-    fail_at(path_, info.offset, "page 0's root sphere differs from the header's");
-  }
   if (page == 0) return;
+  const PtlV2PageInfo& info = pages_[page];
   // The traversal reaches this page through its roots' records in the parent page, whose child
   // counts must be the ones this page's first level was checked against.
   const PtlV2PageInfo& parent = pages_[info.parent_page];
@@ -380,13 +379,13 @@ void PtlV2File::pack_page(std::uint32_t page, PackedPage& out) const {
       parent.offset + std::uint64_t{parent.root_count} * kRootEntrySize;
   for (std::uint32_t r = 0; r < info.root_count; ++r) {
     const std::uint64_t at = parent_records + std::uint64_t{info.first_root + r} * record_size_;
-    const std::uint32_t children = bits(load_u32(base + at), kChildShift, kChildBits);
-    if (children == 0 || children + 1 != root_child_counts[r]) {
+    const std::uint32_t children = record_child_count(load_u32(base + at));
+    if (children == 0 || children != root_child_counts[r]) {
       fail_at(path_, info.offset + 16 * info.root_count + r,
               "page " + str(page) + ": root " + str(r) + " has " + str(root_child_counts[r]) +
                   " children, record " + str(info.first_root + r) + " of parent page " +
                   str(info.parent_page) + " (byte " + str(at) + ") has " +
-                  str(children == 0 ? 0 : children + 1));
+                  str(children));
     }
   }
 }
@@ -447,9 +446,6 @@ SphereTree PtlV2File::decode_all() const {
                 "page " + str(p) + ": record " + str(v) + " has children, but no page holds them");
       }
     }
-  }
-  if (std::memcmp(&pages[0].root_spheres[0], &root_sphere_, sizeof(Sphere)) != 0) {
-    fail_at(path_, pages_[0].offset, "page 0's root sphere differs from the header's");
   }
 
   // Breadth-first over the linked pages: the order in which the tree was written.

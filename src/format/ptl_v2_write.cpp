@@ -277,11 +277,7 @@ PtlV2WriteReport write_ptl_v2(const std::string& path, const SphereTree& tree,
     const std::uint64_t children = nodes[i].child_count == 0 ? 0 : nodes[i].child_count - 1u;
     record[i] = std::uint64_t{code} << kSphereShift | children << kChildShift;
     if (nodes[i].child_count == 0) {
-      const std::uint32_t trim = leaf.trim;
-      record[i] |= mode == LeafTrim::Eighths
-                       ? std::uint64_t{trim} << kConeShift
-                       : std::uint64_t{trim >> 1} << kConeShift | std::uint64_t{trim & 1}
-                                                                      << kLowTrimShift;
+      record[i] |= leaf_trim_bits(leaf.trim, mode);
       if (nodes[i].radius > 0) {
         stats.leaf_ratio_sum += double(leaf.radius) / nodes[i].radius;
         ++stats.leaf_ratio_count;

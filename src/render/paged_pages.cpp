@@ -102,9 +102,9 @@ void PackedPage::index_links(std::uint32_t first_level_count) {
                                      : first_last_level_block() + (k >> kBlockShift)] = base;
     }
     link_step[i] = static_cast<std::uint8_t>(value - base);  // at most 4 · 63
-    const std::uint32_t children = quant::bits(records[i], quant::kChildShift, quant::kChildBits);
+    const std::uint32_t children = quant::record_child_count(records[i]);
     if (i < last_level_begin) {
-      value += children == 0 ? 0 : children + 1;
+      value += children;
     } else {
       value += children != 0;
     }

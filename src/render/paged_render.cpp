@@ -1,9 +1,6 @@
 // The paged QSplat traversal over decoded or packed pages (see paged.hpp); the page cache and
 // loader are in paged_cache.cpp.
 #include <algorithm>
-#include <bit>
-#include <cstddef>
-#include <cstring>
 #include <chrono>
 #include <cmath>
 #include <string>
@@ -12,7 +9,6 @@
 #include "pointillist/core/error.hpp"
 #include "pointillist/render/paged.hpp"
 #include "render/frame_timing.hpp"
-#include "render/simd.hpp"
 #include "render/shading.hpp"
 #include "render/traversal_common.hpp"
 
@@ -72,7 +68,9 @@ class PackedAccess {
       : pages_(pages), has_colors_(has_colors) {}
   Item root(std::uint8_t tests) const {
     const PackedPage& pk = pages_[0]->packed;
-    return {decode(pk, 0, pk.root_parent), 0, 0, tests};
+    Item root{{}, 0, 0, tests};
+    decode(pk, 0, pk.root_parent, root.node);
+    return root;
   }
   const SphereNode& node(const Item& p) const { return p.node; }
   ChildRef children(const Item& p, const SphereNode&) const {
@@ -84,11 +82,7 @@ class PackedAccess {
   }
   const SphereNode* load_children(ChildRef c, const SphereNode& n, SphereNode* scratch) const {
     const PackedPage& pk = pages_[c.page]->packed;
-    Float4 parent;
-    std::memcpy(&parent, &n.center, sizeof parent);  // centre and radius
-    for (std::uint32_t k = 0; k < n.child_count; ++k) {
-      decode_into(pk, c.first + k, parent, scratch[k]);
-    }
+    for (std::uint32_t k = 0; k < n.child_count; ++k) decode(pk, c.first + k, n, scratch[k]);
     return scratch;
   }
   Item item(ChildRef c, std::uint32_t k, const SphereNode* kids, std::uint8_t tests) const {
@@ -96,44 +90,11 @@ class PackedAccess {
   }
 
  private:
-  SphereNode decode(const PackedPage& pk, std::uint32_t i, const Sphere& parent) const {
-    return quant::decode_node(tables_, pk.records[i], has_colors_ ? pk.colors[i] : 0,
-                              has_colors_, pk.leaf_trim, parent);
+  template <class Parent>
+  void decode(const PackedPage& pk, std::uint32_t i, const Parent& parent, SphereNode& out) const {
+    quant::decode_node_into(tables_, pk.records[i], has_colors_ ? pk.colors[i] : 0, has_colors_,
+                            pk.leaf_trim, parent, out);
   }
-  // quant::decode_node, same bits, written as three stores (16, 16 and 8 bytes) that later
-  // copies of the node load whole: built field by field, the node's copies stall on
-  // store-to-load forwarding (a third of the traversal's time, measured).
-  void decode_into(const PackedPage& pk, std::uint32_t i, Float4 parent, SphereNode& out) const {
-    using namespace quant;
-    const std::uint32_t rec = pk.records[i];
-    Float4 cand;
-    std::memcpy(&cand, &tables_.spheres[bits(rec, kSphereShift, kSphereBits)], sizeof cand);
-    // centre + radius · offset and radius · r, as decode_sphere (0 + x is x for x > 0)
-    Float4 sphere = Float4{parent[0], parent[1], parent[2], 0.0f} + splat4(parent[3]) * cand;
-    const std::uint32_t children = bits(rec, kChildShift, kChildBits);
-    float cone = 0.0f;
-    if (children == 0) {
-      sphere[3] = trimmed_leaf_radius(sphere[3], leaf_trim_code(rec, pk.leaf_trim), pk.leaf_trim);
-    } else {
-      cone = decoded_cone_sin(bits(rec, kConeShift, kConeBits));
-    }
-    const Vec3f& normal = tables_.normals[bits(rec, kNormalShift, kNormalBits)];
-    const Float4 normal_cone{normal.x, normal.y, normal.z, cone};
-    const Rgb8 color = has_colors_ ? decode_rgb565(pk.colors[i]) : Rgb8{};
-    const std::uint64_t tail = std::uint64_t{children == 0 ? 0 : children + 1} << 32 |
-                               std::uint64_t{color.r} << 40 | std::uint64_t{color.g} << 48 |
-                               std::uint64_t{color.b} << 56;  // first_child 0
-    auto* bytes = reinterpret_cast<unsigned char*>(&out);
-    std::memcpy(bytes + offsetof(SphereNode, center), &sphere, sizeof sphere);
-    std::memcpy(bytes + offsetof(SphereNode, normal), &normal_cone, sizeof normal_cone);
-    std::memcpy(bytes + offsetof(SphereNode, first_child), &tail, sizeof tail);
-  }
-  static_assert(offsetof(SphereNode, radius) == 12 && offsetof(SphereNode, normal) == 16 &&
-                    offsetof(SphereNode, cone_sin) == 28 &&
-                    offsetof(SphereNode, first_child) == 32 &&
-                    offsetof(SphereNode, child_count) == 36 && offsetof(SphereNode, color) == 37,
-                "decode_into writes SphereNode's layout");
-  static_assert(std::endian::native == std::endian::little, "decode_into writes little-endian");
 
   const PageTable& pages_;
   bool has_colors_;

@@ -46,6 +46,13 @@ void render_until_settled(PagedRenderer& r, const Camera& cam, ThreadPool& pool,
   FAIL() << "did not settle in " << max_rounds << " rounds";
 }
 
+// Memory of every page of `source` when resident.
+std::uint64_t all_pages_memory(const PageSource& source) {
+  std::uint64_t total = 0;
+  for (std::uint32_t p = 0; p < source.page_count(); ++p) total += source.page_memory_bytes(p);
+  return total;
+}
+
 ImageComparison compare(const Frame& reference, const Frame& test) {
   return compare_images({reference.width, reference.height, reference.color},
                         {test.width, test.height, test.color},
@@ -142,8 +149,7 @@ TEST(PagedRender, QualityModeUnderACapDrawsItsStandInsWithoutHoles) {
   ThreadPool pool(2);
   const SphereTree& tree = demo_tree();
   const auto source = paginate(tree.view(), 4096);
-  std::uint64_t total = 0;
-  for (std::uint32_t p = 0; p < source->page_count(); ++p) total += source->page_memory_bytes(p);
+  const std::uint64_t total = all_pages_memory(*source);
   PagedRenderer capped(*source, total / 6, pool);
   const Camera cam = view(20);
   Frame full, frame;
@@ -207,10 +213,7 @@ TEST(PagedRender, MemoryCapHoldsAndTheImageStillHasNoHoles) {
   ThreadPool pool(2);
   const SphereTree& tree = demo_tree();
   const auto source = paginate(tree.view(), 4096);
-  std::uint64_t total = 0;
-  for (std::uint32_t p = 0; p < source->page_count(); ++p) {
-    total += HierarchyPage::memory_bytes(source->page_node_count(p));
-  }
+  const std::uint64_t total = all_pages_memory(*source);
   const std::uint64_t cap = total / 10;
   PagedRenderer paged(*source, cap, pool);
   // Orbit around the model: pages of the far side are dropped for those of the near side.
@@ -261,10 +264,7 @@ TEST(PagedRender, BackgroundLoaderReachesTheFullImageAndHoldsTheCap) {
     EXPECT_TRUE(paged.complete());
     EXPECT_EQ(frame.color, full.color);
   }
-  std::uint64_t total = 0;
-  for (std::uint32_t p = 0; p < source->page_count(); ++p) {
-    total += HierarchyPage::memory_bytes(source->page_node_count(p));
-  }
+  const std::uint64_t total = all_pages_memory(*source);
   PagedRenderer capped(*source, total / 8, pool);
   for (float az = 0; az < 360; az += 60) {
     for (int i = 0; i < 60; ++i) {

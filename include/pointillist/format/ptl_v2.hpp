@@ -160,7 +160,8 @@ class PtlV2File {
     std::uint32_t index = 0;
   };
   PtlV2File() = default;
-  // Validates page `page` (root table, then each record and the level structure) and calls
+  // Validates page `page` (root table, page 0's root against the header's sphere, then each
+  // record and the level structure) and calls
   // on_record(index, record bits 0..31, RGB 565 or 0, parent, is_first_child) for each record in
   // order. Returns the index of the first record of the last level.
   template <class OnRecord>
