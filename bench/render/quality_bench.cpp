@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "bench_data.hpp"
-#include "pointillist/render/image_compare.hpp"
+#include "pointillist/eval/image_compare.hpp"
 #include "pointillist/render/mesh_reference.hpp"
 #include "pointillist/render/quality.hpp"
 #include "pointillist/render/render.hpp"

@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "bench_data.hpp"
-#include "pointillist/render/point_baseline.hpp"
+#include "render/point_baseline.hpp"
 #include "pointillist/render/render.hpp"
 
 using namespace pointillist;

@@ -5,10 +5,10 @@
 #include <fstream>
 #include <string>
 
-#include "cli/commands.hpp"
+#include "commands.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/io/png.hpp"
-#include "pointillist/render/image_compare.hpp"
+#include "pointillist/eval/image_compare.hpp"
 
 namespace pointillist::cli {
 namespace {

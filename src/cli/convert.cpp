@@ -3,9 +3,9 @@
 #include <filesystem>
 #include <sstream>
 
-#include "cli/commands.hpp"
-#include "cli/model_loading.hpp"
-#include "cli/terminal_progress.hpp"
+#include "commands.hpp"
+#include "model_loading.hpp"
+#include "terminal_progress.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/format/ptl.hpp"
 #include "pointillist/format/ptl_v2.hpp"

@@ -4,9 +4,9 @@
 #include <string>
 #include <vector>
 
-#include "cli/commands.hpp"
-#include "cli/model_loading.hpp"
-#include "cli/terminal_progress.hpp"
+#include "commands.hpp"
+#include "model_loading.hpp"
+#include "terminal_progress.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/format/ptl_v2.hpp"
 #include "pointillist/io/ply.hpp"

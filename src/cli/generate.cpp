@@ -1,6 +1,6 @@
 #include <cstdio>
 
-#include "cli/commands.hpp"
+#include "commands.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/io/ply.hpp"
 #include "pointillist/scene/analytic.hpp"

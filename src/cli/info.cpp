@@ -4,8 +4,8 @@
 #include <cstdio>
 #include <string>
 
-#include "cli/commands.hpp"
-#include "cli/model_loading.hpp"
+#include "commands.hpp"
+#include "model_loading.hpp"
 #include "pointillist/lod/sequential_point_tree.hpp"
 #include "pointillist/render/spt_render.hpp"
 

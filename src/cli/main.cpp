@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "cli/commands.hpp"
+#include "commands.hpp"
 #include "pointillist/core/error.hpp"
 
 namespace pc = pointillist::cli;

@@ -1,4 +1,4 @@
-#include "cli/model_loading.hpp"
+#include "model_loading.hpp"
 
 #include <unistd.h>
 

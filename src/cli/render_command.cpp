@@ -8,10 +8,10 @@
 #include <sstream>
 #include <vector>
 
-#include "cli/commands.hpp"
-#include "cli/model_loading.hpp"
-#include "cli/stats_json.hpp"
-#include "cli/terminal_progress.hpp"
+#include "commands.hpp"
+#include "model_loading.hpp"
+#include "stats_json.hpp"
+#include "terminal_progress.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/io/png.hpp"
 #include "pointillist/render/depth_image.hpp"

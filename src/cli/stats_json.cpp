@@ -1,4 +1,4 @@
-#include "cli/stats_json.hpp"
+#include "stats_json.hpp"
 
 #include <cstdio>
 

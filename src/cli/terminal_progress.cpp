@@ -1,4 +1,4 @@
-#include "cli/terminal_progress.hpp"
+#include "terminal_progress.hpp"
 
 #include <unistd.h>
 

@@ -14,8 +14,8 @@
 #include <cstring>
 #include <string>
 
-#include "format/printable.hpp"
-#include "format/ptl_header.hpp"
+#include "printable.hpp"
+#include "ptl_header.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/format/ptl.hpp"
 

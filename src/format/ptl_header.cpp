@@ -1,4 +1,4 @@
-#include "format/ptl_header.hpp"
+#include "ptl_header.hpp"
 
 #include <cstring>
 

@@ -3,7 +3,7 @@
 // sphere, which misses a third of the true spheres (../shared/specs/qsplat-qs-format.md §4.3).
 // Here the code is searched instead: the smallest decoded sphere that encloses the true one and
 // stays inside the decoded parent, so culling against decoded spheres is conservative.
-#include "format/ptl_v2_codec.hpp"
+#include "ptl_v2_codec.hpp"
 
 #include <algorithm>
 #include <array>

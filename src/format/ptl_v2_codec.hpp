@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <span>
 
-#include "format/ptl_v2_layout.hpp"
-#include "format/qs_tables.hpp"
+#include "ptl_v2_layout.hpp"
+#include "qs_tables.hpp"
 #include "pointillist/core/math.hpp"
 
 namespace pointillist::ptl2 {

@@ -9,19 +9,19 @@
 #include <utility>
 #include <vector>
 
-#include "format/ptl_header.hpp"
-#include "format/ptl_v2_codec.hpp"
-#include "format/ptl_v2_layout.hpp"
-#include "io/file_bytes.hpp"
+#include "ptl_header.hpp"
+#include "ptl_v2_codec.hpp"
+#include "ptl_v2_layout.hpp"
+#include "pointillist/core/file_bytes.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/format/ptl.hpp"
 #include "pointillist/format/ptl_v2.hpp"
-#include "pointillist/render/paged.hpp"
+#include "pointillist/lod/pages.hpp"
 
 namespace pointillist {
 
 struct PtlV2File::Mapping {
-  io_detail::FileBytes bytes;
+  FileBytes bytes;
 };
 
 namespace {
@@ -43,7 +43,7 @@ bool finite_sphere(const Sphere& s) {
 std::unique_ptr<PtlV2File> PtlV2File::open(const std::string& path) {
   std::unique_ptr<PtlV2File> file(new PtlV2File);
   file->path_ = path;
-  file->map_ = std::make_unique<Mapping>(Mapping{io_detail::FileBytes::map(path)});
+  file->map_ = std::make_unique<Mapping>(Mapping{FileBytes::map(path)});
   const std::string_view view = file->map_->bytes.view();
   const auto* b = reinterpret_cast<const std::uint8_t*>(view.data());
   const std::uint64_t size = view.size();
@@ -508,7 +508,7 @@ SphereTree PtlV2File::decode_all() const {
 PtlModel read_ptl(const std::string& path) {
   std::uint32_t version = 0;
   {
-    const io_detail::FileBytes bytes = io_detail::FileBytes::map(path);
+    const FileBytes bytes = FileBytes::map(path);
     const std::string_view v = bytes.view();
     if (v.size() >= 12 && std::memcmp(v.data(), ptl::kMagic, sizeof ptl::kMagic) == 0) {
       version = load_u32(reinterpret_cast<const std::uint8_t*>(v.data()) + 8);

@@ -8,10 +8,10 @@
 #include <string>
 #include <vector>
 
-#include "format/ptl_header.hpp"
-#include "format/ptl_v2_codec.hpp"
-#include "format/ptl_v2_layout.hpp"
-#include "io/atomic_file.hpp"
+#include "ptl_header.hpp"
+#include "ptl_v2_codec.hpp"
+#include "ptl_v2_layout.hpp"
+#include "pointillist/core/atomic_file.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/format/ptl_v2.hpp"
 
@@ -395,7 +395,7 @@ PtlV2WriteReport write_ptl_v2(const std::string& path, const SphereTree& tree,
     store_u32(e + 28, pages[p].level_count);
   }
 
-  io_detail::AtomicFile file(path);
+  AtomicFile file(path);
   file.write(head.data(), head.size());
   std::vector<std::uint8_t> bytes;
   for (std::size_t p = 0; p < pages.size(); ++p) {

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "format/ptl_header.hpp"
+#include "ptl_header.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/format/ptl.hpp"
 

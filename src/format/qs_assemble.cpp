@@ -3,7 +3,7 @@
 // (spec ../shared/specs/qsplat-qs-format.md §4.3), and its normal cone codes were computed from
 // the undithered normals (§5.2, §6). Our traversal culls whole subtrees on a parent's sphere and
 // cone, so both are enlarged here, bottom-up, until they cover the children's.
-#include "format/qs_assemble.hpp"
+#include "qs_assemble.hpp"
 
 #include <algorithm>
 #include <cassert>

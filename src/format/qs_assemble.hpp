@@ -5,7 +5,7 @@
 
 #include <vector>
 
-#include "format/qs_layout.hpp"
+#include "qs_layout.hpp"
 #include "pointillist/format/qs.hpp"
 
 namespace pointillist::qs_detail {

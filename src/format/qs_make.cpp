@@ -3,7 +3,7 @@
 // §8.2-8.4. Every value is float32 and evaluated in the spec's order (§8.6), because the files
 // must come out byte-identical to the original's: do not "simplify" an expression here (e.g.
 // x / k into x * (1 / k)) without checking the golden files.
-#include "format/qs_make.hpp"
+#include "qs_make.hpp"
 
 #include <algorithm>
 #include <cassert>

@@ -12,11 +12,11 @@
 #include <string>
 #include <vector>
 
-#include "format/printable.hpp"
-#include "format/qs_assemble.hpp"
-#include "format/qs_layout.hpp"
-#include "format/qs_tables.hpp"
-#include "io/file_bytes.hpp"
+#include "printable.hpp"
+#include "qs_assemble.hpp"
+#include "qs_layout.hpp"
+#include "qs_tables.hpp"
+#include "pointillist/core/file_bytes.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/format/qs.hpp"
 
@@ -260,7 +260,7 @@ DecodedTree decode_fragment(const std::string& path, const std::uint8_t* file, Q
 }  // namespace
 
 QsModel read_qs(const std::string& path) {
-  const io_detail::FileBytes bytes = io_detail::FileBytes::map(path);
+  const FileBytes bytes = FileBytes::map(path);
   const auto* file = reinterpret_cast<const std::uint8_t*>(bytes.view().data());
   const std::uint64_t size = bytes.view().size();
   if (size == 0) fail_at(path, 0, "the file is empty (expected a QSplat .qs file)");

@@ -1,7 +1,7 @@
 // The parts of QSplat's quantization only the .qs files use (Rusinkiewicz & Levoy, SIGGRAPH
 // 2000; ../shared/specs/qsplat-qs-format.md §4.3, §6, §8.6): QSplat 1.0's own sphere and cone
 // encoders and glibc's rand() for its normal dither. The tables are in lod/quantization.hpp.
-#include "format/qs_tables.hpp"
+#include "qs_tables.hpp"
 
 #include <algorithm>
 #include <array>

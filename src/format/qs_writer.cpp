@@ -9,10 +9,10 @@
 #include <string>
 #include <vector>
 
-#include "format/qs_layout.hpp"
-#include "format/qs_make.hpp"
-#include "format/qs_tables.hpp"
-#include "io/atomic_file.hpp"
+#include "qs_layout.hpp"
+#include "qs_make.hpp"
+#include "qs_tables.hpp"
+#include "pointillist/core/atomic_file.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/format/qs.hpp"
 
@@ -171,7 +171,7 @@ QsWriteReport write_qs(const std::string& path, const PointSet& mesh,
   }
   report.file_size = comment.size() + fragment.size();
 
-  io_detail::AtomicFile file(path);
+  AtomicFile file(path);
   if (!comment.empty()) file.write(comment.data(), comment.size());  // data() may be null
   file.write(fragment.data(), fragment.size());
   file.commit();

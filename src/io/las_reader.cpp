@@ -9,8 +9,8 @@
 #include <functional>
 #include <limits>
 
-#include "io/file_bytes.hpp"
-#include "io/text_numbers.hpp"
+#include "pointillist/core/file_bytes.hpp"
+#include "text_numbers.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/core/thread_pool.hpp"
 #include "pointillist/io/las.hpp"

@@ -4,9 +4,9 @@
 #include <cstring>
 #include <limits>
 
-#include "io/file_bytes.hpp"
-#include "io/ply_body.hpp"
-#include "io/text_numbers.hpp"
+#include "pointillist/core/file_bytes.hpp"
+#include "ply_body.hpp"
+#include "text_numbers.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/io/obj.hpp"
 

@@ -9,8 +9,8 @@
 #include <cstring>
 #include <limits>
 
-#include "io/decimal_scan.hpp"
-#include "io/ply_body.hpp"
+#include "decimal_scan.hpp"
+#include "ply_body.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/core/thread_pool.hpp"
 

@@ -6,7 +6,7 @@
 #include <bit>
 #include <cstring>
 
-#include "io/ply_body.hpp"
+#include "ply_body.hpp"
 #include "pointillist/core/error.hpp"
 
 namespace pointillist::ply {

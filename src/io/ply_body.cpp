@@ -1,5 +1,5 @@
 // Shared pieces of the PLY body decoders: error messages and the count check.
-#include "io/ply_body.hpp"
+#include "ply_body.hpp"
 
 #include <algorithm>
 

@@ -11,7 +11,7 @@
 #include <string_view>
 #include <vector>
 
-#include "io/ply_header.hpp"
+#include "ply_header.hpp"
 #include "pointillist/core/math.hpp"
 
 namespace pointillist {

@@ -1,5 +1,5 @@
 // PLY 1.0 header parser (Greg Turk, "The PLY Polygon File Format", 1994).
-#include "io/ply_header.hpp"
+#include "ply_header.hpp"
 
 #include <charconv>
 #include <limits>

@@ -8,9 +8,9 @@
 #include <limits>
 #include <optional>
 
-#include "io/decimal_scan.hpp"
-#include "io/file_bytes.hpp"
-#include "io/ply_body.hpp"
+#include "decimal_scan.hpp"
+#include "pointillist/core/file_bytes.hpp"
+#include "ply_body.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/core/thread_pool.hpp"
 #include "pointillist/io/ply.hpp"
@@ -256,7 +256,7 @@ struct StreamOverflow {};
 
 // The reading side of read_gzip_streaming: waits for the header, then parses the body as it
 // is inflated.
-PointSet parse_stream(io_detail::GzipInflater& inflater,
+PointSet parse_stream(GzipInflater& inflater,
                       const std::function<StreamState(std::size_t)>& wait, const std::string& path,
                       const PlyReadOptions& options, ReadProgress& progress) {
   StreamState state = wait(1 << 16);
@@ -291,11 +291,11 @@ PointSet parse_stream(io_detail::GzipInflater& inflater,
 // Inflating on one thread while parsing on another: the ascii body is parsed as it appears.
 // Returns nothing when the gzip trailer under-stated the size (a multi-member or > 4 GiB file);
 // the caller then starts over with a growing buffer.
-std::optional<PointSet> read_gzip_streaming(const io_detail::FileBytes& raw,
+std::optional<PointSet> read_gzip_streaming(const FileBytes& raw,
                                             const std::string& path, const PlyReadOptions& options,
                                             ReadProgress& progress,
                                             const std::function<void(std::uint64_t)>& on_inflate) {
-  io_detail::GzipInflater inflater(raw.view(), path);
+  GzipInflater inflater(raw.view(), path);
   const auto wait = [&](std::size_t bytes) {
     bool finished = false;
     const std::size_t available = inflater.wait_for(bytes, finished);
@@ -327,7 +327,7 @@ std::optional<PointSet> read_gzip_streaming(const io_detail::FileBytes& raw,
 
 PointSet read_ply(const std::string& path, Progress& progress, const PlyReadOptions& options) {
   using namespace ply;
-  io_detail::FileBytes raw = io_detail::FileBytes::map(path);
+  FileBytes raw = FileBytes::map(path);
   ReadProgress read_progress(progress, raw.file_size());
   // Inflating earns the first half of the progress units of a .gz file.
   std::uint64_t inflated = 0;
@@ -336,14 +336,14 @@ PointSet read_ply(const std::string& path, Progress& progress, const PlyReadOpti
     inflated += consumed;
   };
 
-  const bool gzip = io_detail::has_gzip_magic(raw.view());
+  const bool gzip = has_gzip_magic(raw.view());
   if (gzip && options.pool && options.pool->thread_count() >= 2) {
     if (auto points = read_gzip_streaming(raw, path, options, read_progress, on_inflate))
       return std::move(*points);
   }
-  const io_detail::FileBytes bytes =
+  const FileBytes bytes =
       gzip
-          ? io_detail::FileBytes::inflate(
+          ? FileBytes::inflate(
                 raw, path, inflated == 0 ? std::function<void(std::uint64_t)>(on_inflate) : nullptr)
           : std::move(raw);
   PlyRead read(path, options, read_progress);

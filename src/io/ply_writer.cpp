@@ -3,7 +3,7 @@
 #include <charconv>
 #include <cstring>
 
-#include "io/atomic_file.hpp"
+#include "pointillist/core/atomic_file.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/io/ply.hpp"
 
@@ -62,7 +62,7 @@ char* put(char* p, T value, bool swap) {
   return p + 4;
 }
 
-void write_binary_body(io_detail::AtomicFile& file, const PointSet& points, bool faces,
+void write_binary_body(AtomicFile& file, const PointSet& points, bool faces,
                        bool big_endian) {
   const bool swap = big_endian != (std::endian::native == std::endian::big);
   const std::size_t stride = 12 + (points.has_normals() ? 12 : 0) + (points.has_colors() ? 3 : 0) +
@@ -104,7 +104,7 @@ void write_binary_body(io_detail::AtomicFile& file, const PointSet& points, bool
 char* put_text(char* p, float v) { return std::to_chars(p, p + 32, v).ptr; }
 char* put_text(char* p, std::uint32_t v) { return std::to_chars(p, p + 16, v).ptr; }
 
-void write_ascii_body(io_detail::AtomicFile& file, const PointSet& points, bool faces) {
+void write_ascii_body(AtomicFile& file, const PointSet& points, bool faces) {
   std::vector<char> buffer(1 << 16);
   constexpr std::size_t kMaxLine = 11 * 32;
   char* p = buffer.data();
@@ -159,7 +159,7 @@ void write_ascii_body(io_detail::AtomicFile& file, const PointSet& points, bool 
 void write_ply(const std::string& path, const PointSet& points, const PlyWriteOptions& options) {
   check_sizes(path, points);
   const bool faces = options.write_faces && points.is_mesh();
-  io_detail::AtomicFile file(path);
+  AtomicFile file(path);
   file.write(make_header(points, options, faces));
   if (options.encoding == PlyEncoding::Ascii)
     write_ascii_body(file, points, faces);

@@ -8,8 +8,8 @@
 #include <cstdlib>
 #include <memory>
 
-#include "io/atomic_file.hpp"
-#include "io/file_bytes.hpp"
+#include "pointillist/core/atomic_file.hpp"
+#include "pointillist/core/file_bytes.hpp"
 #include "pointillist/core/error.hpp"
 
 namespace pointillist {
@@ -47,7 +47,7 @@ void encode_and_write(const std::string& path, int width, int height, std::uint8
   std::unique_ptr<void, decltype(&std::free)> png(spng_get_png_buffer(ctx.get(), &size, &error),
                                                   &std::free);
   if (!png) throw IoError("cannot encode " + path + " as PNG: " + spng_strerror(error));
-  io_detail::AtomicFile file(path);
+  AtomicFile file(path);
   file.write(png.get(), size);
   file.commit();
 }
@@ -73,7 +73,7 @@ void write_png_gray16(const std::string& path, int width, int height,
 }
 
 ImageRgb8 read_png_rgb8(const std::string& path) {
-  const auto file = io_detail::FileBytes::map(path);
+  const auto file = FileBytes::map(path);
   SpngCtx ctx(spng_ctx_new(0));
   if (!ctx) throw IoError("cannot read " + path + ": out of memory");
   // Refuse absurd sizes before allocating (a corrupt header could claim gigapixels).

@@ -20,8 +20,8 @@
 #include <type_traits>
 #include <vector>
 
-#include "io/decimal_scan.hpp"
-#include "io/file_bytes.hpp"
+#include "decimal_scan.hpp"
+#include "pointillist/core/file_bytes.hpp"
 #include "pointillist/core/math.hpp"
 #include "pointillist/core/progress.hpp"
 

@@ -11,9 +11,9 @@
 #include <limits>
 #include <optional>
 
-#include "io/file_bytes.hpp"
-#include "io/ply_body.hpp"
-#include "io/text_numbers.hpp"
+#include "pointillist/core/file_bytes.hpp"
+#include "ply_body.hpp"
+#include "text_numbers.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/core/thread_pool.hpp"
 #include "pointillist/io/xyz.hpp"

@@ -7,7 +7,7 @@
 // read off the ends of the lists, its median is the middle entry of the list of the longest
 // axis, and the split is a stable partition of the two other lists by a per-point flag: linear,
 // branch-free passes, the way presorted kd-tree builders work.
-#include "lod/median_split.hpp"
+#include "median_split.hpp"
 
 #include <array>
 #include <cmath>

@@ -1,6 +1,6 @@
 // Interior node bounds for the QSplat hierarchy (Rusinkiewicz & Levoy, "QSplat: A
 // Multiresolution Point Rendering System for Large Meshes", SIGGRAPH 2000, section 3.1).
-#include "lod/node_bounds.hpp"
+#include "node_bounds.hpp"
 
 #include <algorithm>
 #include <cassert>

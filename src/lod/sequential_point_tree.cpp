@@ -23,8 +23,9 @@
 #include <limits>
 #include <string>
 
-#include "lod/splat_input.hpp"
+#include "splat_input.hpp"
 #include "pointillist/core/error.hpp"
+#include "pointillist/core/morton.hpp"
 
 namespace pointillist {
 namespace {
@@ -80,45 +81,8 @@ void check_input(const PointSet& points, const SequentialPointTreeOptions& optio
 
 // ---- Pass 1: Morton order ------------------------------------------------------------------
 
-// Spreads the low 21 bits of v to every third bit.
-std::uint64_t spread_bits(std::uint32_t v) {
-  std::uint64_t x = v & 0x1fffffu;
-  x = (x | x << 32) & 0x1f00000000ffffull;
-  x = (x | x << 16) & 0x1f0000ff0000ffull;
-  x = (x | x << 8) & 0x100f00f00f00f00full;
-  x = (x | x << 4) & 0x10c30c30c30c30c3ull;
-  x = (x | x << 2) & 0x1249249249249249ull;
-  return x;
-}
-
-// Sorts blocks in parallel, then merges pairs of runs level by level. `less` must be a strict
-// total order on the elements (unique keys), so the result does not depend on the blocking.
-template <typename T, typename Less>
-void parallel_sort(std::vector<T>& v, ThreadPool& pool, Less less) {
-  const std::size_t n = v.size(), blocks = (n + kSortBlock - 1) / kSortBlock;
-  if (blocks <= 1) {
-    std::sort(v.begin(), v.end(), less);
-    return;
-  }
-  const auto edge = [&](std::size_t block) { return std::min(n, block * kSortBlock); };
-  pool.run(blocks,
-           [&](std::size_t b) { std::sort(v.data() + edge(b), v.data() + edge(b + 1), less); });
-  std::vector<T> other(n);
-  T* src = v.data();
-  T* dst = other.data();
-  for (std::size_t width = 1; width < blocks; width *= 2) {
-    pool.run((blocks + 2 * width - 1) / (2 * width), [&](std::size_t pair) {
-      const std::size_t lo = edge(2 * pair * width), mid = edge((2 * pair + 1) * width),
-                        hi = edge((2 * pair + 2) * width);
-      std::merge(src + lo, src + mid, src + mid, src + hi, dst + lo, less);
-    });
-    std::swap(src, dst);
-  }
-  if (src != v.data()) v.swap(other);
-}
-
-std::vector<MortonKey> morton_order(const std::vector<Vec3f>& positions, const Aabb& bounds,
-                                    ThreadPool& pool) {
+std::vector<MortonKey> morton_keys(const std::vector<Vec3f>& positions, const Aabb& bounds,
+                                   ThreadPool& pool) {
   const Vec3f e = bounds.extent();
   const double side = std::max({double(e.x), double(e.y), double(e.z)});
   const double scale = side > 0 ? double(1u << kLevels) / side : 0.0;
@@ -130,12 +94,13 @@ std::vector<MortonKey> morton_order(const std::vector<Vec3f>& positions, const A
   parallel_for(pool, positions.size(), kPointGrain, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       const Vec3f p = positions[i];
-      keys[i] = {spread_bits(cell(p.x, bounds.lo.x)) << 2 |
-                     spread_bits(cell(p.y, bounds.lo.y)) << 1 | spread_bits(cell(p.z, bounds.lo.z)),
+      // z in the lowest bit of each triple, x in the highest: the octree's child order.
+      keys[i] = {morton_code(cell(p.z, bounds.lo.z), cell(p.y, bounds.lo.y),
+                             cell(p.x, bounds.lo.x)),
                  static_cast<std::uint32_t>(i)};
     }
   });
-  parallel_sort(keys, pool, std::less<MortonKey>{});
+  parallel_sort(keys, pool, std::less<MortonKey>{}, kSortBlock);
   return keys;
 }
 
@@ -578,7 +543,7 @@ SequentialPointTree build_sequential_point_tree(const PointSet& points, ThreadPo
   std::vector<BuildNode> nodes;
   {
     ProgressPhase phase(progress, "hierarchy", points.size());
-    const std::vector<MortonKey> keys = morton_order(points.positions, tree.bounds, pool);
+    const std::vector<MortonKey> keys = morton_keys(points.positions, tree.bounds, pool);
     const std::vector<SortedSplat> splats = gather_splats(points, keys, pool);
     const NodeMaker maker{keys, splats, tree.has_colors, options.color_tolerance};
     nodes = build_nodes(maker, options.parallel_grain_points, pool, phase);

@@ -18,9 +18,9 @@
 #include <map>
 #include <string>
 
-#include "lod/splat_input.hpp"
-#include "lod/median_split.hpp"
-#include "lod/node_bounds.hpp"
+#include "splat_input.hpp"
+#include "median_split.hpp"
+#include "node_bounds.hpp"
 #include "pointillist/core/error.hpp"
 
 namespace pointillist {

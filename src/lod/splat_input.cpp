@@ -1,5 +1,5 @@
 // Checks of the splats a hierarchy is built from (see splat_input.hpp).
-#include "lod/splat_input.hpp"
+#include "splat_input.hpp"
 
 #include <algorithm>
 #include <cmath>

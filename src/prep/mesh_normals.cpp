@@ -4,7 +4,7 @@
 #include <cassert>
 
 #include "pointillist/prep/normals.hpp"
-#include "prep/vertex_ranges.hpp"
+#include "vertex_ranges.hpp"
 
 namespace pointillist {
 

@@ -14,7 +14,7 @@
 #include <cmath>
 #include <limits>
 
-#include "prep/ordered_cloud.hpp"
+#include "ordered_cloud.hpp"
 
 namespace pointillist::prep_detail {
 namespace {

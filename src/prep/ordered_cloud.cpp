@@ -1,4 +1,4 @@
-#include "prep/ordered_cloud.hpp"
+#include "ordered_cloud.hpp"
 
 #include <sstream>
 

@@ -6,7 +6,7 @@
 #include <string>
 
 #include "pointillist/core/error.hpp"
-#include "prep/ordered_cloud.hpp"
+#include "ordered_cloud.hpp"
 
 namespace pointillist {
 namespace {

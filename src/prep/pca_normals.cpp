@@ -7,7 +7,7 @@
 
 #include "pointillist/core/error.hpp"
 #include "pointillist/prep/normals.hpp"
-#include "prep/ordered_cloud.hpp"
+#include "ordered_cloud.hpp"
 
 namespace pointillist {
 namespace prep_detail {

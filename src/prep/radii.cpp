@@ -10,8 +10,8 @@
 #include <cmath>
 
 #include "pointillist/core/error.hpp"
-#include "prep/ordered_cloud.hpp"
-#include "prep/vertex_ranges.hpp"
+#include "ordered_cloud.hpp"
+#include "vertex_ranges.hpp"
 
 namespace pointillist {
 namespace {

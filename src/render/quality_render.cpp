@@ -1,5 +1,5 @@
 // The quality mode's entry point: selection, then the quality rasterizer, timed.
-#include "render/frame_timing.hpp"
+#include "frame_timing.hpp"
 
 #include "pointillist/render/quality.hpp"
 

@@ -1,7 +1,7 @@
 // The renderer's entry point: selection, then rasterization, timed.
 #include "pointillist/render/render.hpp"
 
-#include "render/frame_timing.hpp"
+#include "frame_timing.hpp"
 
 namespace pointillist {
 

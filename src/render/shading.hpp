@@ -11,7 +11,7 @@
 #include "pointillist/core/error.hpp"
 #include "pointillist/core/math.hpp"
 #include "pointillist/render/settings.hpp"
-#include "render/simd.hpp"
+#include "simd.hpp"
 
 namespace pointillist::render_detail {
 

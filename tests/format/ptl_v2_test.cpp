@@ -23,7 +23,7 @@
 #include "pointillist/format/ptl.hpp"
 #include "pointillist/io/ply.hpp"
 #include "pointillist/prep/prepare.hpp"
-#include "pointillist/render/image_compare.hpp"
+#include "pointillist/eval/image_compare.hpp"
 #include "pointillist/render/render.hpp"
 #include "pointillist/scene/analytic.hpp"
 #include "testing/testing.hpp"

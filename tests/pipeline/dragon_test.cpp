@@ -12,7 +12,7 @@
 #include "pointillist/prep/prepare.hpp"
 #include "pointillist/render/mesh_reference.hpp"
 #include "pointillist/lod/sequential_point_tree.hpp"
-#include "pointillist/render/image_compare.hpp"
+#include "pointillist/eval/image_compare.hpp"
 #include "pointillist/render/render.hpp"
 #include "pointillist/render/spt_render.hpp"
 #include "testing/testing.hpp"

@@ -9,7 +9,7 @@
 #include "pointillist/format/ptl_v2.hpp"
 #include "pointillist/format/ptl_v2_pages.hpp"
 #include "pointillist/lod/sphere_tree.hpp"
-#include "pointillist/render/image_compare.hpp"
+#include "pointillist/eval/image_compare.hpp"
 #include "pointillist/render/paged.hpp"
 #include "pointillist/render/render.hpp"
 #include "pointillist/scene/analytic.hpp"

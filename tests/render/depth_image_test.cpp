@@ -4,7 +4,7 @@
 #include <limits>
 
 #include "pointillist/render/depth_image.hpp"
-#include "pointillist/render/point_baseline.hpp"
+#include "render/point_baseline.hpp"
 #include "render_test_util.hpp"
 
 using namespace pointillist;

@@ -10,7 +10,7 @@
 
 #include "pointillist/core/error.hpp"
 #include "pointillist/lod/sphere_tree.hpp"
-#include "pointillist/render/image_compare.hpp"
+#include "pointillist/eval/image_compare.hpp"
 #include "pointillist/render/paged.hpp"
 #include "pointillist/render/quality.hpp"
 #include "pointillist/render/render.hpp"

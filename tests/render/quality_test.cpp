@@ -18,7 +18,7 @@
 #include "pointillist/io/ply.hpp"
 #include "pointillist/lod/sphere_tree.hpp"
 #include "pointillist/prep/prepare.hpp"
-#include "pointillist/render/image_compare.hpp"
+#include "pointillist/eval/image_compare.hpp"
 #include "pointillist/render/mesh_reference.hpp"
 #include "pointillist/render/quality.hpp"
 #include "pointillist/render/render.hpp"

@@ -8,7 +8,7 @@
 #include "pointillist/lod/sequential_point_tree.hpp"
 #include "pointillist/lod/sphere_tree.hpp"
 #include "pointillist/prep/prepare.hpp"
-#include "pointillist/render/image_compare.hpp"
+#include "pointillist/eval/image_compare.hpp"
 #include "pointillist/render/render.hpp"
 #include "pointillist/render/spt_render.hpp"
 #include "pointillist/scene/analytic.hpp"

@@ -19,7 +19,7 @@
 
 namespace pointillist {
 
-struct PackedPage;  // render/paged.hpp
+struct PackedPage;  // lod/pages.hpp
 
 constexpr std::uint32_t kPtlV2Version = 2;
 

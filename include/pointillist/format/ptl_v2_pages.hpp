@@ -1,4 +1,4 @@
-// A .ptl version 2 file as the page source of the paged renderer (render/paged.hpp): each file
+// A .ptl version 2 file as the page source of the paged renderer (lod/pages.hpp): each file
 // page is one HierarchyPage kept in its packed form (the file's records and about a byte of links
 // a node) and decoded during the traversal, so a model larger than memory renders with only the
 // pages it needs resident, at about 5.1 bytes a node (7.1 with colour).
@@ -7,7 +7,7 @@
 #include <memory>
 
 #include "pointillist/format/ptl_v2.hpp"
-#include "pointillist/render/paged.hpp"
+#include "pointillist/lod/pages.hpp"
 
 namespace pointillist {
 

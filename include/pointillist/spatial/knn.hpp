@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "pointillist/core/math.hpp"
+#include "pointillist/core/morton.hpp"
 #include "pointillist/core/progress.hpp"
 #include "pointillist/core/thread_pool.hpp"
 
@@ -34,12 +35,5 @@ std::vector<std::uint32_t> k_nearest_neighbours(std::span<const Vec3f> points, T
                                                 const KnnOptions& options,
                                                 std::vector<float>* squared_distances = nullptr,
                                                 Progress& progress = Progress::none());
-
-// Permutation that sorts points along a Morton (Z-order) curve over their bounding box (21 bits
-// per axis, one scale for all three axes): entry j is the index of the j-th point along the
-// curve. Points in the same cell keep their index order; non-finite coordinates are clamped to
-// the box. Neighbour queries and tree builds run several times faster on spatially ordered input.
-// Parallel; the result does not depend on the thread count.
-std::vector<std::uint32_t> morton_order(std::span<const Vec3f> points, ThreadPool& pool);
 
 }  // namespace pointillist

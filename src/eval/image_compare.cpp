@@ -1,7 +1,7 @@
 // Image-quality metrics: PSNR, SSIM (Wang, Bovik, Sheikh, Simoncelli, "Image quality
 // assessment: from error visibility to structural similarity", IEEE TIP 13(4), 2004) and
 // silhouette masks. Choices are documented in the header.
-#include "pointillist/render/image_compare.hpp"
+#include "pointillist/eval/image_compare.hpp"
 
 #include <array>
 #include <cassert>

@@ -1,11 +1,11 @@
-// Writing a file so that it appears complete or not at all (private to the io module).
+// Writing a file so that it appears complete or not at all (used by the readers and writers of io and format).
 #pragma once
 
 #include <cstddef>
 #include <string>
 #include <vector>
 
-namespace pointillist::io_detail {
+namespace pointillist {
 
 // Writes go to `path + ".tmp-XXXXXX"` in the same folder; commit() renames it over `path`.
 // Destroyed without commit() (an exception, say), the temporary file is removed.
@@ -35,4 +35,4 @@ class AtomicFile {
   std::size_t used_ = 0;
 };
 
-}  // namespace pointillist::io_detail
+}  // namespace pointillist

@@ -1,4 +1,4 @@
-#include "pointillist/render/point_baseline.hpp"
+#include "render/point_baseline.hpp"
 
 #include <algorithm>
 #include <cassert>

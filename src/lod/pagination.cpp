@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "pointillist/core/error.hpp"
-#include "pointillist/render/paged.hpp"
+#include "pointillist/lod/pages.hpp"
 
 namespace pointillist {
 namespace {

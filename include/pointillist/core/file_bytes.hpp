@@ -1,5 +1,5 @@
 // Whole-file loading for the readers: a read-only memory map of a plain file, or the inflated
-// contents of a gzip file (private to the io module).
+// contents of a gzip file (used by the readers and writers of io and format).
 #pragma once
 
 #include <atomic>
@@ -12,7 +12,7 @@
 #include <string>
 #include <string_view>
 
-namespace pointillist::io_detail {
+namespace pointillist {
 
 // gzip files start with these two bytes (RFC 1952).
 bool has_gzip_magic(std::string_view bytes);
@@ -96,4 +96,4 @@ class GzipInflater {
   bool finished_ = false;      // guarded by mutex_
 };
 
-}  // namespace pointillist::io_detail
+}  // namespace pointillist

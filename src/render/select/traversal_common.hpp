@@ -13,7 +13,7 @@
 #include "pointillist/lod/sphere_tree.hpp"
 #include "pointillist/render/settings.hpp"
 #include "pointillist/render/splat_stream.hpp"
-#include "render/shading.hpp"
+#include "shading.hpp"
 
 namespace pointillist::render_detail {
 constexpr std::uint8_t kTestFrustum = 1;

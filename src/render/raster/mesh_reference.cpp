@@ -9,7 +9,7 @@
 #include <cmath>
 #include <limits>
 
-#include "render/shading.hpp"
+#include "shading.hpp"
 
 namespace pointillist {
 namespace {

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <cstdint>
 
-#include "pointillist/spatial/knn.hpp"
+#include "pointillist/core/morton.hpp"
 
 namespace pointillist {
 namespace {
@@ -25,17 +25,6 @@ struct Keyed {
 // Equal codes keep index order, so the permutation depends only on the points.
 inline bool operator<(const Keyed& a, const Keyed& b) {
   return a.code < b.code || (a.code == b.code && a.index < b.index);
-}
-
-// Spreads the low 21 bits of v so that two zero bits separate consecutive bits.
-inline std::uint64_t spread_bits(std::uint64_t v) {
-  v &= 0x1fffff;
-  v = (v | (v << 32)) & 0x1f00000000ffffULL;
-  v = (v | (v << 16)) & 0x1f0000ff0000ffULL;
-  v = (v | (v << 8)) & 0x100f00f00f00f00fULL;
-  v = (v | (v << 4)) & 0x10c30c30c30c30c3ULL;
-  v = (v | (v << 2)) & 0x1249249249249249ULL;
-  return v;
 }
 
 // Cell of coordinate v in [0, kMaxCell]; NaN and out-of-range values are clamped.
@@ -69,9 +58,8 @@ std::vector<std::uint32_t> morton_order(std::span<const Vec3f> points, ThreadPoo
   parallel_for(pool, n, kGrain, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       const Vec3f p = points[i];
-      keyed[i] = {spread_bits(cell(p.x, box.lo.x, scale)) |
-                      (spread_bits(cell(p.y, box.lo.y, scale)) << 1) |
-                      (spread_bits(cell(p.z, box.lo.z, scale)) << 2),
+      keyed[i] = {morton_code(cell(p.x, box.lo.x, scale), cell(p.y, box.lo.y, scale),
+                              cell(p.z, box.lo.z, scale)),
                   static_cast<std::uint32_t>(i)};
     }
   });

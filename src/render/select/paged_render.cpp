@@ -1,5 +1,5 @@
 // The paged QSplat traversal over decoded or packed pages (see paged.hpp); the page cache and
-// loader are in paged_cache.cpp.
+// its loader are lod's PageCache.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -8,16 +8,16 @@
 
 #include "pointillist/core/error.hpp"
 #include "pointillist/render/paged.hpp"
-#include "render/frame_timing.hpp"
-#include "render/shading.hpp"
-#include "render/traversal_common.hpp"
+#include "frame_timing.hpp"
+#include "shading.hpp"
+#include "select/traversal_common.hpp"
 
 namespace pointillist {
 namespace {
 
 using namespace render_detail;
 
-using PageTable = std::vector<std::unique_ptr<HierarchyPage>>;
+using PageTable = PageCache::PageTable;
 
 // Where the children of a refined node are: nodes [first, first + child_count) of `page`, which
 // may not be resident.
@@ -134,10 +134,8 @@ void PagedRenderer::render_frame(const Camera& camera, const RenderSettings& set
   const CameraFrame cam = make_camera_frame(camera);
   size_frame(frame, cam);
 
-  take_ready();
-  ++frame_number_;
-  for (const Request& r : requests_) requested_[r.page] = 0;
-  requests_.clear();
+  cache_.begin_frame();
+  const PageTable& pages = cache_.pages();
 
   const bool with_colors = summary_.has_colors;
   SplatStream& stream = frame.splats;
@@ -150,12 +148,11 @@ void PagedRenderer::render_frame(const Camera& camera, const RenderSettings& set
       static_cast<std::uint8_t>((settings.frustum_culling ? kTestFrustum : 0) |
                                 (settings.backface_culling ? kTestBackface : 0)),
       with_colors, stream, {}};
-  if (!pages_.empty() && pages_[0]) {
-    last_used_[0] = frame_number_;
-    if (pages_[0]->is_packed()) {
-      select(PackedAccess(pages_, with_colors), selection, pool);
+  if (!pages.empty() && pages[0]) {
+    if (pages[0]->is_packed()) {
+      select(PackedAccess(pages, with_colors), selection, pool);
     } else {
-      select(DecodedAccess(pages_), selection, pool);
+      select(DecodedAccess(pages), selection, pool);
     }
   }
   const Counters& counters = selection.counters;
@@ -167,7 +164,7 @@ void PagedRenderer::render_frame(const Camera& camera, const RenderSettings& set
     // the frame's nodes (decoded copies, stand-ins as drawn) in stream order and index them.
     gathered_.clear();
     gathered_.reserve(splats);
-    const bool packed = !pages_.empty() && pages_[0] && pages_[0]->is_packed();
+    const bool packed = !pages.empty() && pages[0] && pages[0]->is_packed();
     for (std::size_t t = 0; t < stream.chunk_count; ++t) {
       SplatChunk& chunk = stream.chunks[t];
       const TaskOut& out = task_out_[t];
@@ -189,7 +186,7 @@ void PagedRenderer::render_frame(const Camera& camera, const RenderSettings& set
               .culled_frustum = counters.culled_frustum,
               .culled_backface = counters.culled_backface},
              cam, pool.thread_count(), start, selected, Clock::now());
-  stats_.pages_requested = requests_.size();
+  cache_.end_frame();
 }
 
 template <class Access>
@@ -223,7 +220,7 @@ void PagedRenderer::select(const Access& access, Selection& s, ThreadPool& pool)
         counters.culled_frustum += trial.culled_frustum;
         counters.culled_backface += trial.culled_backface;
         if (decision == Decision::Cull) continue;
-        if (c.page != p.page) last_used_[c.page] = frame_number_;
+        if (c.page != p.page) cache_.mark_used(c.page);
         const SphereNode* kids = access.load_children(c, n, scratch);
         for (std::uint32_t k = 0; k < n.child_count; ++k) {
           next.push_back(access.item(c, k, kids, tests));
@@ -320,12 +317,8 @@ void PagedRenderer::select(const Access& access, Selection& s, ThreadPool& pool)
     counters.visited += task_counters[t].visited;
     counters.culled_frustum += task_counters[t].culled_frustum;
     counters.culled_backface += task_counters[t].culled_backface;
-    for (const std::uint32_t page : out.touched) last_used_[page] = frame_number_;
-    for (const Request& r : out.requests) {
-      if (requested_[r.page] || in_flight_[r.page]) continue;
-      requested_[r.page] = 1;
-      requests_.push_back(r);
-    }
+    for (const std::uint32_t page : out.touched) cache_.mark_used(page);
+    for (const PageRequest& r : out.requests) cache_.request(r);
   }
 }
 

@@ -1,5 +1,5 @@
-// The paged renderer's page cache: residency under the memory cap, least recently used
-// eviction, synchronous loads on the pool and the background loader thread (see paged.hpp).
+// The page cache: residency under the memory cap, least recently used eviction, synchronous
+// loads on the pool and the background loader thread (see page_cache.hpp).
 #include <algorithm>
 #include <condition_variable>
 #include <deque>
@@ -11,22 +11,22 @@
 #include <vector>
 
 #include "pointillist/core/error.hpp"
-#include "pointillist/render/paged.hpp"
+#include "pointillist/lod/page_cache.hpp"
 
 namespace pointillist {
 
-struct PagedRenderer::Loader {
+struct PageCache::Loader {
   std::mutex mutex;
   std::condition_variable wake, idle;
-  std::deque<Request> queue;  // handed over, not yet decoded
-  std::vector<std::pair<Request, std::unique_ptr<HierarchyPage>>> ready;
+  std::deque<PageRequest> queue;  // handed over, not yet decoded
+  std::vector<std::pair<PageRequest, std::unique_ptr<HierarchyPage>>> ready;
   std::exception_ptr error;
   std::size_t busy = 0;  // pages being decoded now
   bool stopping = false;
   std::thread thread;
 };
 
-PagedRenderer::~PagedRenderer() {
+PageCache::~PageCache() {
   if (!loader_) return;
   {
     std::lock_guard<std::mutex> lock(loader_->mutex);
@@ -36,13 +36,13 @@ PagedRenderer::~PagedRenderer() {
   loader_->thread.join();
 }
 
-void PagedRenderer::loader_loop() {
+void PageCache::loader_loop() {
   Loader& l = *loader_;
   std::unique_lock<std::mutex> lock(l.mutex);
   for (;;) {
     l.wake.wait(lock, [&] { return l.stopping || !l.queue.empty(); });
     if (l.stopping) return;
-    const Request r = l.queue.front();
+    const PageRequest r = l.queue.front();
     l.queue.pop_front();
     ++l.busy;
     lock.unlock();
@@ -64,9 +64,9 @@ void PagedRenderer::loader_loop() {
   }
 }
 
-std::size_t PagedRenderer::request_in_background(std::size_t max_pages,
+std::size_t PageCache::request_in_background(std::size_t max_pages,
                                                  std::uint64_t max_storage_bytes) {
-  std::vector<Request> chosen = choose(max_pages, max_storage_bytes);
+  std::vector<PageRequest> chosen = choose(max_pages, max_storage_bytes);
   if (chosen.empty()) return 0;
   if (!loader_) {
     loader_ = std::make_unique<Loader>();
@@ -74,7 +74,7 @@ std::size_t PagedRenderer::request_in_background(std::size_t max_pages,
   }
   {
     std::lock_guard<std::mutex> lock(loader_->mutex);
-    for (const Request& r : chosen) {
+    for (const PageRequest& r : chosen) {
       in_flight_[r.page] = 1;
       loader_->queue.push_back(r);
     }
@@ -84,16 +84,24 @@ std::size_t PagedRenderer::request_in_background(std::size_t max_pages,
   return chosen.size();
 }
 
-void PagedRenderer::wait_for_loader() {
+void PageCache::wait_for_loader() {
   if (!loader_) return;
   std::unique_lock<std::mutex> lock(loader_->mutex);
   loader_->idle.wait(lock, [&] { return loader_->queue.empty() && loader_->busy == 0; });
   if (loader_->error) std::rethrow_exception(loader_->error);
 }
 
-void PagedRenderer::take_ready() {
+void PageCache::begin_frame() {
+  take_ready();
+  ++frame_number_;
+  for (const PageRequest& r : requests_) requested_[r.page] = 0;
+  requests_.clear();
+  if (!pages_.empty() && pages_[0]) last_used_[0] = frame_number_;
+}
+
+void PageCache::take_ready() {
   if (!loader_) return;
-  std::vector<std::pair<Request, std::unique_ptr<HierarchyPage>>> ready;
+  std::vector<std::pair<PageRequest, std::unique_ptr<HierarchyPage>>> ready;
   {
     std::lock_guard<std::mutex> lock(loader_->mutex);
     if (loader_->error) std::rethrow_exception(loader_->error);
@@ -107,8 +115,8 @@ void PagedRenderer::take_ready() {
   stats_.resident_bytes_peak = std::max(stats_.resident_bytes_peak, stats_.resident_bytes);
 }
 
-PagedRenderer::PagedRenderer(const PageSource& source, std::uint64_t memory_cap, ThreadPool& pool)
-    : source_(source), cap_(memory_cap), summary_(source.summary()) {
+PageCache::PageCache(const PageSource& source, std::uint64_t memory_cap, ThreadPool& pool)
+    : source_(source), cap_(memory_cap) {
   const std::uint32_t n = source.page_count();
   pages_.resize(n);
   parent_.assign(n, kNoPage);
@@ -128,7 +136,7 @@ PagedRenderer::PagedRenderer(const PageSource& source, std::uint64_t memory_cap,
   load_requested(pool);
 }
 
-bool PagedRenderer::make_room(std::uint64_t bytes) {
+bool PageCache::make_room(std::uint64_t bytes) {
   while (stats_.resident_bytes + bytes > cap_) {
     std::uint32_t victim = kNoPage;
     for (std::uint32_t p = 1; p < pages_.size(); ++p) {
@@ -149,15 +157,17 @@ bool PagedRenderer::make_room(std::uint64_t bytes) {
   return true;
 }
 
-std::vector<PagedRenderer::Request> PagedRenderer::choose(std::size_t max_pages,
-                                                          std::uint64_t max_storage_bytes) {
-  std::stable_sort(requests_.begin(), requests_.end(),
-                   [](const Request& a, const Request& b) { return a.priority > b.priority; });
+std::vector<PageRequest> PageCache::choose(std::size_t max_pages,
+                                           std::uint64_t max_storage_bytes) {
+  std::stable_sort(requests_.begin(), requests_.end(), [](const PageRequest& a,
+                                                          const PageRequest& b) {
+    return a.priority > b.priority;
+  });
   // Choose what fits, reserving its memory (pages chosen now are marked used in this frame, so
   // they are not evicted for each other).
-  std::vector<Request> chosen;
+  std::vector<PageRequest> chosen;
   std::uint64_t storage = 0;
-  for (const Request& r : requests_) {
+  for (const PageRequest& r : requests_) {
     if (chosen.size() >= max_pages) break;
     if (pages_[r.page] || in_flight_[r.page]) continue;
     const std::uint64_t read = source_.page_storage_bytes(r.page);
@@ -175,13 +185,13 @@ std::vector<PagedRenderer::Request> PagedRenderer::choose(std::size_t max_pages,
     storage += read;
     chosen.push_back(r);
   }
-  for (const Request& r : requests_) requested_[r.page] = 0;
+  for (const PageRequest& r : requests_) requested_[r.page] = 0;
   requests_.clear();
   stats_.resident_bytes_peak = std::max(stats_.resident_bytes_peak, stats_.resident_bytes);
   return chosen;
 }
 
-void PagedRenderer::adopt(const Request& r, std::unique_ptr<HierarchyPage> page) {
+void PageCache::adopt(const PageRequest& r, std::unique_ptr<HierarchyPage> page) {
   const bool packed = pages_[0] ? pages_[0]->is_packed() : page->is_packed();
   if (page->node_count() != source_.page_node_count(r.page) ||
       page->memory_bytes() != source_.page_memory_bytes(r.page) || page->is_packed() != packed ||
@@ -201,13 +211,13 @@ void PagedRenderer::adopt(const Request& r, std::unique_ptr<HierarchyPage> page)
   ++stats_.resident_pages;
 }
 
-std::size_t PagedRenderer::load_requested(ThreadPool& pool, std::size_t max_pages,
+std::size_t PageCache::load_requested(ThreadPool& pool, std::size_t max_pages,
                                           std::uint64_t max_storage_bytes) {
-  const std::vector<Request> chosen = choose(max_pages, max_storage_bytes);
+  const std::vector<PageRequest> chosen = choose(max_pages, max_storage_bytes);
   std::vector<std::unique_ptr<HierarchyPage>> loaded(chosen.size());
   pool.run(chosen.size(), [&](std::size_t i) {
     auto page = std::make_unique<HierarchyPage>();
-    const Request& r = chosen[i];
+    const PageRequest& r = chosen[i];
     source_.load(r.page, *page);
     loaded[i] = std::move(page);
   });

@@ -1,4 +1,4 @@
-#include "io/file_bytes.hpp"
+#include "pointillist/core/file_bytes.hpp"
 
 #include <fcntl.h>
 #include <sys/mman.h>
@@ -14,7 +14,7 @@
 
 #include "pointillist/core/error.hpp"
 
-namespace pointillist::io_detail {
+namespace pointillist {
 namespace {
 
 class Fd {
@@ -254,4 +254,4 @@ void GzipInflater::run(bool may_grow,
   }
 }
 
-}  // namespace pointillist::io_detail
+}  // namespace pointillist

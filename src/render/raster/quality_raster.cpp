@@ -28,8 +28,8 @@
 
 #include "pointillist/core/error.hpp"
 #include "pointillist/render/quality.hpp"
-#include "render/quality_kernel.hpp"
-#include "render/shading.hpp"
+#include "raster/quality_kernel.hpp"
+#include "shading.hpp"
 
 namespace pointillist {
 namespace {

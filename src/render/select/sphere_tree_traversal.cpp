@@ -17,8 +17,8 @@
 
 #include "pointillist/core/error.hpp"
 #include "pointillist/render/selection.hpp"
-#include "render/shading.hpp"
-#include "render/traversal_common.hpp"
+#include "shading.hpp"
+#include "select/traversal_common.hpp"
 
 namespace pointillist {
 

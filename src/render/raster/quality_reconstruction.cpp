@@ -9,7 +9,7 @@
 
 #include "pointillist/core/error.hpp"
 #include "pointillist/render/quality.hpp"
-#include "render/quality_kernel.hpp"
+#include "raster/quality_kernel.hpp"
 
 namespace pointillist {
 namespace {

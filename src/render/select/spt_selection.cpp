@@ -16,7 +16,7 @@
 #include "pointillist/core/error.hpp"
 #include "pointillist/render/spt_render.hpp"
 #include "pointillist/render/splat_raster.hpp"
-#include "render/shading.hpp"
+#include "shading.hpp"
 
 namespace pointillist {
 namespace {

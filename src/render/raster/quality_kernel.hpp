@@ -11,7 +11,7 @@
 #include "pointillist/lod/sphere_tree.hpp"
 #include "pointillist/render/quality.hpp"
 #include "pointillist/render/splat_stream.hpp"
-#include "render/simd.hpp"
+#include "simd.hpp"
 
 namespace pointillist::quality_detail {
 

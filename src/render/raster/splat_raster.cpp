@@ -18,7 +18,7 @@
 #include <cstring>
 #include <limits>
 
-#include "render/simd.hpp"
+#include "simd.hpp"
 
 namespace pointillist {
 namespace {

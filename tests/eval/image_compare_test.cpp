@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "pointillist/core/error.hpp"
-#include "pointillist/render/image_compare.hpp"
+#include "pointillist/eval/image_compare.hpp"
 
 using namespace pointillist;
 

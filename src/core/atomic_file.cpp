@@ -1,4 +1,4 @@
-#include "io/atomic_file.hpp"
+#include "pointillist/core/atomic_file.hpp"
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -10,7 +10,7 @@
 
 #include "pointillist/core/error.hpp"
 
-namespace pointillist::io_detail {
+namespace pointillist {
 
 AtomicFile::AtomicFile(const std::string& path) : path_(path), buffer_(1 << 20) {
   constexpr char kAlphabet[] = "abcdefghijklmnopqrstuvwxyz0123456789";
@@ -76,4 +76,4 @@ void AtomicFile::commit() {
   committed_ = true;
 }
 
-}  // namespace pointillist::io_detail
+}  // namespace pointillist

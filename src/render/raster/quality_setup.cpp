@@ -5,7 +5,7 @@
 #include <cmath>
 #include <limits>
 
-#include "render/quality_kernel.hpp"
+#include "raster/quality_kernel.hpp"
 
 namespace pointillist::quality_detail {
 namespace {

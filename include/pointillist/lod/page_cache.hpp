@@ -1,0 +1,114 @@
+// The resident pages of a paged hierarchy (pages.hpp): what a traversal may read, what it asked
+// for, loads on a thread pool or on a background loader thread, and least-recently-used eviction
+// under a cap on resident memory. A traversal reads pages() during a frame and reports the
+// pages it used (mark_used) and the ones it wanted (request); between frames the requested pages
+// are loaded, coarsest (largest on screen) first.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "pointillist/core/thread_pool.hpp"
+#include "pointillist/lod/pages.hpp"
+
+namespace pointillist {
+
+struct PageCacheStats {
+  std::uint64_t pages_requested = 0;  // distinct non-resident pages the last frame wanted
+  std::uint64_t bytes_read = 0;       // storage bytes read so far (open_bytes + loaded pages)
+  std::uint64_t resident_bytes = 0;   // memory of the resident pages now
+  std::uint64_t resident_bytes_peak = 0;
+  std::uint64_t resident_pages = 0;
+  std::uint64_t pages_loaded = 0;     // loads so far (a page dropped and loaded again counts twice)
+  std::uint64_t pages_evicted = 0;
+};
+
+// A page a traversal wants: the page holding the children of a node drawn as a stand-in.
+struct PageRequest {
+  std::uint32_t page;
+  std::uint32_t parent_page;  // the page holding that node
+  float priority;             // the node's projected radius (r / z): larger loads first
+};
+
+// Not thread-safe, except that the loader thread works on its own; one frame at a time.
+class PageCache {
+ public:
+  using PageTable = std::vector<std::unique_ptr<HierarchyPage>>;
+
+  // Loads page 0. Throws OptionError when page 0 alone needs more than `memory_cap` bytes (the
+  // message gives the size needed), and what the source throws. The source must outlive the
+  // cache.
+  PageCache(const PageSource& source, std::uint64_t memory_cap, ThreadPool& pool);
+  ~PageCache();  // stops the loader thread, if one was started
+  PageCache(const PageCache&) = delete;
+  PageCache& operator=(const PageCache&) = delete;
+
+  // Starts a frame: takes in the pages the loader has finished (rethrowing what loading threw),
+  // forgets the last frame's requests and marks page 0 used.
+  void begin_frame();
+  // Ends a frame: its requests are what load_requested / request_in_background will load.
+  void end_frame() { stats_.pages_requested = requests_.size(); }
+  // Resident pages (null where not resident), indexed by page number.
+  const PageTable& pages() const { return pages_; }
+  // The frame used `page` (resident): it is evicted last.
+  void mark_used(std::uint32_t page) { last_used_[page] = frame_number_; }
+  // The frame wants `r.page` (not resident); a page already requested or on its way is ignored.
+  void request(const PageRequest& r) {
+    if (requested_[r.page] || in_flight_[r.page]) return;
+    requested_[r.page] = 1;
+    requests_.push_back(r);
+  }
+
+  // Loads the pages the last frame requested, largest on screen first, at most `max_pages` of
+  // them and at most `max_storage_bytes` read (at least one page is always loaded when one
+  // fits in memory, however large), in parallel on `pool`. A page is loaded only when it fits
+  // under the cap after evicting pages the last frame did not use (least recently used first;
+  // only pages without resident child pages, never page 0). Returns the number of pages loaded.
+  std::size_t load_requested(ThreadPool& pool, std::size_t max_pages = SIZE_MAX,
+                             std::uint64_t max_storage_bytes = UINT64_MAX);
+  // Background loading, as an interactive viewer does it: hands the pages the last frame
+  // requested (chosen as load_requested chooses them, their memory reserved under the cap) to a
+  // loader thread, which decodes them while the next frames render; begin_frame() takes in the
+  // pages that are ready. A page on its way is not requested again. Returns the number of pages
+  // handed over. Frames then depend on timing; load_requested() does not.
+  std::size_t request_in_background(std::size_t max_pages = SIZE_MAX,
+                                    std::uint64_t max_storage_bytes = UINT64_MAX);
+  // Waits until the loader has decoded every page handed to it (they are taken in by the next
+  // begin_frame()). Rethrows what loading a page threw.
+  void wait_for_loader();
+
+  // True when the last frame requested nothing and no page is on its way: what is resident is
+  // all that view needs.
+  bool complete() const { return stats_.pages_requested == 0 && in_flight_count_ == 0; }
+  const PageCacheStats& stats() const { return stats_; }
+  const PageSource& source() const { return source_; }
+  std::uint64_t memory_cap() const { return cap_; }
+
+ private:
+  bool make_room(std::uint64_t bytes);
+  // Chooses requests to load (see load_requested), reserving their memory; clears requests_.
+  std::vector<PageRequest> choose(std::size_t max_pages, std::uint64_t max_storage_bytes);
+  // Makes a loaded page resident (its memory was reserved by choose).
+  void adopt(const PageRequest& r, std::unique_ptr<HierarchyPage> page);
+  void take_ready();
+  void loader_loop();
+  struct Loader;
+
+  const PageSource& source_;
+  std::uint64_t cap_;
+  PageTable pages_;                              // resident pages, null elsewhere
+  std::vector<std::uint32_t> parent_;            // parent page of each resident page
+  std::vector<std::uint32_t> resident_children_;  // resident child pages of each page
+  std::vector<std::uint64_t> last_used_;         // frame number of the last use
+  std::vector<PageRequest> requests_;
+  std::vector<std::uint8_t> requested_;          // per page: already in requests_
+  std::vector<std::uint8_t> in_flight_;          // per page: handed to the loader
+  std::size_t in_flight_count_ = 0;
+  std::uint64_t frame_number_ = 0;
+  PageCacheStats stats_;
+  std::unique_ptr<Loader> loader_;
+};
+
+}  // namespace pointillist
