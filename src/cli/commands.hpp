@@ -8,26 +8,21 @@
 
 #include "pointillist/core/camera.hpp"
 #include "pointillist/lod/quantization.hpp"
+#include "pointillist/pipeline/convert.hpp"
 #include "pointillist/prep/prepare.hpp"
 #include "pointillist/render/quality.hpp"
 #include "pointillist/render/render.hpp"
 
 namespace pointillist::cli {
 
-struct ConvertOptions {
+struct ConvertCommandOptions {
   std::vector<std::string> inputs;
   std::string output;
-  PrepareOptions prepare;
-  std::string columns;  // --columns for text inputs (empty = detect)
-  bool ascii = false;  // .ply output only
-  unsigned ptl_version = 2;  // --ptl-version: 2 (quantized, paged) or 1 (float nodes)
-  // --leaf-trim: how .ptl v2 leaves keep their radius trim (sixteenths; eighths for readers
-  // older than 2026-11-24). Unset: the default, allowed with any output.
-  std::optional<quant::LeafTrim> leaf_trim;
+  ConvertOptions convert;  // what pipeline::convert does
   unsigned threads = 0;
   bool quiet = false;
 };
-int run_convert(const ConvertOptions& options);
+int run_convert(const ConvertCommandOptions& options);
 
 struct ViewOptions {
   int width = 1280, height = 720;

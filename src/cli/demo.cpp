@@ -5,7 +5,9 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "model_loading.hpp"
+#include "util.hpp"
+#include "pointillist/io/merge.hpp"
+#include "pointillist/pipeline/model.hpp"
 #include "terminal_progress.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/format/ptl_v2.hpp"
@@ -39,7 +41,8 @@ const char* shape_name(SplatShape s) {
 void convert_for_demo(const std::string& input, const std::string& output, ThreadPool& pool,
                       Progress& progress) {
   const auto start = std::chrono::steady_clock::now();
-  PointSet points = read_inputs({input}, pool, progress);
+  const std::string inputs[] = {input};
+  PointSet points = merge_inputs(inputs, pool, progress);
   prepare_splats(points, pool, progress, {});
   const SphereTree tree = build_sphere_tree(points, pool, progress);
   write_ptl_v2(output, tree, "generator: pointillist demo\nsource: " + input + "\n");
@@ -53,7 +56,7 @@ void convert_for_demo(const std::string& input, const std::string& output, Threa
 void render_views(const std::string& model_path, const std::string& stem,
                   const std::filesystem::path& dir, const std::vector<DemoView>& views,
                   const std::vector<SplatShape>& shapes, ThreadPool& pool) {
-  const LoadedModel model = LoadedModel::open(model_path, {}, pool, Progress::none());
+  const Model model = open_model(model_path, {.paging = Paging::Never}, pool, Progress::none());
   Frame frame;
   for (const DemoView& v : views) {
     const Camera camera = orbit_camera(

@@ -5,7 +5,10 @@
 #include <string>
 
 #include "commands.hpp"
-#include "model_loading.hpp"
+#include "util.hpp"
+#include "pointillist/format/ptl.hpp"
+#include "pointillist/format/ptl_v2.hpp"
+#include "pointillist/pipeline/model.hpp"
 #include "pointillist/lod/sequential_point_tree.hpp"
 #include "pointillist/render/spt_render.hpp"
 
@@ -28,10 +31,11 @@ std::string input_format_name(const std::string& path) {
 
 int run_info(const InfoOptions& o) {
   ThreadPool pool(o.threads);
-  const LoadedModel model =
-      LoadedModel::open(o.input, {}, pool, Progress::none(), o.columns, false,
-                        o.spt ? LoadedModel::Paging::Never : LoadedModel::Paging::WhenLarge);
+  const Model model =
+      open_model(o.input, {.columns = o.columns, .paging = o.spt ? Paging::Never : Paging::Auto},
+                 pool, Progress::none());
   const SphereTreeView& t = model.tree();
+  const Model::ScanInput& in = model.scan_input();
   std::array<std::uint64_t, 5> children{};
   for (const SphereNode& n : t.nodes) children[n.child_count <= 4 ? n.child_count : 0]++;
   const double leaves = double(t.leaf_count);
@@ -50,16 +54,16 @@ int run_info(const InfoOptions& o) {
       std::printf("nodes:       %llu (%.3f per point)\n", static_cast<unsigned long long>(records),
                   leaves > 0 ? double(records) / leaves : 0.0);
     }
-  } else if (model.memory_mapped()) {
+  } else if (model.ptl_v1()) {
     std::printf("format:      Pointillist model (.ptl) version %u, memory-mapped\n",
-                model.ptl()->version());
-  } else if (model.qsplat()) {
+                model.ptl_v1()->version());
+  } else if (model.kind() == ModelKind::Qsplat) {
     std::printf("format:      QSplat model (.qs 1.1), decoded into memory\n");
   } else {
     std::printf("format:      %s %s, %zu input points%s (hierarchy built in memory)\n",
                 input_format_name(o.input).c_str(),
-                model.input_is_mesh ? "mesh" : "point cloud", model.input_points,
-                model.input_is_mesh ? " (vertices used by faces kept)" : "");
+                in.is_mesh ? "mesh" : "point cloud", in.points,
+                in.is_mesh ? " (vertices used by faces kept)" : "");
   }
   if (!t.nodes.empty()) {
     std::printf("points:      %llu (leaves)\n", static_cast<unsigned long long>(t.leaf_count));
@@ -70,14 +74,14 @@ int run_info(const InfoOptions& o) {
                 static_cast<unsigned long long>(children[4]));
   }
   std::printf("depth:       %u levels below the root\n", t.depth);
-  if (model.memory_mapped() || model.qsplat()) {
+  if (model.kind() != ModelKind::Scan) {
     std::printf("attributes:  position, normal, normal cone, radius%s\n",
                 t.has_colors ? ", color" : "");
   } else {
     std::printf("attributes:  in file: position%s%s%s%s; computed: %s%s\n",
-                model.input_has_normals ? ", normal" : "", model.input_has_colors ? ", color" : "",
-                model.input_has_radii ? ", radius" : "", model.input_is_mesh ? ", faces" : "",
-                model.input_has_normals ? "" : "normal, ", model.input_has_radii ? "-" : "radius");
+                in.has_normals ? ", normal" : "", in.has_colors ? ", color" : "",
+                in.has_radii ? ", radius" : "", in.is_mesh ? ", faces" : "",
+                in.has_normals ? "" : "normal, ", in.has_radii ? "-" : "radius");
   }
   std::printf("bounds:      min (%g, %g, %g)  max (%g, %g, %g)\n", t.bounds.lo.x, t.bounds.lo.y,
               t.bounds.lo.z, t.bounds.hi.x, t.bounds.hi.y, t.bounds.hi.z);
@@ -93,8 +97,9 @@ int run_info(const InfoOptions& o) {
   std::printf("view sphere: centre (%g, %g, %g), radius %g (used by --view)\n",
               t.view_sphere.center.x, t.view_sphere.center.y, t.view_sphere.center.z,
               t.view_sphere.radius);
-  std::printf("file size:   %s (%.2f bytes/point)\n", human_bytes(double(model.file_size)).c_str(),
-              leaves > 0 ? double(model.file_size) / leaves : 0.0);
+  std::printf("file size:   %s (%.2f bytes/point)\n",
+              human_bytes(double(model.file_size())).c_str(),
+              leaves > 0 ? double(model.file_size()) / leaves : 0.0);
   if (o.spt) {
     const SequentialPointTree spt = build_sequential_point_tree(sphere_tree_leaves(t), pool);
     std::printf("sequential point tree (built in memory, chunk level %u):\n", spt.chunk_level);
@@ -120,13 +125,13 @@ int run_info(const InfoOptions& o) {
                 static_cast<unsigned long long>(s.chunks_culled),
                 static_cast<unsigned long long>(s.chunks_total));
   }
-  if (!model.metadata.empty()) {
+  if (!model.metadata().empty()) {
     std::printf("metadata:\n");
     std::size_t start = 0;
-    while (start < model.metadata.size()) {
-      std::size_t end = model.metadata.find('\n', start);
-      if (end == std::string::npos) end = model.metadata.size();
-      std::printf("  %s\n", model.metadata.substr(start, end - start).c_str());
+    while (start < model.metadata().size()) {
+      std::size_t end = model.metadata().find('\n', start);
+      if (end == std::string::npos) end = model.metadata().size();
+      std::printf("  %s\n", model.metadata().substr(start, end - start).c_str());
       start = end + 1;
     }
   }

@@ -151,7 +151,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "pointillist 0.1.0");
 
   // convert
-  pc::ConvertOptions convert;
+  pc::ConvertCommandOptions convert;
   auto* convert_cmd = app.add_subcommand(
       "convert", "Convert scans (PLY, XYZ/PTS/CSV, OBJ, LAS; .gz too) into a splat model (.ptl, "
                  ".qs) or points with normals and radii (.ply)");
@@ -161,10 +161,10 @@ int main(int argc, char** argv) {
   convert_cmd->add_option("-o,--output", convert.output,
                           "Output file: .ptl (Pointillist model), .qs (QSplat 1.1 model) or .ply")
       ->required();
-  add_columns(convert_cmd, convert.columns);
-  add_prepare_options(convert_cmd, convert.prepare);
-  convert_cmd->add_flag("--ascii", convert.ascii, "Write .ply output as ascii");
-  convert_cmd->add_option("--ptl-version", convert.ptl_version,
+  add_columns(convert_cmd, convert.convert.columns);
+  add_prepare_options(convert_cmd, convert.convert.prepare);
+  convert_cmd->add_flag("--ascii", convert.convert.ascii, "Write .ply output as ascii");
+  convert_cmd->add_option("--ptl-version", convert.convert.ptl_version,
                           ".ptl version to write: 2 (quantized, paged; the default) or 1 (float "
                           "nodes, 40 bytes each)")
       ->default_val(2);
@@ -172,7 +172,7 @@ int main(int argc, char** argv) {
       {"sixteenths", pointillist::quant::LeafTrim::Sixteenths},
       {"eighths", pointillist::quant::LeafTrim::Eighths}};
   convert_cmd
-      ->add_option("--leaf-trim", convert.leaf_trim,
+      ->add_option("--leaf-trim", convert.convert.leaf_trim,
                    ".ptl v2: steps in which leaves keep their radius trim: sixteenths (the "
                    "default, tighter splats) or eighths (files that Pointillist before "
                    "2026-11-24 reads)")

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "model_loading.hpp"
+#include "pointillist/pipeline/model.hpp"
 #include "stats_json.hpp"
 #include "terminal_progress.hpp"
 #include "pointillist/core/error.hpp"
@@ -106,9 +106,9 @@ void check_sequence_options(const RenderOptions& o) {
 // SPT error bound (pixels).
 class FrameRenderer {
  public:
-  FrameRenderer(const RenderOptions& o, const LoadedModel& model, ThreadPool& pool,
+  FrameRenderer(const RenderOptions& o, const Model& model, ThreadPool& pool,
                 Progress& progress)
-      : o_(o), tree_(model.tree()), mesh_(model.source), pool_(pool) {
+      : o_(o), tree_(model.tree()), mesh_(model.source()), pool_(pool) {
     if (o.mode == RenderMode::Reference) {
       if (o.lod == LodScheme::Spt) {
         throw OptionError("--mode reference draws the mesh's triangles; it cannot be combined with "
@@ -116,7 +116,7 @@ class FrameRenderer {
       }
       if (!mesh_.is_mesh()) {
         throw OptionError(o.input + ": --mode reference draws a mesh's triangles, and this input " +
-                          (model.memory_mapped() || model.qsplat()
+                          (model.kind() != ModelKind::Scan
                                ? std::string("is a splat model")
                                : std::string("has no faces")) +
                           "; give the source mesh (.ply, .obj)");
@@ -320,11 +320,14 @@ int run_render(const RenderOptions& o) {
   TerminalProgress progress(!o.quiet && TerminalProgress::stderr_is_terminal());
   const bool paging_asked = o.memory_cap > 0 || o.progressive_frames > 0;
   const bool paging_possible = o.mode == RenderMode::Fast && o.lod == LodScheme::QSplat;
-  const LoadedModel model = LoadedModel::open(
-      o.input, o.prepare, pool, progress, o.columns, o.mode == RenderMode::Reference,
-      paging_asked ? LoadedModel::Paging::Always
-                   : (paging_possible ? LoadedModel::Paging::WhenLarge
-                                      : LoadedModel::Paging::Never));
+  const Model model = open_model(
+      o.input,
+      {.prepare = o.prepare,
+       .columns = o.columns,
+       .keep_source = o.mode == RenderMode::Reference,
+       .paging = paging_asked ? Paging::Always
+                              : (paging_possible ? Paging::Auto : Paging::Never)},
+      pool, progress);
   FrameRenderer renderer(o, model, pool, progress);
   Frame frame;
   const bool sequence = o.orbit_frames > 0 || o.refine_frames > 0 || o.frame_ms > 0 ||

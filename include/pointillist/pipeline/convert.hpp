@@ -1,0 +1,44 @@
+// Scans to a model file in one call: read and merge the inputs, prepare the splats (normals,
+// radii, outliers), build the hierarchy and write .ptl, QSplat .qs or the prepared points as .ply.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "pointillist/core/progress.hpp"
+#include "pointillist/core/thread_pool.hpp"
+#include "pointillist/lod/quantization.hpp"
+#include "pointillist/prep/prepare.hpp"
+
+namespace pointillist {
+
+struct ConvertOptions {
+  PrepareOptions prepare;    // normals, radii, outliers
+  std::string columns;       // text inputs: the column layout (empty = detected)
+  bool ascii = false;        // .ply output: text instead of binary little endian
+  unsigned ptl_version = 2;  // .ptl output: 2 (quantized, paged) or 1 (float nodes)
+  // .ptl v2 output: how leaves keep their radius trim (sixteenths; eighths for readers older
+  // than 2026-11-24). Unset: the default, allowed with any output.
+  std::optional<quant::LeafTrim> leaf_trim;
+};
+
+struct ConvertResult {
+  std::size_t input_points = 0;   // points (vertices) read from all inputs
+  std::size_t output_points = 0;  // points written (fewer when outliers were dropped)
+  // Things the user should know that did not stop the work (inputs without colors, options
+  // that do not apply to this output).
+  std::vector<std::string> warnings;
+};
+
+// Converts `inputs` (scans, merged in the first one's frame: see merge_inputs) to `output`,
+// chosen by its extension: .ptl, .qs (a mesh gives the bytes QSplat's qsplat_make writes) or
+// .ply. The output is written atomically. Throws OptionError for an unknown output extension or
+// options that do not fit it, Error when an input is already a model, and what reading,
+// preparing, building and writing throw.
+ConvertResult convert(std::span<const std::string> inputs, const std::string& output,
+                      const ConvertOptions& options, ThreadPool& pool, Progress& progress);
+
+}  // namespace pointillist

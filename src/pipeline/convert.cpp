@@ -1,0 +1,108 @@
+// pipeline::convert (see convert.hpp).
+#include "pointillist/pipeline/convert.hpp"
+
+#include <filesystem>
+#include <sstream>
+
+#include "pointillist/core/error.hpp"
+#include "pointillist/format/ptl.hpp"
+#include "pointillist/format/ptl_v2.hpp"
+#include "pointillist/format/qs.hpp"
+#include "pointillist/io/merge.hpp"
+#include "pointillist/io/ply.hpp"
+#include "pointillist/io/point_file.hpp"
+#include "pointillist/lod/sphere_tree.hpp"
+#include "pointillist/pipeline/model.hpp"
+
+namespace pointillist {
+namespace {
+
+bool ends_with(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() &&
+         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+const char* normal_source_name(NormalSource s) {
+  switch (s) {
+    case NormalSource::Auto: return "auto";
+    case NormalSource::Keep: return "keep";
+    case NormalSource::Mesh: return "mesh";
+    case NormalSource::Pca: return "pca";
+  }
+  return "?";
+}
+
+}  // namespace
+
+ConvertResult convert(std::span<const std::string> inputs, const std::string& output,
+                      const ConvertOptions& o, ThreadPool& pool, Progress& progress) {
+  const bool to_ptl = ends_with(output, ".ptl");
+  const bool to_ply = ends_with(output, ".ply");
+  const bool to_qs = ends_with(output, ".qs");
+  if (!to_ptl && !to_ply && !to_qs) {
+    throw OptionError("convert: output '" + output +
+                      "' has an unknown extension; use .ptl (Pointillist model), .qs (QSplat 1.1 "
+                      "model) or .ply (points with normals and radii)");
+  }
+  if (o.ascii && !to_ply) throw OptionError("convert: --ascii applies only to .ply output");
+  if (o.ptl_version != 1 && o.ptl_version != 2) {
+    throw OptionError("convert: --ptl-version " + std::to_string(o.ptl_version) +
+                      " does not exist; use 2 (compact, the default) or 1 (float nodes)");
+  }
+  if (o.leaf_trim && !(to_ptl && o.ptl_version == 2)) {
+    throw OptionError("convert: --leaf-trim applies only to .ptl version 2 output; drop it");
+  }
+  for (const std::string& path : inputs) {
+    if (std::filesystem::exists(path) && is_model_file(path)) {
+      throw Error(path + ": is already a splat model (" + (is_ptl_file(path) ? ".ptl" : ".qs") +
+                  "); give the source scan (" + supported_point_file_extensions() +
+                  ") to convert, or render the model directly");
+    }
+  }
+
+  ConvertResult result;
+  PointSet points =
+      merge_inputs(inputs, pool, progress, {.columns = o.columns}, &result.warnings);
+  result.input_points = points.size();
+  // A mesh goes to write_qs as read: like qsplat_make, it computes normals and radii from the
+  // faces itself (that is what makes the file byte-identical to the original tool's).
+  if (!(to_qs && points.is_mesh())) {
+    prepare_splats(points, pool, progress, o.prepare);
+  } else if (o.prepare.normals != NormalSource::Auto || o.prepare.radius_scale != 1.0f ||
+             o.prepare.k != PrepareOptions{}.k || o.prepare.drop_outliers) {
+    result.warnings.push_back(
+        "--normals, --k, --radius-scale and --drop-outliers are ignored for .qs output of a "
+        "mesh: its normals and radii follow qsplat_make's rules, which make the file "
+        "byte-identical to QSplat's (convert to .ply first to apply them)");
+  }
+  result.output_points = points.size();
+
+  if (to_qs) {
+    ProgressPhase phase(progress, "write", 0);
+    write_qs(output, points, {.write_colors = points.has_colors()});
+  } else if (to_ptl) {
+    const SphereTree tree = build_sphere_tree(points, pool, progress);
+    std::ostringstream meta;
+    meta << "generator: pointillist " << "0.1.0" << "\n";
+    for (const auto& in : inputs) meta << "source: " << in << "\n";
+    meta << "normals: " << normal_source_name(o.prepare.normals) << "\n"
+         << "k: " << o.prepare.k << "\n"
+         << "radius_scale: " << o.prepare.radius_scale << "\n";
+    for (const auto& c : points.comments) meta << "comment: " << c << "\n";
+    ProgressPhase phase(progress, "write", 0);
+    if (o.ptl_version == 1) {
+      write_ptl(output, tree, meta.str());
+    } else {
+      PtlV2WriteOptions v2;
+      if (o.leaf_trim) v2.leaf_trim = *o.leaf_trim;
+      write_ptl_v2(output, tree, meta.str(), v2, pool);
+    }
+  } else {
+    ProgressPhase phase(progress, "write", 0);
+    write_ply(output, points,
+              {.encoding = o.ascii ? PlyEncoding::Ascii : PlyEncoding::BinaryLittleEndian});
+  }
+  return result;
+}
+
+}  // namespace pointillist

@@ -1,0 +1,110 @@
+// open_model: every kind of model file, and scans built in memory (see model.hpp).
+#include <unistd.h>
+
+#include <filesystem>
+#include <string>
+
+#include "pointillist/core/error.hpp"
+#include "pointillist/format/ptl.hpp"
+#include "pointillist/format/ptl_v2.hpp"
+#include "pointillist/format/ptl_v2_pages.hpp"
+#include "pointillist/format/qs.hpp"
+#include "pointillist/io/merge.hpp"
+#include "pointillist/pipeline/model.hpp"
+
+namespace pointillist {
+
+Model::Model() = default;
+Model::Model(Model&&) noexcept = default;
+Model& Model::operator=(Model&&) noexcept = default;
+Model::~Model() = default;
+
+bool is_model_file(const std::string& path) { return is_ptl_file(path) || is_qs_file(path); }
+
+namespace {
+
+std::uint64_t physical_memory_bytes() {
+  return std::uint64_t(::sysconf(_SC_PHYS_PAGES)) * std::uint64_t(::sysconf(_SC_PAGESIZE));
+}
+
+std::string megabytes(double bytes) { return std::to_string(std::uint64_t(bytes / 1e6)) + " MB"; }
+
+}  // namespace
+
+Model open_model(const std::string& path, const OpenModelOptions& options, ThreadPool& pool,
+                 Progress& progress) {
+  Model model;
+  model.path_ = path;
+  if (!std::filesystem::exists(path)) {
+    throw IoError(path + ": no such file; check the path");
+  }
+  model.file_size_ = std::filesystem::file_size(path);
+  if (is_ptl_file(path) && ptl_file_version(path) == kPtlV2Version) {
+    model.kind_ = ModelKind::PtlV2;
+    model.v2_ = PtlV2File::open(path);
+    model.metadata_ = model.v2_->metadata();
+    const double decoded_bytes = double(model.v2_->node_count()) * sizeof(SphereNode);
+    const double memory =
+        double(options.memory_bytes ? options.memory_bytes : physical_memory_bytes());
+    bool paged = false;
+    switch (options.paging) {
+      case Paging::Always:
+        paged = true;
+        model.paging_reason_ = "paged: asked for (a memory cap or progressive loading)";
+        break;
+      case Paging::Never:
+        model.paging_reason_ = "decoded whole: the frames need the whole hierarchy";
+        break;
+      case Paging::Auto:
+        paged = decoded_bytes > memory / 4;
+        model.paging_reason_ =
+            std::string(paged ? "paged" : "decoded whole") + ": the decoded hierarchy takes " +
+            megabytes(decoded_bytes) + (paged ? ", more" : ", less") +
+            " than a quarter of the memory (" + megabytes(memory) + ")";
+        break;
+    }
+    if (paged) {
+      model.pages_ = ptl_v2_page_source(*model.v2_);
+      model.view_ = model.pages_->summary();
+    } else {
+      ProgressPhase phase(progress, "decode", 0);
+      model.built_ = model.v2_->decode_all();
+      model.view_ = model.built_.view();
+    }
+    return model;
+  }
+  if (is_ptl_file(path)) {
+    model.kind_ = ModelKind::PtlV1;
+    model.v1_ = PtlFile::open(path);
+    model.view_ = model.v1_->tree();
+    model.metadata_ = model.v1_->metadata();
+    model.paging_reason_ = "mapped: .ptl version 1 files are read through a memory map";
+    return model;
+  }
+  if (is_qs_file(path)) {
+    ProgressPhase phase(progress, "decode", 0);
+    QsModel qs = read_qs(path);
+    model.kind_ = ModelKind::Qsplat;
+    model.metadata_ = qs.metadata();
+    model.built_ = std::move(qs.tree);
+    model.view_ = model.built_.view();
+    model.paging_reason_ = "decoded whole: .qs files are decoded on opening";
+    return model;
+  }
+  const std::string paths[] = {path};
+  PointSet points = merge_inputs(paths, pool, progress, {.columns = options.columns});
+  model.kind_ = ModelKind::Scan;
+  model.scan_input_ = {.points = points.size(),
+                       .has_normals = points.has_normals(),
+                       .has_colors = points.has_colors(),
+                       .has_radii = points.has_radii(),
+                       .is_mesh = points.is_mesh()};
+  prepare_splats(points, pool, progress, options.prepare);
+  model.built_ = build_sphere_tree(points, pool, progress);
+  model.view_ = model.built_.view();
+  model.paging_reason_ = "in memory: built from the scan";
+  if (options.keep_source) model.source_ = std::move(points);
+  return model;
+}
+
+}  // namespace pointillist

@@ -1,0 +1,186 @@
+// The library pipeline: merging scans, open_model for every kind of model and its paging
+// decision, and convert.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "pointillist/core/error.hpp"
+#include "pointillist/io/merge.hpp"
+#include "pointillist/io/ply.hpp"
+#include "pointillist/pipeline/convert.hpp"
+#include "pointillist/pipeline/model.hpp"
+#include "pointillist/scene/analytic.hpp"
+#include "testing/testing.hpp"
+
+using namespace pointillist;
+using ::testing::HasSubstr;
+
+namespace {
+
+OpenModelOptions paging(Paging mode, std::uint64_t memory_bytes = 0) {
+  OpenModelOptions o;
+  o.paging = mode;
+  o.memory_bytes = memory_bytes;
+  return o;
+}
+
+// A text scan of n points on a line, at coordinates large enough that the reader moves them to
+// a local origin: x = base + i (metres), y = z = 0.5 + i / 10.
+void write_xyz(const std::string& path, double base, int n) {
+  std::ofstream out(path);
+  out.precision(12);
+  for (int i = 0; i < n; ++i) {
+    out << base + i << " " << 0.5 + i / 10.0 << " " << 0.5 + i / 10.0 << "\n";
+  }
+}
+
+// A sampled sphere (no normals) written as PLY.
+std::string write_sphere(const pointillist::testing::TempDir& dir, std::size_t n) {
+  const SurfaceSamples s = sample_scene(sphere_scene(), n, 3);
+  const std::string path = dir.file("sphere.ply");
+  write_ply(path, s.points, {});
+  return path;
+}
+
+}  // namespace
+
+TEST(MergeInputs, TilesWithTheirOwnOriginsLineUpInTheFirstOnesFrame) {
+  pointillist::testing::TempDir dir;
+  // Two tiles 1000 km apart in x: each reader picks its own origin, the merge must undo that.
+  write_xyz(dir.file("a.xyz"), 6.0e6, 10);
+  write_xyz(dir.file("b.xyz"), 7.0e6, 10);
+  ThreadPool pool(2);
+  const std::vector<std::string> paths = {dir.file("a.xyz"), dir.file("b.xyz")};
+  const PointSet merged = merge_inputs(paths, pool, Progress::none());
+  ASSERT_EQ(merged.size(), 20u);
+  // Same position within each tile's step, and 1e6 apart between the tiles (float precision of
+  // a 1e6 offset: 0.0625).
+  EXPECT_NEAR(merged.positions[10].x - merged.positions[0].x, 1.0e6, 0.125);
+  EXPECT_NEAR(merged.positions[11].x - merged.positions[10].x, 1.0, 0.125);
+  EXPECT_FLOAT_EQ(merged.positions[13].y, merged.positions[3].y);
+  int origins = 0;
+  for (const auto& c : merged.comments) origins += c.rfind("origin: ", 0) == 0;
+  EXPECT_EQ(origins, 1);  // the first tile's
+}
+
+TEST(MergeInputs, CommentsRepeatedByTheTilesAreKeptOnce) {
+  pointillist::testing::TempDir dir;
+  PointSet p;
+  p.positions = {{0, 0, 0}, {1, 0, 0}};
+  p.comments = {"survey 7", "tile a"};
+  write_ply(dir.file("a.ply"), p, {});
+  p.comments = {"survey 7", "tile b"};
+  write_ply(dir.file("b.ply"), p, {});
+  ThreadPool pool(1);
+  const std::vector<std::string> paths = {dir.file("a.ply"), dir.file("b.ply")};
+  const PointSet merged = merge_inputs(paths, pool, Progress::none());
+  EXPECT_EQ(merged.comments, (std::vector<std::string>{"survey 7", "tile a", "tile b"}));
+}
+
+TEST(MergeInputs, MissingFileIsNamed) {
+  ThreadPool pool(1);
+  const std::vector<std::string> paths = {"/nonexistent/scan.ply"};
+  try {
+    merge_inputs(paths, pool, Progress::none());
+    FAIL() << "expected IoError";
+  } catch (const IoError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("/nonexistent/scan.ply: no such file"));
+  }
+}
+
+TEST(OpenModel, EveryKindOfModelOpensWithTheSameLeaves) {
+  pointillist::testing::TempDir dir;
+  const std::string scan = write_sphere(dir, 3000);
+  ThreadPool pool(2);
+  const std::vector<std::string> in = {scan};
+  convert(in, dir.file("s.ptl"), {}, pool, Progress::none());
+  ConvertOptions v1;
+  v1.ptl_version = 1;
+  convert(in, dir.file("s1.ptl"), v1, pool, Progress::none());
+  convert(in, dir.file("s.qs"), {}, pool, Progress::none());
+  struct Case {
+    std::string path;
+    ModelKind kind;
+  };
+  for (const Case& c : {Case{scan, ModelKind::Scan}, Case{dir.file("s.ptl"), ModelKind::PtlV2},
+                        Case{dir.file("s1.ptl"), ModelKind::PtlV1},
+                        Case{dir.file("s.qs"), ModelKind::Qsplat}}) {
+    const Model m = open_model(c.path, paging(Paging::Never), pool, Progress::none());
+    EXPECT_EQ(m.kind(), c.kind) << c.path;
+    EXPECT_EQ(m.tree().leaf_count, 3000u) << c.path;
+    EXPECT_FALSE(m.paged()) << c.path;
+    EXPECT_FALSE(m.paging_reason().empty()) << c.path;
+  }
+}
+
+TEST(OpenModel, AutoPagingPagesWhatWouldTakeMoreThanAQuarterOfTheMemory) {
+  pointillist::testing::TempDir dir;
+  const std::vector<std::string> in = {write_sphere(dir, 3000)};
+  ThreadPool pool(2);
+  convert(in, dir.file("s.ptl"), {}, pool, Progress::none());
+  // 3000 leaves give some 4000 nodes of 40 bytes: about 160 KB decoded.
+  const Model small_machine =
+      open_model(dir.file("s.ptl"), paging(Paging::Auto, 400'000), pool, Progress::none());
+  EXPECT_TRUE(small_machine.paged());
+  EXPECT_TRUE(small_machine.tree().nodes.empty());
+  EXPECT_EQ(small_machine.tree().leaf_count, 3000u);
+  EXPECT_THAT(small_machine.paging_reason(), HasSubstr("more than a quarter"));
+  const Model big_machine =
+      open_model(dir.file("s.ptl"), paging(Paging::Auto, 1'000'000'000), pool,
+                 Progress::none());
+  EXPECT_FALSE(big_machine.paged());
+  EXPECT_EQ(big_machine.tree().leaf_count, 3000u);
+  EXPECT_GT(big_machine.tree().nodes.size(), 3000u);
+  EXPECT_TRUE(open_model(dir.file("s.ptl"), paging(Paging::Always), pool, Progress::none()).paged());
+}
+
+TEST(OpenModel, KeepsTheScanOnlyWhenAsked) {
+  pointillist::testing::TempDir dir;
+  const std::string scan = write_sphere(dir, 500);
+  ThreadPool pool(1);
+  EXPECT_EQ(open_model(scan, {}, pool, Progress::none()).source().size(), 0u);
+  OpenModelOptions keep;
+  keep.keep_source = true;
+  const Model kept = open_model(scan, keep, pool, Progress::none());
+  ASSERT_EQ(kept.source().size(), 500u);
+  EXPECT_TRUE(kept.source().has_normals());
+  EXPECT_EQ(kept.scan_input().points, 500u);
+  EXPECT_FALSE(kept.scan_input().has_normals);
+}
+
+TEST(Convert, RefusesAModelAsInputAndAnUnknownOutput) {
+  pointillist::testing::TempDir dir;
+  const std::vector<std::string> in = {write_sphere(dir, 500)};
+  ThreadPool pool(1);
+  convert(in, dir.file("s.ptl"), {}, pool, Progress::none());
+  const std::vector<std::string> model_in = {dir.file("s.ptl")};
+  try {
+    convert(model_in, dir.file("t.ptl"), {}, pool, Progress::none());
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_THAT(e.what(), HasSubstr("is already a splat model"));
+  }
+  EXPECT_THROW(convert(in, dir.file("t.obj"), {}, pool, Progress::none()), OptionError);
+  EXPECT_FALSE(std::filesystem::exists(dir.file("t.ptl")));
+  EXPECT_FALSE(std::filesystem::exists(dir.file("t.obj")));
+}
+
+TEST(Convert, DroppedOutliersAreCounted) {
+  pointillist::testing::TempDir dir;
+  const SurfaceSamples s = sample_scene(sphere_scene(), 3000, 3);
+  PointSet p = s.points;
+  // Five strays far from the unit sphere.
+  for (int i = 0; i < 5; ++i) p.positions.push_back({3.0f + i, 3.0f, -3.0f - i});
+  write_ply(dir.file("strays.ply"), p, {});
+  ThreadPool pool(2);
+  ConvertOptions o;
+  o.prepare.drop_outliers = true;
+  const std::vector<std::string> in = {dir.file("strays.ply")};
+  const ConvertResult r = convert(in, dir.file("s.ptl"), o, pool, Progress::none());
+  EXPECT_EQ(r.input_points, 3005u);
+  EXPECT_EQ(r.output_points, 3000u);
+}
