@@ -38,6 +38,7 @@ void BM_SelectQsplat(benchmark::State& state) {
   ThreadPool pool;
   const CameraFrame cam = make_camera_frame(dragon_camera(tree.view_sphere, float(state.range(0)) / 10));
   SplatStream stream;
+  stream.with_discs = false;  // as fast frames select (the quality rasterizer needs the discs)
   SelectionStats stats;
   RenderSettings settings;
   for (auto _ : state) select_splats(tree.view(), cam, settings, pool, stream, stats);
@@ -53,6 +54,7 @@ void BM_SelectSpt(benchmark::State& state) {
   ThreadPool pool;
   const CameraFrame cam = make_camera_frame(dragon_camera(tree.view_sphere, float(state.range(0)) / 10));
   SplatStream stream;
+  stream.with_discs = false;  // as fast frames select
   SptSelectionStats stats;
   for (auto _ : state) select_splats_spt(spt, cam, RenderSettings{}, {.epsilon_px = 1}, pool, stream, stats);
   state.SetItemsProcessed(state.iterations() * std::int64_t(stats.splats));

@@ -56,7 +56,9 @@ void convert_for_demo(const std::string& input, const std::string& output, Threa
 void render_views(const std::string& model_path, const std::string& stem,
                   const std::filesystem::path& dir, const std::vector<DemoView>& views,
                   const std::vector<SplatShape>& shapes, ThreadPool& pool) {
-  const Model model = open_model(model_path, {.paging = Paging::Never}, pool, Progress::none());
+  OpenModelOptions open;
+  open.paging = Paging::Never;
+  const Model model = open_model(model_path, open, pool, Progress::none());
   Frame frame;
   for (const DemoView& v : views) {
     const Camera camera = orbit_camera(

@@ -31,9 +31,10 @@ std::string input_format_name(const std::string& path) {
 
 int run_info(const InfoOptions& o) {
   ThreadPool pool(o.threads);
-  const Model model =
-      open_model(o.input, {.columns = o.columns, .paging = o.spt ? Paging::Never : Paging::Auto},
-                 pool, Progress::none());
+  OpenModelOptions open;
+  open.columns = o.columns;
+  open.paging = o.spt ? Paging::Never : Paging::Auto;
+  const Model model = open_model(o.input, open, pool, Progress::none());
   const SphereTreeView& t = model.tree();
   const Model::ScanInput& in = model.scan_input();
   std::array<std::uint64_t, 5> children{};

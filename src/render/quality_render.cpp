@@ -16,9 +16,10 @@ void render_quality(const SphereTreeView& tree, const Camera& camera,
   render_detail::size_frame(frame, cam);
 
   SelectionStats selection;
+  frame.splats.with_discs = true;
   select_splats(tree, cam, settings, pool, frame.splats, selection);
   const auto selected = Clock::now();
-  rasterize_quality(frame.splats, tree, cam, settings, quality, pool, scratch, frame.color,
+  rasterize_quality(frame.splats, cam, settings, quality, pool, scratch, frame.color,
                     frame.depth);
   render_detail::fill_stats(frame, selection, cam, pool.thread_count(), start, selected,
                             Clock::now());

@@ -14,6 +14,7 @@ void render(const SphereTreeView& tree, const Camera& camera, const RenderSettin
   render_detail::size_frame(frame, cam);
 
   SelectionStats selection;
+  frame.splats.with_discs = false;  // the fast rasterizer does not read them
   select_splats(tree, cam, settings, pool, frame.splats, selection);
   const auto selected = Clock::now();
   rasterize_splats(frame.splats, cam, settings, pool, frame.scratch, frame.color, frame.depth);

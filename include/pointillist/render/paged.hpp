@@ -83,7 +83,6 @@ class PagedRenderer {
     std::vector<std::uint32_t> touched;      // resident pages it used below the top
   };
   std::vector<TaskOut> task_out_;
-  std::vector<SphereNode> gathered_;  // quality mode: the last frame's nodes in stream order
 };
 
 }  // namespace pointillist

@@ -117,9 +117,9 @@ struct QualityScratch {
   std::vector<std::vector<float>> band_buffers;        // per-pixel accumulators, one per worker
 };
 
-// Draws `stream` (selected from `tree` for `camera`) into color and depth (width × height of the
-// camera, rows top to bottom). Every splat is the disc of its node (centre c, normal n, radius
-// R = radius_scale × node radius) with the Gaussian kernel of `quality`; for pixel centre
+// Draws `stream` (selected for `camera`) into color and depth (width × height of the camera, rows
+// top to bottom), reading nothing but the stream. Every splat is its disc (centre c, normal n,
+// radius R = radius_scale × the stream's radius) with the Gaussian kernel of `quality`; for pixel centre
 // (i + ½, j + ½) the eye ray
 // t·(a, b, 1) in eye coordinates (x right, y up, z = depth), a = (i + ½ − W/2)/f,
 // b = (H/2 − j − ½)/f, meets the disc's plane at depth t = (n·c)/(n·(a, b, 1)) (Botsch et al.
@@ -133,8 +133,7 @@ struct QualityScratch {
 // front surface's weighted depth (+infinity where nothing was drawn); color the background
 // there. The image bits do not depend on pool.thread_count(): bands of rows are drawn in
 // parallel, each visiting its splats in stream order. Throws OptionError for invalid settings.
-void rasterize_quality(const SplatStream& stream, const SphereTreeView& tree,
-                       const CameraFrame& camera, const RenderSettings& settings,
+void rasterize_quality(const SplatStream& stream, const CameraFrame& camera, const RenderSettings& settings,
                        const QualitySettings& quality, ThreadPool& pool, QualityScratch& scratch,
                        std::span<Rgb8> color, std::span<float> depth);
 

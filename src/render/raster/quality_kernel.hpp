@@ -86,7 +86,7 @@ struct SetupConstants {
 // Writes the setup of every splat of `chunk` into `splats` (kStride floats each) and bins the
 // splats by band: bins[b] .. bins[b + 1] − 1 (offsets counted from bins[band_count + 1]) are
 // the indices, in stream order, of the chunk's splats whose pixel box meets band b.
-void prepare_chunk(const SplatChunk& chunk, const SphereTreeView& tree, const SetupConstants& k,
+void prepare_chunk(const SplatChunk& chunk, const SetupConstants& k,
                    std::vector<float>& splats, std::vector<std::uint32_t>& bins);
 
 }  // namespace pointillist::quality_detail

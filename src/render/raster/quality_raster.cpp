@@ -338,8 +338,7 @@ BandLayout choose_bands(int width, int height, unsigned threads) {
 
 }  // namespace
 
-void rasterize_quality(const SplatStream& stream, const SphereTreeView& tree,
-                       const CameraFrame& camera, const RenderSettings& settings,
+void rasterize_quality(const SplatStream& stream, const CameraFrame& camera, const RenderSettings& settings,
                        const QualitySettings& quality, ThreadPool& pool, QualityScratch& scratch,
                        std::span<Rgb8> color, std::span<float> depth) {
   [[maybe_unused]] const std::size_t pixels =
@@ -355,7 +354,7 @@ void rasterize_quality(const SplatStream& stream, const SphereTreeView& tree,
   setup.rule = rule_constants(quality);
   setup.lowpass_radius_px = quality.lowpass_radius_px;
   setup.radius_scale = quality.radius_scale;
-  setup.has_colors = stream.has_colors && tree.has_colors;
+  setup.has_colors = stream.has_colors;
   setup.base_color = settings.base_color;
   setup.band_rows = bands.rows;
   setup.band_count = bands.count;
@@ -364,7 +363,7 @@ void rasterize_quality(const SplatStream& stream, const SphereTreeView& tree,
     scratch.chunk_bins.resize(stream.chunk_count);
   }
   pool.run(stream.chunk_count, [&](std::size_t c) {
-    prepare_chunk(stream.chunks[c], tree, setup, scratch.chunk_splats[c], scratch.chunk_bins[c]);
+    prepare_chunk(stream.chunks[c], setup, scratch.chunk_splats[c], scratch.chunk_bins[c]);
   });
 
   View v;

@@ -43,7 +43,7 @@ Range pixel_span(float lo, float hi, int n) {
 
 }  // namespace
 
-void prepare_chunk(const SplatChunk& chunk, const SphereTreeView& tree, const SetupConstants& k,
+void prepare_chunk(const SplatChunk& chunk, const SetupConstants& k,
                    std::vector<float>& splats, std::vector<std::uint32_t>& bins) {
   const std::size_t n = chunk.count;
   if (splats.size() < kStride * n) splats.resize(std::max(kStride * n, 2 * splats.size()));
@@ -57,22 +57,21 @@ void prepare_chunk(const SplatChunk& chunk, const SphereTreeView& tree, const Se
   const std::size_t bands = static_cast<std::size_t>(k.band_count);
   bins.assign(bands + 1, 0);
   for (std::size_t i = 0; i < n; ++i) {
-    const SphereNode& node = tree.nodes[chunk.node[i]];
     float* s = &splats[kStride * i];
-    const Vec3f d = node.center - cam.eye;
+    const Vec3f normal = chunk.normal[i];
+    const Vec3f d = chunk.center[i] - cam.eye;
     const Vec3f c{dot(d, cam.right), dot(d, cam.up), dot(d, cam.forward)};
-    const Vec3f nn{dot(node.normal, cam.right), dot(node.normal, cam.up),
-                   dot(node.normal, cam.forward)};
-    const float r = k.radius_scale * node.radius;
+    const Vec3f nn{dot(normal, cam.right), dot(normal, cam.up), dot(normal, cam.forward)};
+    const float r = k.radius_scale * chunk.radius[i];
     s[kCx] = c.x;
     s[kCy] = c.y;
     s[kCz] = c.z;
     s[kNx] = nn.x;
     s[kNy] = nn.y;
     s[kNz] = nn.z;
-    s[kWx] = node.normal.x;
-    s[kWy] = node.normal.y;
-    s[kWz] = node.normal.z;
+    s[kWx] = normal.x;
+    s[kWy] = normal.y;
+    s[kWz] = normal.z;
     s[kNc] = dot(nn, c);
     s[kInvR2] = 1.0f / (r * r);
     s[kSx] = chunk.x_px[i];
@@ -89,9 +88,10 @@ void prepare_chunk(const SplatChunk& chunk, const SphereTreeView& tree, const Se
       s[kBound] = k.rule.z_threshold * r;
     }
     if (k.has_colors) {
-      s[kBaseR] = static_cast<float>(node.color.r) * kColorScale;
-      s[kBaseG] = static_cast<float>(node.color.g) * kColorScale;
-      s[kBaseB] = static_cast<float>(node.color.b) * kColorScale;
+      const Rgb8 color = chunk.color[i];
+      s[kBaseR] = static_cast<float>(color.r) * kColorScale;
+      s[kBaseG] = static_cast<float>(color.g) * kColorScale;
+      s[kBaseB] = static_cast<float>(color.b) * kColorScale;
     } else {
       s[kBaseR] = k.base_color.x;
       s[kBaseG] = k.base_color.y;

@@ -139,10 +139,11 @@ void PagedRenderer::render_frame(const Camera& camera, const RenderSettings& set
 
   const bool with_colors = summary_.has_colors;
   SplatStream& stream = frame.splats;
+  stream.with_discs = quality != nullptr;
   stream.has_colors = with_colors;
   stream.chunk_count = 0;
   const Shader shader(settings, cam);
-  const ViewConstants v = make_view_constants(shader, cam, settings);
+  const ViewConstants v = make_view_constants(shader, cam, settings, stream.with_discs);
   Selection selection{
       v,
       static_cast<std::uint8_t>((settings.frustum_culling ? kTestFrustum : 0) |
@@ -160,23 +161,7 @@ void PagedRenderer::render_frame(const Camera& camera, const RenderSettings& set
   for (std::size_t t = 0; t < stream.chunk_count; ++t) splats += stream.chunks[t].count;
   const auto selected = Clock::now();
   if (quality) {
-    // The quality rasterizer reads each splat's node through the stream's node index: gather
-    // the frame's nodes (decoded copies, stand-ins as drawn) in stream order and index them.
-    gathered_.clear();
-    gathered_.reserve(splats);
-    const bool packed = !pages.empty() && pages[0] && pages[0]->is_packed();
-    for (std::size_t t = 0; t < stream.chunk_count; ++t) {
-      SplatChunk& chunk = stream.chunks[t];
-      const TaskOut& out = task_out_[t];
-      for (std::size_t i = 0; i < chunk.count; ++i) {
-        const std::uint32_t local = chunk.node[i];
-        gathered_.push_back(packed ? out.values[local] : *out.emitted[local]);
-        chunk.node[i] = static_cast<std::uint32_t>(gathered_.size() - 1);
-      }
-    }
-    SphereTreeView nodes = summary_;
-    nodes.nodes = gathered_;
-    rasterize_quality(stream, nodes, cam, settings, *quality, pool, *scratch, frame.color,
+    rasterize_quality(stream, cam, settings, *quality, pool, *scratch, frame.color,
                       frame.depth);
   } else {
     rasterize_splats(stream, cam, settings, pool, frame.scratch, frame.color, frame.depth);

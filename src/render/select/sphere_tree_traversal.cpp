@@ -30,6 +30,8 @@ void SplatChunk::reserve(std::size_t n, bool with_colors) {
   depth.resize(cap);
   size_px.resize(cap);
   shaded.resize(cap);
+  center.resize(cap);
+  radius.resize(cap);
   normal.resize(cap);
   node.resize(cap);
   if (with_colors) color.resize(cap);
@@ -138,7 +140,7 @@ void select_splats(const SphereTreeView& tree, const CameraFrame& camera,
   if (tree.nodes.empty()) return;
 
   const Shader shader(settings, camera);
-  const ViewConstants v = make_view_constants(shader, camera, settings);
+  const ViewConstants v = make_view_constants(shader, camera, settings, stream.with_discs);
 
   const std::uint8_t tests =
       static_cast<std::uint8_t>((settings.frustum_culling ? kTestFrustum : 0) |

@@ -89,8 +89,8 @@ struct BlockCounters {
 // mask pass, a compaction of the selected indices, then projection and shading four splats at a
 // time, keeping the lanes in front of the eye and on the image.
 void run_block(const SequentialPointTree& t, Block b, const ViewConstants& v,
-               const render_detail::Shader& shader, bool with_colors, SplatChunk& out,
-               BlockCounters& counters) {
+               const render_detail::Shader& shader, bool with_colors, bool with_discs,
+               SplatChunk& out, BlockCounters& counters) {
   using render_detail::Float4;
   using render_detail::Int4;
   using render_detail::kLanes;
@@ -171,6 +171,10 @@ void run_block(const SequentialPointTree& t, Block b, const ViewConstants& v,
         out.shaded[o] = static_cast<std::uint32_t>(packed[l]);
         out.node[o] = idx[l];
         out.normal[o] = Vec3f{normal[0][l], normal[1][l], normal[2][l]};
+        if (with_discs) {
+          out.center[o] = Vec3f{cx[idx[l]], cy[idx[l]], cz[idx[l]]};
+          out.radius[o] = 0.5f * diameter[l];
+        }
         if (with_colors) out.color[o] = t.colors[idx[l]];
         const bool kept = visible[l] != 0;
         out.count += kept;
@@ -235,7 +239,8 @@ void select_splats_spt(const SequentialPointTree& tree, const CameraFrame& camer
   stream.chunk_count = blocks.size();
   std::vector<BlockCounters> counters(blocks.size());
   pool.run(blocks.size(), [&](std::size_t b) {
-    run_block(tree, blocks[b], v, shader, tree.has_colors, stream.chunks[b], counters[b]);
+    run_block(tree, blocks[b], v, shader, tree.has_colors, stream.with_discs, stream.chunks[b],
+              counters[b]);
   });
   for (std::size_t b = 0; b < blocks.size(); ++b) {
     stats.entries_scanned += counters[b].scanned;
@@ -260,6 +265,7 @@ void render_spt(const SequentialPointTree& tree, const Camera& camera,
   frame.color.resize(pixels);
   frame.depth.resize(pixels);
   SptSelectionStats selection;
+  frame.splats.with_discs = false;  // the fast rasterizer does not read them
   select_splats_spt(tree, cam, settings, options, pool, frame.splats, selection);
   const auto selected = clock::now();
   rasterize_splats(frame.splats, cam, settings, pool, frame.scratch, frame.color, frame.depth);

@@ -41,6 +41,7 @@ struct ViewConstants {
   float size_per_radius;  // 2·f: projected diameter = r · size_per_radius / z
   float threshold_px;
   std::array<Plane, 4> planes;
+  bool with_discs;  // finish_chunk writes the discs (SplatStream::with_discs)
 };
 
 enum class Decision { Cull, Draw, Refine };
@@ -153,7 +154,7 @@ class Emitter {
   std::uint32_t* node_ = nullptr;
 };
 
-// Copies normals and colors of the chunk's nodes and shades them, four at a time (a second pass
+// Copies the discs (centre, radius, normal) and colors of the chunk's nodes and shades them, four at a time (a second pass
 // keeps the traversal loop small; the nodes are still in cache). A last partial group repeats
 // its last splat in the unused lanes.
 // `node_at(i)` gives the node of the chunk's node index i (a const SphereNode&).
@@ -171,6 +172,12 @@ void finish_chunk(const NodeAt& node_at, const ViewConstants& v, bool with_color
     for (std::size_t k = 0; k < lanes; ++k) {
       out.normal[i + k] = n[k]->normal;
       if (with_colors) out.color[i + k] = n[k]->color;
+    }
+    if (v.with_discs) {
+      for (std::size_t k = 0; k < lanes; ++k) {
+        out.center[i + k] = n[k]->center;
+        out.radius[i + k] = n[k]->radius;
+      }
     }
     Float4 normal[3], to_eye[3], base[3];
     for (int c = 0; c < 3; ++c) {
@@ -207,7 +214,7 @@ void finish_chunk(const NodeAt& node_at, const ViewConstants& v, bool with_color
 
 // The constants of one view (the shader must outlive them).
 inline ViewConstants make_view_constants(const Shader& shader, const CameraFrame& camera,
-                                         const RenderSettings& settings) {
+                                         const RenderSettings& settings, bool with_discs) {
   ViewConstants v;
   v.shader = &shader;
   v.base_color = shader.base_color();
@@ -221,6 +228,7 @@ inline ViewConstants make_view_constants(const Shader& shader, const CameraFrame
   v.size_per_radius = 2.0f * camera.focal_px;
   v.threshold_px = settings.threshold_px;
   v.planes = camera.planes;
+  v.with_discs = with_discs;
   return v;
 }
 
