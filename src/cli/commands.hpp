@@ -12,6 +12,7 @@
 #include "pointillist/prep/prepare.hpp"
 #include "pointillist/render/quality.hpp"
 #include "pointillist/render/render.hpp"
+#include "pointillist/render/renderer.hpp"
 
 namespace pointillist::cli {
 
@@ -32,19 +33,13 @@ struct ViewOptions {
   std::optional<Vec3f> eye, target, up;
 };
 
-enum class LodScheme { QSplat, Spt };
-enum class RenderMode { Fast, Quality, Reference };
-
 struct RenderOptions {
-  std::string input;
-  LodScheme lod = LodScheme::QSplat;  // --lod qsplat|spt
-  float epsilon_px = 1.0f;            // --epsilon (spt)
-  bool no_chunk_culling = false;      // --no-chunk-culling (spt; to measure what culling saves)
+  // Models or scans (drawn together in their shared world frame), or one scene file (.json).
+  std::vector<std::string> inputs;
   std::string output;
   ViewOptions view;
   RenderSettings settings;
-  RenderMode mode = RenderMode::Fast;  // --mode fast|quality|reference
-  QualitySettings quality;             // --reconstruction, --opacity (quality mode)
+  FrameSettings frame;  // --lod, --epsilon, --no-chunk-culling, --mode, --reconstruction, --opacity
   std::string depth_output;  // empty = no depth image
   std::string stats_output;  // empty = none, "-" = stdout
   PrepareOptions prepare;    // for point/mesh file inputs (built in memory)
@@ -63,9 +58,9 @@ struct RenderOptions {
 };
 int run_render(const RenderOptions& options);
 
-// The camera of `view` for a model: the orbit around tree.view_sphere, or the explicit
+// The camera of `view` for a model or scene: the orbit around `view_sphere`, or the explicit
 // eye/target/up. Throws OptionError when only one of --eye/--target is given.
-Camera make_camera(const ViewOptions& view, const SphereTreeView& tree);
+Camera make_camera(const ViewOptions& view, const Sphere& view_sphere);
 
 struct InfoOptions {
   std::string input;

@@ -107,7 +107,7 @@ int run_info(const InfoOptions& o) {
     std::printf("  list:      %zu entries (%.3f per point), top list %u, %zu chunks\n",
                 spt.node_count(), leaves > 0 ? double(spt.node_count()) / leaves : 0.0, spt.top_end,
                 spt.chunks.size());
-    const Camera camera = make_camera(o.view, t);
+    const Camera camera = make_camera(o.view, t.view_sphere);
     SplatStream stream;
     SptSelectionStats s;
     select_splats_spt(spt, make_camera_frame(camera), RenderSettings{}, {.epsilon_px = o.epsilon_px},

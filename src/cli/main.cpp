@@ -185,7 +185,11 @@ int main(int argc, char** argv) {
   std::string size = "1280x720", view, eye, target, up, background = "0,0,0";
   auto* render_cmd =
       app.add_subcommand("render", "Render a model (.ptl, .qs, or a scan built in memory) to PNG");
-  render_cmd->add_option("input", render.input, "Model file")->required()->check(CLI::ExistingFile);
+  render_cmd
+      ->add_option("inputs", render.inputs,
+                   "Models or scans (several are drawn together), or one scene file (.json)")
+      ->required()
+      ->check(CLI::ExistingFile);
   render_cmd->add_option("-o,--output", render.output, "Output PNG")->required();
   render_cmd->add_option("--size", size, "Image size WxH")->default_str("1280x720");
   render_cmd->add_option("--view", view, "Orbit view AZ,EL in degrees (default 0,0)");
@@ -214,18 +218,18 @@ int main(int argc, char** argv) {
       ->default_str("0,0,0");
   render_cmd->add_option("--depth", render.depth_output, "Also write a 16-bit depth PNG");
   render_cmd->add_option("--stats", render.stats_output, "Write statistics as JSON (- = stdout)");
-  const std::map<std::string, pc::LodScheme> lods{{"qsplat", pc::LodScheme::QSplat},
-                                                  {"spt", pc::LodScheme::Spt}};
-  render_cmd->add_option("--lod", render.lod,
+  const std::map<std::string, pointillist::LodScheme> lods{
+      {"qsplat", pointillist::LodScheme::QSplat}, {"spt", pointillist::LodScheme::Spt}};
+  render_cmd->add_option("--lod", render.frame.lod,
                          "Level-of-detail scheme: qsplat (hierarchy traversal) or spt (Sequential "
                          "Point Tree, one sequential pass)")
       ->transform(CLI::CheckedTransformer(lods, CLI::ignore_case))
       ->default_str("qsplat");
-  render_cmd->add_option("--epsilon", render.epsilon_px,
+  render_cmd->add_option("--epsilon", render.frame.epsilon_px,
                          "With --lod spt: allowed geometric error in pixels (1 = full detail)")
       ->default_val(1.0f)
       ->check(CLI::Range(0.001f, 1000.0f));
-  render_cmd->add_flag("--no-chunk-culling", render.no_chunk_culling,
+  render_cmd->add_flag("--no-chunk-culling{false}", render.frame.spt_chunk_culling,
                        "With --lod spt: scan every chunk's list even when the chunk is outside "
                        "the view (to measure what chunk culling saves)");
   std::string path;
@@ -253,10 +257,11 @@ int main(int argc, char** argv) {
                          "(default 1M, a disk at 30 MB/s shown at 30 frames/s)");
   render_cmd->add_option("--frames-out", render.frames_out,
                          "Write every frame of a sequence to DIR/frame_NNNNN.png");
-  const std::map<std::string, pc::RenderMode> modes{{"fast", pc::RenderMode::Fast},
-                                                    {"quality", pc::RenderMode::Quality},
-                                                    {"reference", pc::RenderMode::Reference}};
-  render_cmd->add_option("--mode", render.mode,
+  const std::map<std::string, pointillist::Rasterizer> modes{
+      {"fast", pointillist::Rasterizer::Fast},
+      {"quality", pointillist::Rasterizer::Quality},
+      {"reference", pointillist::Rasterizer::Reference}};
+  render_cmd->add_option("--mode", render.frame.rasterizer,
                          "fast (opaque splats, the default), quality (perspective-correct "
                          "Gaussian surface splatting with per-pixel shading), or reference (a "
                          "mesh input's triangles, z-buffered, same camera and shading)")
@@ -265,12 +270,12 @@ int main(int argc, char** argv) {
   const std::map<std::string, pointillist::Reconstruction> reconstructions{
       {"zthreshold", pointillist::Reconstruction::ZThreshold},
       {"zrange", pointillist::Reconstruction::ZRange}};
-  render_cmd->add_option("--reconstruction", render.quality.reconstruction,
+  render_cmd->add_option("--reconstruction", render.frame.quality.reconstruction,
                          "With --mode quality: which fragments of a pixel blend, zrange (depth "
                          "intervals overlap) or zthreshold (within a fixed depth of the front)")
       ->transform(CLI::CheckedTransformer(reconstructions, CLI::ignore_case))
       ->default_str("zrange");
-  render_cmd->add_option("--opacity", render.quality.opacity,
+  render_cmd->add_option("--opacity", render.frame.quality.opacity,
                          "With --mode quality: opacity of every surface, composited front to back "
                          "(1 = opaque)")
       ->default_val(1.0f)

@@ -14,7 +14,7 @@
 
 namespace pointillist {
 
-Model::Model() = default;
+Model::Model() : source_(std::make_unique<PointSet>()) {}
 Model::Model(Model&&) noexcept = default;
 Model& Model::operator=(Model&&) noexcept = default;
 Model::~Model() = default;
@@ -31,8 +31,8 @@ std::string megabytes(double bytes) { return std::to_string(std::uint64_t(bytes 
 
 }  // namespace
 
-Model open_model(const std::string& path, const OpenModelOptions& options, ThreadPool& pool,
-                 Progress& progress) {
+Model Model::open_file(const std::string& path, const OpenModelOptions& options, ThreadPool& pool,
+                       Progress& progress) {
   Model model;
   model.path_ = path;
   if (!std::filesystem::exists(path)) {
@@ -103,7 +103,20 @@ Model open_model(const std::string& path, const OpenModelOptions& options, Threa
   model.built_ = build_sphere_tree(points, pool, progress);
   model.view_ = model.built_.view();
   model.paging_reason_ = "in memory: built from the scan";
-  if (options.keep_source) model.source_ = std::move(points);
+  if (options.keep_source) *model.source_ = std::move(points);
+  return model;
+}
+
+Model open_model(const std::string& path, const OpenModelOptions& options, ThreadPool& pool,
+                 Progress& progress) {
+  Model model = Model::open_file(path, options, pool, progress);
+  model.renderable_ = std::make_unique<RenderModel>(
+      RenderModel{.tree = model.view_,
+                  .pages = model.pages_.get(),
+                  .mesh = options.keep_source && model.kind_ == ModelKind::Scan
+                              ? model.source_.get()
+                              : nullptr,
+                  .name = path});
   return model;
 }
 

@@ -13,6 +13,7 @@
 #include "pointillist/lod/pages.hpp"
 #include "pointillist/lod/sphere_tree.hpp"
 #include "pointillist/prep/prepare.hpp"
+#include "pointillist/render/renderer.hpp"
 
 namespace pointillist {
 
@@ -59,7 +60,9 @@ class Model {
   // Why the model is paged or held whole, for --stats and messages.
   const std::string& paging_reason() const { return paging_reason_; }
   // A scan's prepared points (with OpenModelOptions::keep_source; empty otherwise).
-  const PointSet& source() const { return source_; }
+  const PointSet& source() const { return *source_; }
+  // What the renderer draws (its address stays the same for the model's life, moves included).
+  const RenderModel& renderable() const { return *renderable_; }
   // The file's metadata text (.ptl, .qs), one "key: value" per line.
   const std::string& metadata() const { return metadata_; }
   std::uint64_t file_size() const { return file_size_; }
@@ -76,6 +79,7 @@ class Model {
 
  private:
   friend Model open_model(const std::string&, const OpenModelOptions&, ThreadPool&, Progress&);
+  static Model open_file(const std::string&, const OpenModelOptions&, ThreadPool&, Progress&);
   std::string path_;
   ModelKind kind_ = ModelKind::Scan;
   std::unique_ptr<PtlFile> v1_;
@@ -84,7 +88,8 @@ class Model {
   std::string paging_reason_;
   SphereTree built_;
   SphereTreeView view_;
-  PointSet source_;
+  std::unique_ptr<PointSet> source_;
+  std::unique_ptr<RenderModel> renderable_;
   std::string metadata_;
   std::uint64_t file_size_ = 0;
   ScanInput scan_input_;

@@ -17,6 +17,7 @@
 #include "pointillist/lod/sphere_tree.hpp"
 #include "pointillist/render/quality.hpp"
 #include "pointillist/render/render.hpp"
+#include "pointillist/render/selection.hpp"
 
 namespace pointillist {
 
@@ -47,6 +48,13 @@ class PagedRenderer {
                       const QualitySettings& quality, ThreadPool& pool, Frame& frame,
                       QualityScratch& scratch);
 
+  // The selection of render() alone: writes the splats of the resident pages seen by `camera`
+  // into `stream` (discs filled when stream.with_discs) and records the pages wanted. With
+  // `same_frame`, the selection adds to the last one's requests (another instance of the model
+  // in the same frame) instead of starting a frame.
+  SelectionStats select(const CameraFrame& camera, const RenderSettings& settings,
+                        ThreadPool& pool, SplatStream& stream, bool same_frame = false);
+
   // Loading between frames: see PageCache (the requests are the last render's).
   std::size_t load_requested(ThreadPool& pool, std::size_t max_pages = SIZE_MAX,
                              std::uint64_t max_storage_bytes = UINT64_MAX) {
@@ -70,7 +78,7 @@ class PagedRenderer {
   struct Selection;
   // The traversal over decoded or packed pages (Access: see paged_render.cpp).
   template <class Access>
-  void select(const Access& access, Selection& selection, ThreadPool& pool);
+  void select_pages(const Access& access, Selection& selection, ThreadPool& pool);
 
   PageCache cache_;
   SphereTreeView summary_;

@@ -123,23 +123,15 @@ void PagedRenderer::render_quality(const Camera& camera, const RenderSettings& s
   render_frame(camera, settings, &quality, &scratch, pool, frame);
 }
 
-void PagedRenderer::render_frame(const Camera& camera, const RenderSettings& settings,
-                                 const QualitySettings* quality, QualityScratch* scratch,
-                                 ThreadPool& pool, Frame& frame) {
+SelectionStats PagedRenderer::select(const CameraFrame& cam, const RenderSettings& settings,
+                                    ThreadPool& pool, SplatStream& stream, bool same_frame) {
   if (!(settings.threshold_px > 0.0f) || !std::isfinite(settings.threshold_px)) {
     throw OptionError("splat size threshold " + std::to_string(settings.threshold_px) +
                       " px is invalid; give a positive number of pixels (1 draws every detail)");
   }
-  const auto start = Clock::now();
-  const CameraFrame cam = make_camera_frame(camera);
-  size_frame(frame, cam);
-
-  cache_.begin_frame();
+  if (!same_frame) cache_.begin_frame();
   const PageTable& pages = cache_.pages();
-
   const bool with_colors = summary_.has_colors;
-  SplatStream& stream = frame.splats;
-  stream.with_discs = quality != nullptr;
   stream.has_colors = with_colors;
   stream.chunk_count = 0;
   const Shader shader(settings, cam);
@@ -151,14 +143,29 @@ void PagedRenderer::render_frame(const Camera& camera, const RenderSettings& set
       with_colors, stream, {}};
   if (!pages.empty() && pages[0]) {
     if (pages[0]->is_packed()) {
-      select(PackedAccess(pages, with_colors), selection, pool);
+      select_pages(PackedAccess(pages, with_colors), selection, pool);
     } else {
-      select(DecodedAccess(pages), selection, pool);
+      select_pages(DecodedAccess(pages), selection, pool);
     }
   }
+  cache_.end_frame();
   const Counters& counters = selection.counters;
   std::uint64_t splats = 0;
   for (std::size_t t = 0; t < stream.chunk_count; ++t) splats += stream.chunks[t].count;
+  return {.splats = splats, .nodes_visited = counters.visited,
+          .culled_frustum = counters.culled_frustum,
+          .culled_backface = counters.culled_backface};
+}
+
+void PagedRenderer::render_frame(const Camera& camera, const RenderSettings& settings,
+                                 const QualitySettings* quality, QualityScratch* scratch,
+                                 ThreadPool& pool, Frame& frame) {
+  const auto start = Clock::now();
+  const CameraFrame cam = make_camera_frame(camera);
+  size_frame(frame, cam);
+  SplatStream& stream = frame.splats;
+  stream.with_discs = quality != nullptr;
+  const SelectionStats selection = select(cam, settings, pool, stream);
   const auto selected = Clock::now();
   if (quality) {
     rasterize_quality(stream, cam, settings, *quality, pool, *scratch, frame.color,
@@ -166,16 +173,11 @@ void PagedRenderer::render_frame(const Camera& camera, const RenderSettings& set
   } else {
     rasterize_splats(stream, cam, settings, pool, frame.scratch, frame.color, frame.depth);
   }
-  fill_stats(frame,
-             {.splats = splats, .nodes_visited = counters.visited,
-              .culled_frustum = counters.culled_frustum,
-              .culled_backface = counters.culled_backface},
-             cam, pool.thread_count(), start, selected, Clock::now());
-  cache_.end_frame();
+  fill_stats(frame, selection, cam, pool.thread_count(), start, selected, Clock::now());
 }
 
 template <class Access>
-void PagedRenderer::select(const Access& access, Selection& s, ThreadPool& pool) {
+void PagedRenderer::select_pages(const Access& access, Selection& s, ThreadPool& pool) {
   using Item = typename Access::Item;
   const ViewConstants& v = s.v;
   const bool with_colors = s.with_colors;

@@ -1,0 +1,306 @@
+// The renderer's one entry point (see renderer.hpp): per instance, selection by the chosen
+// level-of-detail scheme into the frame's stream; then one rasterization of the whole stream.
+#include "pointillist/render/renderer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <utility>
+
+#include "frame_timing.hpp"
+#include "pointillist/core/error.hpp"
+#include "pointillist/render/mesh_reference.hpp"
+#include "pointillist/render/paged.hpp"
+#include "pointillist/render/selection.hpp"
+
+namespace pointillist {
+
+using render_detail::Clock;
+
+namespace {
+
+// Page size when a model held whole is cut into pages (RendererOptions::page_all).
+constexpr std::uint64_t kInMemoryPageBytes = 64 * 1024;
+constexpr std::uint32_t kInMemoryPageLevels = 4;
+
+Vec3f rotate(const InstanceTransform& t, Vec3f v) {
+  return {dot(t.rotation[0], v), dot(t.rotation[1], v), dot(t.rotation[2], v)};
+}
+// Rᵀ·v: the inverse rotation.
+Vec3f rotate_back(const InstanceTransform& t, Vec3f v) {
+  return t.rotation[0] * v.x + t.rotation[1] * v.y + t.rotation[2] * v.z;
+}
+
+// The camera as the model sees it: the same image of the model at p as the world camera gives
+// of translate + scale·R·p. Sizes on screen are unchanged (radius and distance scale alike).
+Camera model_camera(const Camera& world, const InstanceTransform& t) {
+  Camera c = world;
+  const float inv_scale = 1.0f / t.scale;
+  c.eye = rotate_back(t, world.eye - t.translate) * inv_scale;
+  c.target = rotate_back(t, world.target - t.translate) * inv_scale;
+  c.up = rotate_back(t, world.up);
+  return c;
+}
+
+// Moves a chunk selected in model space into the world: discs, and depth (model depth × scale).
+void to_world(const InstanceTransform& t, SplatChunk& chunk, bool with_discs) {
+  for (std::size_t i = 0; i < chunk.count; ++i) {
+    chunk.depth[i] *= t.scale;
+    chunk.normal[i] = rotate(t, chunk.normal[i]);
+    if (with_discs) {
+      chunk.center[i] = t.translate + rotate(t, chunk.center[i]) * t.scale;
+      chunk.radius[i] *= t.scale;
+    }
+  }
+}
+
+std::uint8_t to_byte(float v) {
+  return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
+}
+
+void add(SelectionStats& a, const SelectionStats& b) {
+  a.splats += b.splats;
+  a.nodes_visited += b.nodes_visited;
+  a.culled_frustum += b.culled_frustum;
+  a.culled_backface += b.culled_backface;
+}
+
+}  // namespace
+
+bool InstanceTransform::is_identity() const {
+  return translate == Vec3f{0, 0, 0} && scale == 1.0f && rotation[0] == Vec3f{1, 0, 0} &&
+         rotation[1] == Vec3f{0, 1, 0} && rotation[2] == Vec3f{0, 0, 1};
+}
+
+struct Renderer::ModelState {
+  const RenderModel* model = nullptr;
+  std::unique_ptr<PageSource> owned_pages;  // a model held whole, cut into pages
+  const PageSource* pages = nullptr;
+  std::optional<PagedRenderer> paged;
+  std::optional<SequentialPointTree> spt;
+  std::uint64_t frame = 0;  // the last frame that drew the model
+};
+
+Renderer::Renderer(const RendererOptions& options) : options_(options) {}
+Renderer::~Renderer() = default;
+
+Renderer::ModelState& Renderer::state_for(const RenderModel& model, ThreadPool& pool,
+                                          const FrameSettings& fs) {
+  ModelState* state = nullptr;
+  for (auto& s : states_) {
+    if (s->model == &model) state = s.get();
+  }
+  if (!state) {
+    states_.push_back(std::make_unique<ModelState>());
+    state = states_.back().get();
+    state->model = &model;
+    if (model.pages || options_.page_all) {
+      state->pages = model.pages;
+      if (!state->pages) {
+        // A model held whole: cut into pages in memory, so that paging can be watched; the cap
+        // bounds the pages the renderer keeps, not the model's own memory.
+        state->owned_pages = paginate(model.tree, kInMemoryPageBytes, kInMemoryPageLevels);
+        state->pages = state->owned_pages.get();
+      }
+      state->paged.emplace(*state->pages,
+                           options_.memory_cap > 0 ? options_.memory_cap : UINT64_MAX, pool);
+    }
+  }
+  if (fs.lod == LodScheme::Spt && !state->spt) {
+    state->spt = build_sequential_point_tree(sphere_tree_leaves(model.tree), pool);
+  }
+  return *state;
+}
+
+void Renderer::render(std::span<const SceneInstance> scene, const Camera& camera,
+                      const RenderSettings& settings, const FrameSettings& fs, ThreadPool& pool,
+                      Frame& frame) {
+  const bool several = scene.size() > 1 ||
+                       (scene.size() == 1 && !scene[0].transform.is_identity());
+  if (fs.rasterizer == Rasterizer::Reference) {
+    if (fs.lod == LodScheme::Spt) {
+      throw OptionError("--mode reference draws the mesh's triangles; it cannot be combined with "
+                        "--lod spt");
+    }
+    if (several) {
+      throw OptionError("--mode reference draws one mesh as it is; give a single input without "
+                        "a transform");
+    }
+  }
+  if (fs.rasterizer == Rasterizer::Quality) validate_quality_settings(fs.quality);
+  for (const SceneInstance& inst : scene) {
+    const RenderModel& m = *inst.model;
+    if (fs.rasterizer == Rasterizer::Reference && !(m.mesh && m.mesh->is_mesh())) {
+      throw OptionError(m.name + ": --mode reference draws a mesh's triangles, and this input " +
+                        (m.mesh ? "has no faces" : "is a splat model") +
+                        "; give the source mesh (.ply, .obj)");
+    }
+    if ((m.pages || options_.page_all) &&
+        (fs.lod == LodScheme::Spt || fs.rasterizer == Rasterizer::Reference)) {
+      throw OptionError(std::string(m.pages ? m.name + " is rendered page by page"
+                                            : "--memory and --progressive render page by page") +
+                        ": the QSplat hierarchy in the fast or quality mode; drop " +
+                        (fs.lod == LodScheme::Spt ? "--lod spt" : "--mode reference"));
+    }
+  }
+
+  const auto start = Clock::now();
+  const CameraFrame world = make_camera_frame(camera);
+  render_detail::size_frame(frame, world);
+  last_frame_.clear();
+  spt_stats_ = {};
+  ++frame_number_;
+
+  if (fs.rasterizer == Rasterizer::Reference) {
+    render_mesh_reference(*scene[0].model->mesh, camera, settings, frame);
+    return;
+  }
+
+  // Selection, instance after instance; the first instance selects straight into the frame's
+  // stream, the others into a scratch stream whose chunks are then moved behind.
+  SplatStream& stream = frame.splats;
+  const bool with_discs = fs.rasterizer == Rasterizer::Quality;
+  stream.chunk_count = 0;
+  stream.has_colors = false;
+  stream.with_discs = with_discs;
+  SelectionStats total;
+  bool any_colors = false;
+  for (const SceneInstance& inst : scene) any_colors = any_colors || inst.model->tree.has_colors;
+  for (std::size_t i = 0; i < scene.size(); ++i) {
+    const SceneInstance& inst = scene[i];
+    ModelState& state = state_for(*inst.model, pool, fs);
+    const bool first_use = state.frame != frame_number_;
+    state.frame = frame_number_;
+    if (first_use) last_frame_.push_back(&state);
+    const bool identity = inst.transform.is_identity();
+    const CameraFrame cam =
+        identity ? world : make_camera_frame(model_camera(camera, inst.transform));
+    SplatStream& into = i == 0 ? stream : scratch_stream_;
+    into.with_discs = with_discs;
+    into.chunk_count = 0;
+    SelectionStats selected;
+    if (fs.lod == LodScheme::Spt) {
+      SptSelectionStats spt;
+      select_splats_spt(*state.spt, cam, settings,
+                        {.epsilon_px = fs.epsilon_px, .chunk_culling = fs.spt_chunk_culling},
+                        pool, into, spt);
+      selected = {.splats = spt.splats, .nodes_visited = spt.entries_scanned,
+                  .culled_frustum = spt.chunks_culled + spt.culled_frustum,
+                  .culled_backface = spt.culled_backface};
+      spt_stats_.splats += spt.splats;
+      spt_stats_.entries_scanned += spt.entries_scanned;
+      spt_stats_.entries_total += spt.entries_total;
+      spt_stats_.chunks_total += spt.chunks_total;
+      spt_stats_.chunks_culled += spt.chunks_culled;
+      spt_stats_.culled_backface += spt.culled_backface;
+      spt_stats_.culled_frustum += spt.culled_frustum;
+    } else if (state.paged) {
+      selected = state.paged->select(cam, settings, pool, into, !first_use);
+    } else {
+      select_splats(inst.model->tree, cam, settings, pool, into, selected);
+    }
+    add(total, selected);
+    const bool colors = into.has_colors;
+    for (std::size_t c = 0; c < into.chunk_count; ++c) {
+      SplatChunk& chunk = into.chunks[c];
+      chunk.instance = static_cast<std::uint32_t>(i);
+      if (!identity) to_world(inst.transform, chunk, with_discs);
+      if (any_colors && !colors) {
+        // A model without colours beside coloured ones: its base colour, as the others carry.
+        const Rgb8 base{to_byte(settings.base_color.x), to_byte(settings.base_color.y),
+                        to_byte(settings.base_color.z)};
+        chunk.reserve(chunk.count, true);
+        std::fill(chunk.color.begin(), chunk.color.begin() + chunk.count, base);
+      }
+    }
+    if (i > 0) {
+      const std::size_t base = stream.chunk_count;
+      if (stream.chunks.size() < base + into.chunk_count) {
+        stream.chunks.resize(base + into.chunk_count);
+      }
+      for (std::size_t c = 0; c < into.chunk_count; ++c) {
+        std::swap(stream.chunks[base + c], into.chunks[c]);
+      }
+      stream.chunk_count = base + into.chunk_count;
+    }
+  }
+  stream.has_colors = any_colors;
+  const auto selected_at = Clock::now();
+  if (fs.rasterizer == Rasterizer::Quality) {
+    rasterize_quality(stream, world, settings, fs.quality, pool, quality_scratch_, frame.color,
+                      frame.depth);
+  } else {
+    rasterize_splats(stream, world, settings, pool, frame.scratch, frame.color, frame.depth);
+  }
+  render_detail::fill_stats(frame, total, world, pool.thread_count(), start, selected_at,
+                            Clock::now());
+}
+
+std::size_t Renderer::load_requested(ThreadPool& pool, std::size_t max_pages,
+                                     std::uint64_t max_storage_bytes) {
+  std::size_t n = 0;
+  for (ModelState* s : last_frame_) {
+    if (s->paged) n += s->paged->load_requested(pool, max_pages, max_storage_bytes);
+  }
+  return n;
+}
+
+std::size_t Renderer::request_in_background(std::size_t max_pages,
+                                            std::uint64_t max_storage_bytes) {
+  std::size_t n = 0;
+  for (ModelState* s : last_frame_) {
+    if (s->paged) n += s->paged->request_in_background(max_pages, max_storage_bytes);
+  }
+  return n;
+}
+
+void Renderer::wait_for_loader() {
+  for (ModelState* s : last_frame_) {
+    if (s->paged) s->paged->wait_for_loader();
+  }
+}
+
+bool Renderer::complete() const {
+  for (const ModelState* s : last_frame_) {
+    if (s->paged && !s->paged->complete()) return false;
+  }
+  return true;
+}
+
+bool Renderer::paging() const {
+  for (const ModelState* s : last_frame_) {
+    if (s->paged) return true;
+  }
+  return false;
+}
+
+bool Renderer::pages_any(std::span<const SceneInstance> scene) const {
+  if (options_.page_all) return !scene.empty();
+  return std::any_of(scene.begin(), scene.end(),
+                     [](const SceneInstance& i) { return i.model->pages != nullptr; });
+}
+
+PagingStats Renderer::paging_stats() const {
+  PagingStats p;
+  for (const ModelState* s : last_frame_) {
+    if (!s->paged) continue;
+    p.paged = true;
+    p.pages += s->pages->page_count();
+    p.model_bytes += s->pages->open_bytes();
+    for (std::uint32_t i = 0; i < s->pages->page_count(); ++i) {
+      p.model_bytes += s->pages->page_storage_bytes(i);
+    }
+    const PageCacheStats& c = s->paged->stats();
+    p.cache.pages_requested += c.pages_requested;
+    p.cache.bytes_read += c.bytes_read;
+    p.cache.resident_bytes += c.resident_bytes;
+    p.cache.resident_bytes_peak += c.resident_bytes_peak;
+    p.cache.resident_pages += c.resident_pages;
+    p.cache.pages_loaded += c.pages_loaded;
+    p.cache.pages_evicted += c.pages_evicted;
+    p.complete = p.complete && s->paged->complete();
+  }
+  return p;
+}
+
+}  // namespace pointillist
