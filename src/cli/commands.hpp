@@ -2,6 +2,7 @@
 // them. Each returns the process exit code; errors are thrown as pointillist::Error.
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -14,7 +15,24 @@
 #include "pointillist/render/render.hpp"
 #include "pointillist/render/renderer.hpp"
 
+namespace CLI {
+class App;
+}
+
 namespace pointillist::cli {
+
+// A subcommand registered on the command line: its CLI11 app (options bound to an options
+// struct it owns) and what runs it once the line is parsed (returns the exit code).
+struct Command {
+  CLI::App* app = nullptr;
+  std::function<int()> run;
+};
+Command add_convert_command(CLI::App& app);
+Command add_render_command(CLI::App& app);
+Command add_info_command(CLI::App& app);
+Command add_demo_command(CLI::App& app);
+Command add_generate_command(CLI::App& app);
+Command add_compare_command(CLI::App& app);
 
 struct ConvertCommandOptions {
   std::vector<std::string> inputs;
@@ -55,6 +73,7 @@ struct RenderOptions {
   std::uint64_t memory_cap = 0;     // --memory BYTES
   unsigned progressive_frames = 0;  // --progressive N
   std::uint64_t read_per_frame = 1u << 20;  // --read-per-frame BYTES (progressive loading)
+  std::vector<std::string> warnings;  // options given that do not apply (printed by run_render)
 };
 int run_render(const RenderOptions& options);
 

@@ -3,9 +3,11 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <memory>
 #include <string>
 
 #include "commands.hpp"
+#include "options.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/io/png.hpp"
 #include "pointillist/eval/image_compare.hpp"
@@ -96,6 +98,29 @@ int run_compare(const CompareOptions& o) {
   }
   print_text(o, c, reference.width, reference.height);
   return 0;
+}
+
+Command add_compare_command(CLI::App& app) {
+  auto o = std::make_shared<CompareOptions>();
+  auto background = std::make_shared<std::string>();
+  auto* cmd = app.add_subcommand(
+      "compare", "Compare a render with a reference image of the same size: PSNR, SSIM, hole "
+                 "pixels, silhouette IoU");
+  cmd->add_option("reference", o->reference, "Reference PNG")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("test", o->test, "PNG to measure against the reference")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--background", *background,
+                  "Background color R,G,B (0-255) for the silhouette masks (default: the "
+                  "reference's top-left pixel)");
+  cmd->add_option("--json", o->json_output,
+                  "Also write the metrics as JSON to FILE (- = stdout, instead of text)");
+  return {cmd, [o, background] {
+            if (!background->empty()) o->background = parse_rgb8(*background, "--background");
+            return run_compare(*o);
+          }};
 }
 
 }  // namespace pointillist::cli

@@ -2,8 +2,10 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 
 #include "commands.hpp"
+#include "options.hpp"
 #include "terminal_progress.hpp"
 #include "util.hpp"
 #include "pointillist/pipeline/convert.hpp"
@@ -32,6 +34,42 @@ int run_convert(const ConvertCommandOptions& o) {
                 n ? size / double(n) : 0.0);
   }
   return 0;
+}
+
+Command add_convert_command(CLI::App& app) {
+  auto o = std::make_shared<ConvertCommandOptions>();
+  auto* cmd = app.add_subcommand(
+      "convert", "Convert scans (PLY, XYZ/PTS/CSV, OBJ, LAS; .gz too) into a splat model (.ptl, "
+                 ".qs) or points with normals and radii (.ply)");
+  cmd->add_option("inputs", o->inputs, "Input files (several are merged)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("-o,--output", o->output,
+                  "Output file: .ptl (Pointillist model), .qs (QSplat 1.1 model) or .ply")
+      ->required()
+      ->group(kGroupOutput);
+  cmd->add_option("--ptl-version", o->convert.ptl_version,
+                  ".ptl version to write: 2 (quantized, paged; the default) or 1 (float nodes, 40 "
+                  "bytes each)")
+      ->default_val(2)
+      ->group(kGroupOutput);
+  auto trim = std::make_shared<quant::LeafTrim>();
+  CLI::Option* trim_option = add_enum<quant::LeafTrim>(cmd, "--leaf-trim", *trim,
+                            {{"sixteenths", quant::LeafTrim::Sixteenths},
+                             {"eighths", quant::LeafTrim::Eighths}},
+                            ".ptl v2: steps in which leaves keep their radius trim: sixteenths "
+                            "(the default, tighter splats) or eighths (files that Pointillist "
+                            "before 2026-11-24 reads)");
+  trim_option->group(kGroupOutput);
+  cmd->add_flag("--ascii", o->convert.ascii, "Write .ply output as ascii")->group(kGroupOutput);
+  add_columns(cmd, o->convert.columns);
+  add_prepare_options(cmd, o->convert.prepare);
+  add_threads(cmd, o->threads);
+  cmd->add_flag("-q,--quiet", o->quiet, "No progress bars and no summary");
+  return {cmd, [o, trim, trim_option] {
+            if (trim_option->count() > 0) o->convert.leaf_trim = *trim;
+            return run_convert(*o);
+          }};
 }
 
 }  // namespace pointillist::cli

@@ -1,10 +1,12 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "commands.hpp"
+#include "options.hpp"
 #include "util.hpp"
 #include "pointillist/io/merge.hpp"
 #include "pointillist/pipeline/model.hpp"
@@ -118,6 +120,20 @@ int run_demo(const DemoOptions& o) {
   }
   std::printf("images written to %s\n", o.out_dir.c_str());
   return 0;
+}
+
+Command add_demo_command(CLI::App& app) {
+  auto o = std::make_shared<DemoOptions>();
+  auto* cmd = app.add_subcommand(
+      "demo", "Generate the built-in analytic scene, convert it, render views with every kernel "
+              "(and the Stanford dragon when fetched)");
+  cmd->add_option("--out", o->out_dir, "Output folder")->default_val("demo-out");
+  cmd->add_option("--points", o->points, "Samples in the generated scene")
+      ->default_val(400000)
+      ->check(CLI::Range(std::size_t{100}, std::size_t{200'000'000}));
+  add_threads(cmd, o->threads);
+  cmd->add_flag("-q,--quiet", o->quiet, "No progress bars");
+  return {cmd, [o] { return run_demo(*o); }};
 }
 
 }  // namespace pointillist::cli

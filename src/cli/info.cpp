@@ -2,9 +2,11 @@
 #include <array>
 #include <cctype>
 #include <cstdio>
+#include <memory>
 #include <string>
 
 #include "commands.hpp"
+#include "options.hpp"
 #include "util.hpp"
 #include "pointillist/format/ptl.hpp"
 #include "pointillist/format/ptl_v2.hpp"
@@ -137,6 +139,29 @@ int run_info(const InfoOptions& o) {
     }
   }
   return 0;
+}
+
+Command add_info_command(CLI::App& app) {
+  auto o = std::make_shared<InfoOptions>();
+  auto view = std::make_shared<std::string>(), size = std::make_shared<std::string>("1280x720");
+  auto* cmd = app.add_subcommand("info", "Describe a model or scan file");
+  cmd->add_option("input", o->input, "Model or scan file")->required()->check(CLI::ExistingFile);
+  add_threads(cmd, o->threads);
+  add_columns(cmd, o->columns);
+  cmd->add_flag("--spt", o->spt,
+                "Also build the Sequential Point Tree and report its list and the share of it "
+                "one view scans");
+  cmd->add_option("--view", *view, "With --spt: orbit view AZ,EL (default 0,0)");
+  cmd->add_option("--size", *size, "With --spt: image size WxH")->default_str("1280x720");
+  cmd->add_option("--distance", o->view.distance,
+                  "With --spt: eye distance in model radii (default: whole model in view)");
+  cmd->add_option("--epsilon", o->epsilon_px, "With --spt: error bound, pixels")
+      ->default_val(1.0f)
+      ->check(CLI::Range(0.001f, 1000.0f));
+  return {cmd, [o, view, size] {
+            parse_size_and_view(*size, *view, o->view);
+            return run_info(*o);
+          }};
 }
 
 }  // namespace pointillist::cli

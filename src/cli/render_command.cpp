@@ -165,6 +165,9 @@ std::vector<FrameRecord> to_records(const std::vector<SequenceFrame>& frames) {
 
 int run_render(const RenderOptions& o) {
   check_options(o);
+  for (const std::string& w : o.warnings) {
+    std::fprintf(stderr, "pointillist render: warning: %s\n", w.c_str());
+  }
   ThreadPool pool(o.threads);
   TerminalProgress progress(!o.quiet && TerminalProgress::stderr_is_terminal());
   const bool paging_asked = o.memory_cap > 0 || o.progressive_frames > 0;

@@ -128,6 +128,10 @@ void Renderer::render(std::span<const SceneInstance> scene, const Camera& camera
     }
   }
   if (fs.rasterizer == Rasterizer::Quality) validate_quality_settings(fs.quality);
+  if (!(fs.splat_scale > 0.0f) || !std::isfinite(fs.splat_scale)) {
+    throw OptionError("splat scale " + std::to_string(fs.splat_scale) +
+                      " is invalid; give a positive number (1 draws splats at their size)");
+  }
   for (const SceneInstance& inst : scene) {
     const RenderModel& m = *inst.model;
     if (fs.rasterizer == Rasterizer::Reference && !(m.mesh && m.mesh->is_mesh())) {
@@ -225,6 +229,15 @@ void Renderer::render(std::span<const SceneInstance> scene, const Camera& camera
     }
   }
   stream.has_colors = any_colors;
+  if (fs.splat_scale != 1.0f) {
+    for (std::size_t c = 0; c < stream.chunk_count; ++c) {
+      SplatChunk& chunk = stream.chunks[c];
+      for (std::size_t i = 0; i < chunk.count; ++i) chunk.size_px[i] *= fs.splat_scale;
+      if (with_discs) {
+        for (std::size_t i = 0; i < chunk.count; ++i) chunk.radius[i] *= fs.splat_scale;
+      }
+    }
+  }
   const auto selected_at = Clock::now();
   if (fs.rasterizer == Rasterizer::Quality) {
     rasterize_quality(stream, world, settings, fs.quality, pool, quality_scratch_, frame.color,

@@ -67,6 +67,9 @@ struct FrameSettings {
   // SPT: skip chunks outside the view frustum (turn off only to measure what it saves).
   bool spt_chunk_culling = true;
   QualitySettings quality;
+  // Every splat is drawn this many times its size (a point-size control); the level of detail
+  // is chosen as at 1. > 0.
+  float splat_scale = 1.0f;
 };
 
 struct RendererOptions {

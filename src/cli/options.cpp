@@ -1,0 +1,147 @@
+// Command-line option helpers (see options.hpp).
+#include "options.hpp"
+
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+
+#include "pointillist/core/error.hpp"
+
+namespace pointillist::cli {
+namespace {
+
+std::vector<float> parse_floats(const std::string& text, std::size_t count, const char sep,
+                                const std::string& option) {
+  std::vector<float> values;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, sep)) {
+    try {
+      std::size_t used = 0;
+      const float v = std::stof(item, &used);
+      if (used != item.size()) throw std::invalid_argument(item);
+      values.push_back(v);
+    } catch (const std::exception&) {
+      values.clear();
+      break;
+    }
+  }
+  if (values.size() != count) {
+    throw OptionError(option + " '" + text + "': expected " + std::to_string(count) +
+                      " numbers separated by '" + sep + "'");
+  }
+  return values;
+}
+
+}  // namespace
+
+// --size WxH and --view AZ,EL (may be empty) into `v`.
+void parse_size_and_view(const std::string& size, const std::string& view, ViewOptions& v) {
+  const auto wh = parse_floats(size, 2, 'x', "--size");
+  v.width = static_cast<int>(wh[0]);
+  v.height = static_cast<int>(wh[1]);
+  if (wh[0] < 1 || wh[1] < 1 || wh[0] > 32768 || wh[1] > 32768 || wh[0] != v.width ||
+      wh[1] != v.height) {
+    throw OptionError("--size '" + size +
+                                   "': width and height must be whole numbers from 1 to 32768");
+  }
+  if (!view.empty()) {
+    const auto ae = parse_floats(view, 2, ',', "--view");
+    v.azimuth_deg = ae[0];
+    v.elevation_deg = ae[1];
+  }
+}
+
+// "500000", "64K", "512M", "1.5G" (powers of 1024) -> bytes.
+std::uint64_t parse_bytes(const std::string& text, const std::string& option) {
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  double scale = 1;
+  const std::string unit = end ? std::string(end) : std::string();
+  if (unit == "K" || unit == "k" || unit == "KB" || unit == "KiB") scale = 1024.0;
+  else if (unit == "M" || unit == "MB" || unit == "MiB") scale = 1024.0 * 1024;
+  else if (unit == "G" || unit == "GB" || unit == "GiB") scale = 1024.0 * 1024 * 1024;
+  else if (!unit.empty()) scale = -1;
+  const double bytes = value * scale;
+  if (text.empty() || end == text.c_str() || scale < 0 || !(bytes >= 1) || bytes > 1e18) {
+    throw OptionError(option + " '" + text +
+                      "': give a size in bytes, optionally with K, M or G (e.g. 512M)");
+  }
+  return static_cast<std::uint64_t>(bytes);
+}
+
+// "orbit:N" (1 <= N <= 100000) -> N.
+unsigned parse_orbit_path(const std::string& text) {
+  const std::string prefix = "orbit:";
+  if (text.rfind(prefix, 0) == 0) {
+    const std::string count = text.substr(prefix.size());
+    char* end = nullptr;
+    const unsigned long n = std::strtoul(count.c_str(), &end, 10);
+    if (!count.empty() && *end == '\0' && n >= 1 && n <= 100000 && count[0] != '-') {
+      return static_cast<unsigned>(n);
+    }
+  }
+  throw OptionError("--path '" + text +
+                                 "' is not a camera path; give orbit:N with N frames from 1 to 100000 "
+                                 "(e.g. --path orbit:120)");
+}
+
+Vec3f parse_vec3(const std::string& text, const std::string& option) {
+  const auto v = parse_floats(text, 3, ',', option);
+  return {v[0], v[1], v[2]};
+}
+
+// "R,G,B" with each component a whole number 0-255.
+Rgb8 parse_rgb8(const std::string& text, const std::string& option) {
+  const Vec3f c = parse_vec3(text, option);
+  for (float v : {c.x, c.y, c.z}) {
+    if (v < 0 || v > 255 || v != std::floor(v)) {
+      throw OptionError(option + " '" + text + "': components must be whole numbers 0-255");
+    }
+  }
+  return {static_cast<std::uint8_t>(c.x), static_cast<std::uint8_t>(c.y),
+          static_cast<std::uint8_t>(c.z)};
+}
+
+void add_columns(CLI::App* app, std::string& columns) {
+  app->add_option("--columns", columns,
+                  "Text inputs (.xyz .pts .csv .txt): what each column holds, e.g. "
+                  "x,y,z,skip,r,g,b (names: x y z nx ny nz r g b skip; default: detect)")
+      ->group(kGroupScan);
+}
+
+void add_threads(CLI::App* app, unsigned& threads) {
+  app->add_option("--threads", threads, "Worker threads (0 = one per core)")->default_val(0);
+}
+
+void add_prepare_options(CLI::App* app, PrepareOptions& p, bool with_radius_scale) {
+  add_enum<NormalSource>(app, "--normals", p.normals,
+                         {{"auto", NormalSource::Auto},
+                          {"keep", NormalSource::Keep},
+                          {"mesh", NormalSource::Mesh},
+                          {"pca", NormalSource::Pca}},
+                         "Normal source: auto (file, else mesh faces, else PCA), keep, mesh, pca",
+                         "auto")
+      ->group(kGroupScan);
+  app->add_option("--k", p.k, "Neighbours for PCA normals")
+      ->default_val(16)
+      ->check(CLI::Range(3u, 256u))
+      ->group(kGroupScan);
+  if (with_radius_scale) {
+    app->add_option("--radius-scale", p.radius_scale, "Multiply every splat radius by S")
+        ->default_val(1.0f)
+        ->check(CLI::PositiveNumber)
+        ->group(kGroupScan);
+  }
+  app->add_flag("--drop-outliers", p.drop_outliers,
+                "Point clouds: drop stray points, whose neighbours are much farther than usual")
+      ->group(kGroupScan);
+  app->add_option("--outlier-ratio", p.outlier_ratio_drop,
+                  "With --drop-outliers: how many times farther than its neighbours' a point's "
+                  "neighbours must be (lower drops more)")
+      ->default_val(3.0f)
+      ->check(CLI::Range(1.0001f, 1e6f))
+      ->group(kGroupScan);
+}
+
+}  // namespace pointillist::cli

@@ -1,0 +1,211 @@
+// The options of `pointillist render`, grouped as --help shows them.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "options.hpp"
+#include "pointillist/pipeline/model.hpp"
+
+namespace pointillist::cli {
+namespace {
+
+// Text options parsed after CLI11 has read the line.
+struct RenderText {
+  std::string size = "1280x720", view, eye, target, up, background = "0,0,0", path, memory,
+              read_per_frame;
+  bool no_chunk_culling = false;
+};
+
+void add_camera(CLI::App* cmd, RenderOptions& o, RenderText& t) {
+  cmd->add_option("--size", t.size, "Image size WxH")->default_str("1280x720")->group(kGroupCamera);
+  cmd->add_option("--view", t.view, "Orbit view AZ,EL in degrees (default 0,0)")
+      ->group(kGroupCamera);
+  cmd->add_option("--distance", o.view.distance,
+                  "Eye distance in model radii (default: whole model in view)")
+      ->group(kGroupCamera);
+  cmd->add_option("--fov", o.view.fov_deg, "Vertical field of view, degrees")
+      ->default_val(30.0f)
+      ->group(kGroupCamera);
+  cmd->add_option("--eye", t.eye, "Explicit eye X,Y,Z (with --target)")->group(kGroupCamera);
+  cmd->add_option("--target", t.target, "Explicit target X,Y,Z (with --eye)")
+      ->group(kGroupCamera);
+  cmd->add_option("--up", t.up,
+                  "Up vector X,Y,Z: with --eye/--target the camera's (default 0,1,0); otherwise "
+                  "the up axis for --view and --path (default: the model's, +Z for LAS scans, "
+                  "else +Y)")
+      ->group(kGroupCamera);
+}
+
+void add_look(CLI::App* cmd, RenderOptions& o, RenderText& t) {
+  add_enum<Rasterizer>(cmd, "--mode", o.frame.rasterizer,
+                       {{"fast", Rasterizer::Fast},
+                        {"quality", Rasterizer::Quality},
+                        {"reference", Rasterizer::Reference}},
+                       "fast (opaque splats), quality (perspective-correct Gaussian surface "
+                       "splatting with per-pixel shading), or reference (a mesh input's "
+                       "triangles, z-buffered, same camera and shading)",
+                       "fast")
+      ->group(kGroupLook);
+  add_enum<SplatShape>(cmd, "--splat", o.settings.shape,
+                       {{"square", SplatShape::Square},
+                        {"circle", SplatShape::Circle},
+                        {"ellipse", SplatShape::Ellipse}},
+                       "Splat kernel: square, circle, ellipse", "circle")
+      ->group(kGroupLook);
+  cmd->add_option("--radius-scale", o.frame.splat_scale,
+                  "Draw every splat S times its size (a point-size control; the level of "
+                  "detail is unchanged)")
+      ->default_val(1.0f)
+      ->check(CLI::Range(0.01f, 100.0f))
+      ->group(kGroupLook);
+  cmd->add_option("--background", t.background, "Background color R,G,B (0-255)")
+      ->group(kGroupLook);
+  add_enum<Reconstruction>(cmd, "--reconstruction", o.frame.quality.reconstruction,
+                           {{"zrange", Reconstruction::ZRange},
+                            {"zthreshold", Reconstruction::ZThreshold}},
+                           "With --mode quality: which fragments of a pixel blend, zrange "
+                           "(depth intervals overlap) or zthreshold (within a fixed depth of "
+                           "the front)",
+                           "zrange")
+      ->group(kGroupLook);
+  cmd->add_option("--opacity", o.frame.quality.opacity,
+                  "With --mode quality: opacity of every surface, composited front to back "
+                  "(1 = opaque)")
+      ->default_val(1.0f)
+      ->check(CLI::Range(0.001f, 1.0f))
+      ->group(kGroupLook);
+}
+
+void add_detail(CLI::App* cmd, RenderOptions& o, RenderText& t) {
+  add_enum<LodScheme>(cmd, "--lod", o.frame.lod,
+                      {{"qsplat", LodScheme::QSplat}, {"spt", LodScheme::Spt}},
+                      "Level-of-detail scheme: qsplat (hierarchy traversal) or spt (Sequential "
+                      "Point Tree, one sequential pass)",
+                      "qsplat")
+      ->group(kGroupDetail);
+  cmd->add_option("--threshold", o.settings.threshold_px,
+                  "QSplat: stop refining at this projected splat diameter, pixels")
+      ->default_val(1.0f)
+      ->check(CLI::Range(0.01f, 1000.0f))
+      ->group(kGroupDetail);
+  cmd->add_option("--epsilon", o.frame.epsilon_px,
+                  "With --lod spt: allowed geometric error in pixels (1 = full detail)")
+      ->default_val(1.0f)
+      ->check(CLI::Range(0.001f, 1000.0f))
+      ->group(kGroupDetail);
+  cmd->add_flag("--no-chunk-culling", t.no_chunk_culling,
+                "With --lod spt: scan every chunk's list even when the chunk is outside the "
+                "view (to measure what chunk culling saves)")
+      ->group(kGroupDetail);
+}
+
+void add_sequences_and_paging(CLI::App* cmd, RenderOptions& o, RenderText& t) {
+  cmd->add_option("--path", t.path,
+                  "Render a sequence of frames along a camera path: orbit:N = N frames around "
+                  "the model (azimuth +0..360 degrees from --view)")
+      ->group(kGroupSequence);
+  cmd->add_option("--frame-ms", o.frame_ms,
+                  "With --path: adjust the level of detail frame to frame to hold T ms per frame")
+      ->check(CLI::Range(0.1, 100000.0))
+      ->group(kGroupSequence);
+  cmd->add_option("--refine", o.refine_frames,
+                  "Then render K frames refining to full detail, as a viewer does when the "
+                  "camera stops")
+      ->check(CLI::Range(1u, 100000u))
+      ->group(kGroupSequence);
+  cmd->add_option("--frames-out", o.frames_out,
+                  "Write every frame of a sequence to DIR/frame_NNNNN.png")
+      ->group(kGroupSequence);
+  cmd->add_option("--memory", t.memory,
+                  "Render page by page keeping at most this much of the model in memory (e.g. "
+                  "512M); coarser where the cap bites")
+      ->group(kGroupPaging);
+  cmd->add_option("--progressive", o.progressive_frames,
+                  "Render N frames at the view while the model's pages load, as a viewer shows "
+                  "a model streaming in")
+      ->check(CLI::Range(1u, 100000u))
+      ->group(kGroupPaging);
+  cmd->add_option("--read-per-frame", t.read_per_frame,
+                  "With --progressive: bytes of the model read between two frames (default 1M, "
+                  "a disk at 30 MB/s shown at 30 frames/s)")
+      ->group(kGroupPaging);
+}
+
+// Options given that cannot apply to this command line, as warnings.
+std::vector<std::string> ignored_options(const CLI::App& cmd, const RenderOptions& o,
+                                         const RenderText& t) {
+  std::vector<std::string> w;
+  const auto given = [&](const char* name) { return cmd.count(name) > 0; };
+  const auto ignored = [&](const char* name, const std::string& why) {
+    if (given(name)) w.push_back(std::string(name) + " is ignored: " + why);
+  };
+  const bool spt = o.frame.lod == LodScheme::Spt;
+  const bool quality = o.frame.rasterizer == Rasterizer::Quality;
+  if (spt) ignored("--threshold", "it is the QSplat traversal's detail; --lod spt uses --epsilon");
+  if (!spt) {
+    ignored("--epsilon", "it is the Sequential Point Tree's detail; add --lod spt");
+    ignored("--no-chunk-culling", "it applies to --lod spt");
+  }
+  if (!quality) {
+    ignored("--reconstruction", "it applies to --mode quality");
+    ignored("--opacity", "it applies to --mode quality");
+  }
+  if (o.progressive_frames == 0) ignored("--read-per-frame", "it applies to --progressive");
+  bool all_models = true;
+  for (const std::string& in : o.inputs) all_models = all_models && is_model_file(in);
+  if (all_models) {
+    for (const char* name : {"--normals", "--k", "--drop-outliers", "--outlier-ratio",
+                             "--columns"}) {
+      ignored(name, "it prepares scans, and the inputs are splat models");
+    }
+  }
+  if (!t.eye.empty() || !t.target.empty()) {
+    ignored("--view", "--eye/--target place the camera");
+    ignored("--distance", "--eye/--target place the camera");
+  }
+  return w;
+}
+
+}  // namespace
+
+Command add_render_command(CLI::App& app) {
+  auto o = std::make_shared<RenderOptions>();
+  auto t = std::make_shared<RenderText>();
+  auto* cmd = app.add_subcommand(
+      "render", "Render models (.ptl, .qs, or scans built in memory) or a scene file to PNG");
+  cmd->add_option("inputs", o->inputs,
+                  "Models or scans (several are drawn together), or one scene file (.json)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("-o,--output", o->output, "Output PNG")->required()->group(kGroupOutput);
+  cmd->add_option("--depth", o->depth_output, "Also write a 16-bit depth PNG")
+      ->group(kGroupOutput);
+  cmd->add_option("--stats", o->stats_output, "Write statistics as JSON (- = stdout)")
+      ->group(kGroupOutput);
+  add_camera(cmd, *o, *t);
+  add_look(cmd, *o, *t);
+  add_detail(cmd, *o, *t);
+  add_sequences_and_paging(cmd, *o, *t);
+  add_prepare_options(cmd, o->prepare, /*with_radius_scale=*/false);
+  add_columns(cmd, o->columns);
+  add_threads(cmd, o->threads);
+  cmd->add_flag("-q,--quiet", o->quiet, "No progress bars and no summary");
+  return {cmd, [o, t, cmd] {
+            o->warnings = ignored_options(*cmd, *o, *t);
+            o->frame.spt_chunk_culling = !t->no_chunk_culling;
+            parse_size_and_view(t->size, t->view, o->view);
+            if (!t->eye.empty()) o->view.eye = parse_vec3(t->eye, "--eye");
+            if (!t->target.empty()) o->view.target = parse_vec3(t->target, "--target");
+            if (!t->up.empty()) o->view.up = parse_vec3(t->up, "--up");
+            o->settings.background = parse_rgb8(t->background, "--background");
+            if (!t->path.empty()) o->orbit_frames = parse_orbit_path(t->path);
+            if (!t->memory.empty()) o->memory_cap = parse_bytes(t->memory, "--memory");
+            if (!t->read_per_frame.empty()) {
+              o->read_per_frame = parse_bytes(t->read_per_frame, "--read-per-frame");
+            }
+            return run_render(*o);
+          }};
+}
+
+}  // namespace pointillist::cli
