@@ -77,9 +77,11 @@ struct RenderOptions {
 };
 int run_render(const RenderOptions& options);
 
-// The camera of `view` for a model or scene: the orbit around `view_sphere`, or the explicit
-// eye/target/up. Throws OptionError when only one of --eye/--target is given.
-Camera make_camera(const ViewOptions& view, const Sphere& view_sphere);
+// The camera of `view` for a model or scene: the orbit around `view_sphere` keeping `model_up`
+// up (unless --up says otherwise), or the explicit eye/target/up. Throws OptionError when only
+// one of --eye/--target is given.
+Camera make_camera(const ViewOptions& view, const Sphere& view_sphere,
+                   Vec3f model_up = {0, 1, 0});
 
 struct InfoOptions {
   std::string input;

@@ -86,8 +86,20 @@ int run_info(const InfoOptions& o) {
                 in.has_radii ? ", radius" : "", in.is_mesh ? ", faces" : "",
                 in.has_normals ? "" : "normal, ", in.has_radii ? "-" : "radius");
   }
-  std::printf("bounds:      min (%g, %g, %g)  max (%g, %g, %g)\n", t.bounds.lo.x, t.bounds.lo.y,
-              t.bounds.lo.z, t.bounds.hi.x, t.bounds.hi.y, t.bounds.hi.z);
+  const std::array<double, 3>& org = t.origin;
+  if (org != std::array<double, 3>{}) {
+    // Georeferenced: the box in the scan's own (world) coordinates, and the local frame.
+    std::printf("bounds:      min (%.3f, %.3f, %.3f)  max (%.3f, %.3f, %.3f) (world)\n",
+                org[0] + t.bounds.lo.x, org[1] + t.bounds.lo.y, org[2] + t.bounds.lo.z,
+                org[0] + t.bounds.hi.x, org[1] + t.bounds.hi.y, org[2] + t.bounds.hi.z);
+    std::printf("origin:      (%.3f, %.3f, %.3f); positions are stored relative to it\n", org[0],
+                org[1], org[2]);
+  } else {
+    std::printf("bounds:      min (%g, %g, %g)  max (%g, %g, %g)\n", t.bounds.lo.x,
+                t.bounds.lo.y, t.bounds.lo.z, t.bounds.hi.x, t.bounds.hi.y, t.bounds.hi.z);
+  }
+  std::printf("up axis:     (%g, %g, %g)%s\n", t.up.x, t.up.y, t.up.z,
+              t.up == Vec3f{0, 0, 1} ? " (Z up, as LAS scans)" : "");
   if (v2) {
     const Sphere& root = v2->root_sphere();
     std::printf("sphere:      centre (%g, %g, %g), radius %g (root of the hierarchy)\n",
@@ -109,7 +121,7 @@ int run_info(const InfoOptions& o) {
     std::printf("  list:      %zu entries (%.3f per point), top list %u, %zu chunks\n",
                 spt.node_count(), leaves > 0 ? double(spt.node_count()) / leaves : 0.0, spt.top_end,
                 spt.chunks.size());
-    const Camera camera = make_camera(o.view, t.view_sphere);
+    const Camera camera = make_camera(o.view, t.view_sphere, t.up);
     SplatStream stream;
     SptSelectionStats s;
     select_splats_spt(spt, make_camera_frame(camera), RenderSettings{}, {.epsilon_px = o.epsilon_px},

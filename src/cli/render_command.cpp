@@ -18,7 +18,7 @@
 
 namespace pointillist::cli {
 
-Camera make_camera(const ViewOptions& v, const Sphere& view_sphere) {
+Camera make_camera(const ViewOptions& v, const Sphere& view_sphere, Vec3f model_up) {
   const bool explicit_eye = v.eye || v.target;
   if (explicit_eye) {
     if (!v.eye || !v.target) {
@@ -39,7 +39,7 @@ Camera make_camera(const ViewOptions& v, const Sphere& view_sphere) {
                                     .fov_deg = v.fov_deg,
                                     .width = v.width,
                                     .height = v.height,
-                                    .up = v.up.value_or(Vec3f{0, 1, 0})});
+                                    .up = v.up.value_or(model_up)});
 }
 
 void write_text(const std::string& where, const std::string& json) {
@@ -182,6 +182,7 @@ int run_render(const RenderOptions& o) {
                           ? read_scene(o.inputs[0], open, pool, progress)
                           : scene_of_models(o.inputs, open, pool, progress);
   const Sphere view_sphere = scene.view_sphere();
+  const Vec3f up = scene.up();
   Renderer renderer({.page_all = paging_asked, .memory_cap = o.memory_cap});
   Frame frame;
   const bool sequence = o.orbit_frames > 0 || o.refine_frames > 0 || o.frame_ms > 0 ||
@@ -193,7 +194,7 @@ int run_render(const RenderOptions& o) {
         renderer, scene.instances(),
         [&](float azimuth) {
           view.azimuth_deg = azimuth;
-          return make_camera(view, view_sphere);
+          return make_camera(view, view_sphere, up);
         },
         o.view.azimuth_deg, o.settings, o.frame, sequence_options(o), pool, frame,
         [&](const Frame& f, std::size_t index) {
@@ -202,7 +203,7 @@ int run_render(const RenderOptions& o) {
           }
         });
   } else {
-    render_settled(renderer, scene.instances(), make_camera(o.view, view_sphere), o.settings,
+    render_settled(renderer, scene.instances(), make_camera(o.view, view_sphere, up), o.settings,
                    o.frame, pool, frame);
   }
   write_png_rgb8(o.output, frame.width, frame.height, frame.color);

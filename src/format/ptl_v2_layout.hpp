@@ -17,6 +17,8 @@ constexpr std::uint32_t kHeaderSize = 256;
 constexpr std::uint32_t kEndianMarker = 0x01020304;  // stored little-endian: 04 03 02 01
 constexpr std::uint32_t kFlagHasColors = 1u << 0;
 constexpr std::uint32_t kKnownFlags = kFlagHasColors;
+// compat_flags bit 0: the header holds the model's coordinate frame (origin, up axis).
+constexpr std::uint32_t kCompatFrame = 1u << 0;
 constexpr std::uint32_t kPageEntrySize = 32;
 constexpr std::uint32_t kRootEntrySize = 17;  // f32 centre x, y, z, radius; u8 child count
 constexpr std::uint32_t kMinPageBytes = 1024;
@@ -44,7 +46,9 @@ constexpr std::uint32_t kViewRadius = 132;
 constexpr std::uint32_t kPageBytes = 136;
 constexpr std::uint32_t kAttributeCount = 140;
 constexpr std::uint32_t kAttributes = 144;  // kMaxAttributes entries of 8 bytes
-constexpr std::uint32_t kReserved = 192;    // up to 256: zeros
+constexpr std::uint32_t kOrigin = 192;      // f64[3], with kCompatFrame (else zeros)
+constexpr std::uint32_t kUp = 216;          // f32[3], with kCompatFrame (else zeros)
+constexpr std::uint32_t kReserved = 228;    // up to 256: zeros
 }  // namespace offset
 
 // Attribute table entry: u16 attribute, u16 encoding, u8 first bit, u8 bit count, u16 zero.
@@ -98,6 +102,7 @@ inline void store_u64(std::uint8_t* p, std::uint64_t v) {
   for (int i = 0; i < 8; ++i) p[i] = static_cast<std::uint8_t>(v >> (8 * i));
 }
 inline void store_f32(std::uint8_t* p, float v) { store_u32(p, std::bit_cast<std::uint32_t>(v)); }
+inline void store_f64(std::uint8_t* p, double v) { store_u64(p, std::bit_cast<std::uint64_t>(v)); }
 inline void store_vec(std::uint8_t* p, Vec3f v) {
   store_f32(p, v.x);
   store_f32(p + 4, v.y);
@@ -117,6 +122,7 @@ inline std::uint64_t load_u64(const std::uint8_t* p) {
   return v;
 }
 inline float load_f32(const std::uint8_t* p) { return std::bit_cast<float>(load_u32(p)); }
+inline double load_f64(const std::uint8_t* p) { return std::bit_cast<double>(load_u64(p)); }
 inline Vec3f load_vec(const std::uint8_t* p) {
   return {load_f32(p), load_f32(p + 4), load_f32(p + 8)};
 }

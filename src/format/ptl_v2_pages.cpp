@@ -32,6 +32,8 @@ class PtlV2Pages final : public PageSource {
     summary_.depth = file.depth();
     summary_.bounds = file.bounds();
     summary_.view_sphere = file.view_sphere();
+    summary_.origin = file.origin();
+    summary_.up = file.up();
   }
 
   std::uint32_t page_count() const override { return file_.page_count(); }

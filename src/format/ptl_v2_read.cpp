@@ -133,6 +133,18 @@ std::unique_ptr<PtlV2File> PtlV2File::open(const std::string& path) {
   file->root_sphere_ = {load_vec(b + offset::kRootSphere), load_f32(b + offset::kRootSphere + 12)};
   file->bounds_ = {load_vec(b + offset::kBoundsLo), load_vec(b + offset::kBoundsHi)};
   file->view_sphere_ = {load_vec(b + offset::kViewCenter), load_f32(b + offset::kViewRadius)};
+  if (load_u32(b + offset::kCompatFlags) & kCompatFrame) {
+    for (int a = 0; a < 3; ++a) file->origin_[a] = load_f64(b + offset::kOrigin + 8 * a);
+    const Vec3f up = load_vec(b + offset::kUp);
+    if (!std::isfinite(file->origin_[0]) || !std::isfinite(file->origin_[1]) ||
+        !std::isfinite(file->origin_[2])) {
+      fail_at(path, offset::kOrigin, "origin is not finite");
+    }
+    if (!is_finite(up) || !(dot(up, up) > 0.5f && dot(up, up) < 2.0f)) {
+      fail_at(path, offset::kUp, "up axis is not a unit vector");
+    }
+    file->up_ = normalized(up);
+  }
   if (!finite_sphere(file->root_sphere_)) {
     fail_at(path, offset::kRootSphere, "root sphere is not finite or has a negative radius");
   }
@@ -502,6 +514,8 @@ SphereTree PtlV2File::decode_all() const {
   tree.depth = depth;
   tree.bounds = bounds_;
   tree.view_sphere = view_sphere_;
+  tree.origin = origin_;
+  tree.up = up_;
   return tree;
 }
 

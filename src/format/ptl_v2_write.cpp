@@ -359,7 +359,13 @@ PtlV2WriteReport write_ptl_v2(const std::string& path, const SphereTree& tree,
   store_u32(h + offset::kHeaderSize, kHeaderSize);
   store_u32(h + offset::kEndian, kEndianMarker);
   store_u32(h + offset::kFlags, colors ? kFlagHasColors : 0);
-  store_u32(h + offset::kCompatFlags, 0);
+  // The frame only when it is not the default, so such files keep their old bytes.
+  const bool frame = tree.origin != std::array<double, 3>{} || !(tree.up == Vec3f{0, 1, 0});
+  store_u32(h + offset::kCompatFlags, frame ? kCompatFrame : 0);
+  if (frame) {
+    for (int a = 0; a < 3; ++a) store_f64(h + offset::kOrigin + 8 * a, tree.origin[a]);
+    store_vec(h + offset::kUp, tree.up);
+  }
   store_u32(h + offset::kRecordSize, record_size);
   store_u64(h + offset::kNodeCount, n);
   store_u64(h + offset::kLeafCount, leaves);

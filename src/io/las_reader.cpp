@@ -274,8 +274,8 @@ PointSet read_las(const std::string& path, Progress& progress, const LasReadOpti
                             std::to_string(h.record_length) + "-byte records");
   if (!h.system.empty()) points.comments.push_back("system identifier: " + h.system);
   if (!h.software.empty()) points.comments.push_back("generating software: " + h.software);
-  if (origin[0] != 0 || origin[1] != 0 || origin[2] != 0)
-    points.comments.push_back(origin_comment(origin));
+  points.origin = origin;
+  points.up = {0, 0, 1};  // LAS coordinates are projected: x east, y north, z up
   read_progress.finish();
   return points;
 }

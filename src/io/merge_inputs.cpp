@@ -82,6 +82,7 @@ PointSet merge_inputs(std::span<const std::string> paths, ThreadPool& pool, Prog
     if (i == 0) {
       all = std::move(part);
       all_origin = origin;
+      all.origin = origin;
     } else {
       append_points(all, std::move(part), all_origin, origin);
     }

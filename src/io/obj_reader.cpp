@@ -263,7 +263,7 @@ PointSet ObjParser::finish() {
                               " of " + std::to_string(n) + " vertices have them");
   }
   if (origin_[0] != 0 || origin_[1] != 0 || origin_[2] != 0)
-    points.comments.push_back(origin_comment(origin_));
+    points.origin = origin_;
   return points;
 }
 

@@ -6,6 +6,7 @@
 #include "pointillist/core/atomic_file.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/io/ply.hpp"
+#include "text_numbers.hpp"
 
 namespace pointillist {
 namespace {
@@ -39,6 +40,15 @@ std::string make_header(const PointSet& points, const PlyWriteOptions& options, 
     for (char& c : line)
       if (c == '\n' || c == '\r') c = ' ';
     h += "comment " + line + "\n";
+  }
+  using io_detail::format_double;
+  if (points.origin != std::array<double, 3>{}) {
+    h += "comment origin: " + format_double(points.origin[0]) + " " +
+         format_double(points.origin[1]) + " " + format_double(points.origin[2]) + "\n";
+  }
+  if (!(points.up == Vec3f{0, 1, 0})) {
+    h += "comment up: " + format_double(points.up.x) + " " + format_double(points.up.y) + " " +
+         format_double(points.up.z) + "\n";
   }
   h += "element vertex " + std::to_string(points.size()) + "\n";
   h += "property float x\nproperty float y\nproperty float z\n";

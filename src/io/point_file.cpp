@@ -81,6 +81,7 @@ PointSet read_point_file(const std::string& path, Progress& progress,
 }
 
 std::optional<std::array<double, 3>> point_set_origin(const PointSet& points) {
+  if (points.origin != std::array<double, 3>{}) return points.origin;
   constexpr std::string_view kPrefix = "origin: ";
   for (const std::string& comment : points.comments) {
     if (!comment.starts_with(kPrefix)) continue;

@@ -589,8 +589,7 @@ PointSet read_xyz(const std::string& path, Progress& progress, const XyzReadOpti
   }
   points.comments.push_back("columns: " + columns_text(layout, pre.first_count) + " (from " +
                             pre.layout_source + ")");
-  if (origin[0] != 0 || origin[1] != 0 || origin[2] != 0)
-    points.comments.push_back(origin_comment(origin));
+  points.origin = origin;
   read_progress.finish();
   return points;
 }

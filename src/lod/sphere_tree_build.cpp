@@ -188,6 +188,8 @@ SphereTree build_sphere_tree(const PointSet& points, ThreadPool& pool, Progress&
   SphereTree tree;
   tree.has_colors = points.has_colors();
   tree.leaf_count = n;
+  tree.origin = points.origin;
+  tree.up = points.up;
   tree.bounds =
       lod_detail::check_points_and_bound(points, pool, "cannot build a splat hierarchy");
   tree.view_sphere = {tree.bounds.center(),

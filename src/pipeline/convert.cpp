@@ -84,7 +84,14 @@ ConvertResult convert(std::span<const std::string> inputs, const std::string& ou
     const SphereTree tree = build_sphere_tree(points, pool, progress);
     std::ostringstream meta;
     meta << "generator: pointillist " << "0.1.0" << "\n";
-    for (const auto& in : inputs) meta << "source: " << in << "\n";
+    // A survey of hundreds of tiles names the first few (the metadata stays readable in info).
+    constexpr std::size_t kListedSources = 5;
+    for (std::size_t i = 0; i < inputs.size() && i < kListedSources; ++i) {
+      meta << "source: " << inputs[i] << "\n";
+    }
+    if (inputs.size() > kListedSources) {
+      meta << "source: ... and " << inputs.size() - kListedSources << " more files\n";
+    }
     meta << "normals: " << normal_source_name(o.prepare.normals) << "\n"
          << "k: " << o.prepare.k << "\n"
          << "radius_scale: " << o.prepare.radius_scale << "\n";

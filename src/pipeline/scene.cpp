@@ -147,6 +147,14 @@ Sphere Scene::view_sphere() const {
   return s;
 }
 
+Vec3f Scene::up() const {
+  if (instances_.empty()) return {0, 1, 0};
+  const SceneInstance& first = instances_[0];
+  const Vec3f u = first.model->tree.up;
+  const InstanceTransform& t = first.transform;
+  return normalized(Vec3f{dot(t.rotation[0], u), dot(t.rotation[1], u), dot(t.rotation[2], u)});
+}
+
 Scene scene_of_models(std::span<const std::string> paths, const OpenModelOptions& options,
                       ThreadPool& pool, Progress& progress) {
   ModelCache cache(options, pool, progress);

@@ -213,6 +213,31 @@ TEST(InputsCli, GeoreferencedLasTilesLineUpWhenMerged) {
   EXPECT_NEAR(box[3] - box[0], 19.5, 1e-3) << info.output;
   EXPECT_NEAR(box[4] - box[1], 9.5, 1e-3) << info.output;
   EXPECT_NEAR(box[5] - box[2], 0.0, 1e-3) << info.output;
+  // The frame: world bounds (the first tile's absolute coordinates) and LAS's Z-up axis.
+  EXPECT_THAT(info.output, HasSubstr("(world)"));
+  EXPECT_THAT(info.output, HasSubstr("min (500000.000, 4000000.000, 100.000)"));
+  EXPECT_THAT(info.output, HasSubstr("up axis:     (0, 0, 1)"));
+  // Rendered upright by default: the same image as asking for Z up, not the Y-up one. (The
+  // flat survey faces one way: of the views from above and below, one shows it.)
+  const auto lit = [](const ImageRgb8& img) {
+    int n = 0;
+    for (const Rgb8& p : img.pixels) n += p.r + p.g + p.b > 0;
+    return n;
+  };
+  int shown = 0;
+  for (const char* view : {"30,40", "30,-40"}) {
+    const std::string base = "render " + ptl + " --size 96x64 -q --view " + view + " -o ";
+    ASSERT_EQ(run_cli(base + dir.file("default.png")).exit_code, 0);
+    ASSERT_EQ(run_cli(base + dir.file("z.png") + " --up 0,0,1").exit_code, 0);
+    ASSERT_EQ(run_cli(base + dir.file("y.png") + " --up 0,1,0").exit_code, 0);
+    const ImageRgb8 d = read_png_rgb8(dir.file("default.png"));
+    EXPECT_EQ(d.pixels, read_png_rgb8(dir.file("z.png")).pixels) << view;
+    if (lit(d) > 100) {
+      ++shown;
+      EXPECT_NE(d.pixels, read_png_rgb8(dir.file("y.png")).pixels) << view;
+    }
+  }
+  EXPECT_EQ(shown, 1);
 }
 
 TEST(InputsCli, CompressedLasIsRefusedWithAdviceAndNoOutput) {

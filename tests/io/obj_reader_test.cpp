@@ -192,8 +192,7 @@ TEST(ObjReader, IgnoresOtherStatements) {
 TEST(ObjReader, ShiftsLargeCoordinates) {
   TempDir dir;
   const PointSet p = read_text(dir, "v 700123.5 100 4000000.25\nv 700124 101 4000001\n");
-  ASSERT_EQ(p.comments.size(), 1u);
-  EXPECT_EQ(p.comments[0], "origin: 700000 0 4000000");
+  EXPECT_EQ(p.origin, (std::array<double, 3>{700000, 0, 4000000}));
   expect_vec(p.positions[0], {123.5f, 100, 0.25f}, 0);
   expect_vec(p.positions[1], {124, 101, 1}, 0);
 }

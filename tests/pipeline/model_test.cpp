@@ -62,9 +62,30 @@ TEST(MergeInputs, TilesWithTheirOwnOriginsLineUpInTheFirstOnesFrame) {
   EXPECT_NEAR(merged.positions[10].x - merged.positions[0].x, 1.0e6, 0.125);
   EXPECT_NEAR(merged.positions[11].x - merged.positions[10].x, 1.0, 0.125);
   EXPECT_FLOAT_EQ(merged.positions[13].y, merged.positions[3].y);
-  int origins = 0;
-  for (const auto& c : merged.comments) origins += c.rfind("origin: ", 0) == 0;
-  EXPECT_EQ(origins, 1);  // the first tile's
+  EXPECT_EQ(merged.origin, (std::array<double, 3>{6.0e6, 0, 0}));  // the first tile's
+}
+
+// The frame travels: a LAS-like scan's origin and up axis survive .ply export, the .ptl v2
+// header and opening the model; a model without them keeps the old header bytes.
+TEST(ModelFrame, OriginAndUpAxisSurviveExportConvertAndOpen) {
+  pointillist::testing::TempDir dir;
+  const SurfaceSamples s = sample_scene(sphere_scene(), 2000, 3);
+  PointSet p = s.points;
+  p.origin = {512000.5, 5403000.25, 120};
+  p.up = {0, 0, 1};
+  write_ply(dir.file("geo.ply"), p, {});
+  ThreadPool pool(2);
+  const std::vector<std::string> in = {dir.file("geo.ply")};
+  const PointSet back = merge_inputs(in, pool, Progress::none());
+  EXPECT_EQ(back.origin, p.origin);
+  EXPECT_EQ(back.up, p.up);
+  for (const auto& c : back.comments) EXPECT_EQ(c.rfind("origin", 0), std::string::npos) << c;
+  convert(in, dir.file("geo.ptl"), {}, pool, Progress::none());
+  for (Paging mode : {Paging::Never, Paging::Always}) {
+    const Model m = open_model(dir.file("geo.ptl"), paging(mode), pool, Progress::none());
+    EXPECT_EQ(m.tree().origin, p.origin);
+    EXPECT_EQ(m.tree().up, p.up);
+  }
 }
 
 TEST(MergeInputs, CommentsRepeatedByTheTilesAreKeptOnce) {

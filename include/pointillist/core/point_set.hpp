@@ -19,6 +19,12 @@ struct PointSet {
   std::vector<float> radii;                       // splat radius, world units
   std::vector<std::array<std::uint32_t, 3>> triangles;  // mesh faces (fan-triangulated), may be empty
   std::vector<std::string> comments;              // header comments of the source file, for metadata
+  // Where positions are relative to: absolute (georeferenced) = origin + position. Readers of
+  // files with large coordinates (LAS, text, OBJ) move them next to the origin so that float
+  // positions stay precise.
+  std::array<double, 3> origin{};
+  // The scan's up axis (unit): +Y by convention, +Z for LAS scans.
+  Vec3f up{0, 1, 0};
 
   std::size_t size() const { return positions.size(); }
   bool has_normals() const { return !normals.empty(); }

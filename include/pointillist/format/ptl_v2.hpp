@@ -148,6 +148,9 @@ class PtlV2File {
   const Sphere& root_sphere() const { return root_sphere_; }
   const Aabb& bounds() const { return bounds_; }
   const Sphere& view_sphere() const { return view_sphere_; }
+  // The model's coordinate frame: absolute position = origin + position, and its up axis.
+  const std::array<double, 3>& origin() const { return origin_; }
+  Vec3f up() const { return up_; }
   const std::string& metadata() const { return metadata_; }
   std::uint64_t file_size() const { return size_; }
   const std::string& path() const { return path_; }
@@ -179,6 +182,8 @@ class PtlV2File {
   Sphere root_sphere_;
   Aabb bounds_;
   Sphere view_sphere_;
+  std::array<double, 3> origin_{};
+  Vec3f up_{0, 1, 0};
   std::string metadata_;
   std::vector<PtlV2PageInfo> pages_;
 };

@@ -6,6 +6,7 @@
 // after it, so the coarse levels are a prefix of the array. Leaves are single input splats.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -40,6 +41,8 @@ struct SphereTreeView {
   std::uint32_t depth = 0;  // levels below the root (a single leaf has depth 0)
   Aabb bounds;              // box around all sample positions (not radii)
   Sphere view_sphere;       // centre of `bounds`, largest distance to a sample (orbit camera)
+  std::array<double, 3> origin{};  // absolute position = origin + position (PointSet::origin)
+  Vec3f up{0, 1, 0};               // the model's up axis (PointSet::up)
 };
 
 // Owning hierarchy as built in memory.
@@ -50,9 +53,11 @@ struct SphereTree {
   std::uint32_t depth = 0;
   Aabb bounds;
   Sphere view_sphere;
+  std::array<double, 3> origin{};
+  Vec3f up{0, 1, 0};
 
   SphereTreeView view() const {
-    return {nodes, has_colors, leaf_count, depth, bounds, view_sphere};
+    return {nodes, has_colors, leaf_count, depth, bounds, view_sphere, origin, up};
   }
 };
 

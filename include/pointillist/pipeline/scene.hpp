@@ -37,6 +37,9 @@ class Scene {
   // otherwise centred on the box around every instance's (transformed) bounds, with the radius
   // reaching every instance's transformed view sphere.
   Sphere view_sphere() const;
+  // The up axis an orbit camera keeps: the first instance's model's (+Z for LAS scans, else
+  // +Y), turned by that instance's rotation.
+  Vec3f up() const;
 
  private:
   std::vector<std::shared_ptr<const Model>> models_;
