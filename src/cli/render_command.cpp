@@ -152,15 +152,6 @@ std::string extra_json(const RenderOptions& o, const Renderer& renderer) {
   return buf;
 }
 
-std::vector<FrameRecord> to_records(const std::vector<SequenceFrame>& frames) {
-  std::vector<FrameRecord> records;
-  for (const SequenceFrame& f : frames) {
-    records.push_back({f.phase, f.azimuth_deg, f.detail, f.stats, f.bytes_read,
-                       f.resident_bytes});
-  }
-  return records;
-}
-
 }  // namespace
 
 int run_render(const RenderOptions& o) {
@@ -214,7 +205,7 @@ int run_render(const RenderOptions& o) {
   const float finest = std::min(1.0f, initial_detail(o.settings, o.frame));
   if (!o.stats_output.empty()) {
     const std::string extra = extra_json(o, renderer);
-    write_text(o.stats_output, sequence ? sequence_to_json(to_records(frames), o.frame_ms,
+    write_text(o.stats_output, sequence ? sequence_to_json(frames, o.frame_ms,
                                                            kSettleFrames, finest, extra)
                                         : stats_to_json(frame.stats, extra));
   }

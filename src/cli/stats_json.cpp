@@ -26,21 +26,7 @@ std::string stats_to_json(const RenderStats& s, const std::string& extra) {
   return buf;
 }
 
-double hit_rate(const std::vector<FrameRecord>& frames, double target_ms, std::size_t settle,
-                float finest) {
-  std::size_t hits = 0, counted = 0, path_index = 0;
-  for (std::size_t i = 0; i < frames.size(); ++i) {
-    // Only the frames along the path are held to the target (refinement adds detail on purpose).
-    if (std::string(frames[i].phase) != "path" || path_index++ < settle) continue;
-    const double ms = frames[i].stats.ms_total;
-    ++counted;
-    hits += (ms >= 0.8 * target_ms && ms <= 1.2 * target_ms) ||
-            (frames[i].threshold_px <= finest && ms < target_ms);
-  }
-  return counted ? double(hits) / double(counted) : 1.0;
-}
-
-std::string sequence_to_json(const std::vector<FrameRecord>& frames, double target_ms,
+std::string sequence_to_json(std::span<const SequenceFrame> frames, double target_ms,
                              std::size_t settle, float finest, const std::string& extra) {
   std::string json =
       frames.empty() ? std::string("{\n}\n") : stats_to_json(frames.back().stats, extra);
@@ -54,11 +40,11 @@ std::string sequence_to_json(const std::vector<FrameRecord>& frames, double targ
   }
   json += ",\n  \"frames\": [";
   for (std::size_t i = 0; i < frames.size(); ++i) {
-    const FrameRecord& f = frames[i];
+    const SequenceFrame& f = frames[i];
     std::snprintf(buf, sizeof buf,
                   "%s\n    {\"phase\": \"%s\", \"azimuth\": %.3f, \"threshold\": %.4f, "
                   "\"splats\": %llu, \"ms\": %.3f, \"ms_select\": %.3f, \"ms_raster\": %.3f}",
-                  i ? "," : "", f.phase, f.azimuth_deg, f.threshold_px,
+                  i ? "," : "", f.phase, f.azimuth_deg, f.detail,
                   static_cast<unsigned long long>(f.stats.splats), f.stats.ms_total,
                   f.stats.ms_select, f.stats.ms_raster);
     json += buf;

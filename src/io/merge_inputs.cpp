@@ -46,9 +46,7 @@ void append_points(PointSet& a, PointSet&& b, const std::array<double, 3>& a_ori
                                   : p);
   }
   for (auto t : b.triangles) a.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
-  for (auto& c : b.comments) {
-    if (c.rfind("origin: ", 0) != 0) a.comments.push_back(std::move(c));
-  }
+  for (auto& c : b.comments) a.comments.push_back(std::move(c));
 }
 
 // Keeps the first of equal comments (tiles of one survey repeat their header comments).

@@ -2,10 +2,8 @@
 // which property feeds which PointSet array, and hands the body to the ascii or binary decoder.
 #include <sys/mman.h>
 
-#include <array>
-#include <charconv>
-
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <limits>
@@ -14,6 +12,7 @@
 #include "decimal_scan.hpp"
 #include "pointillist/core/file_bytes.hpp"
 #include "ply_body.hpp"
+#include "text_numbers.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/core/thread_pool.hpp"
 #include "pointillist/io/ply.hpp"
@@ -22,21 +21,6 @@ namespace pointillist {
 namespace ply {
 
 namespace {
-
-// Three numbers after `skip` characters of `text` (blank-separated, finite); false otherwise.
-bool read_triple(const std::string& text, std::size_t skip, std::array<double, 3>& out) {
-  const char* p = text.data() + skip;
-  const char* end = text.data() + text.size();
-  std::array<double, 3> v{};
-  for (double& x : v) {
-    while (p < end && *p == ' ') ++p;
-    const auto r = std::from_chars(p, end, x);
-    if (r.ec != std::errc() || !std::isfinite(x)) return false;
-    p = r.ptr;
-  }
-  out = v;
-  return true;
-}
 
 
 [[noreturn]] void fail_line(const std::string& path, std::size_t line, const std::string& what) {
@@ -246,9 +230,9 @@ class PlyRead {
     if (points.has_normals()) io_detail::finish_normals(points.normals);
     // Our own writer keeps the coordinate frame in two comments ("origin: X Y Z", "up: X Y Z").
     for (const std::string& c : header.comments) {
-      if (c.starts_with("origin: ") && read_triple(c, 8, points.origin)) continue;
+      if (c.starts_with("origin: ") && io_detail::read_triple(c, 8, points.origin)) continue;
       std::array<double, 3> up{};
-      if (c.starts_with("up: ") && read_triple(c, 4, up) &&
+      if (c.starts_with("up: ") && io_detail::read_triple(c, 4, up) &&
           (up[0] != 0 || up[1] != 0 || up[2] != 0)) {
         points.up = normalized(Vec3f{float(up[0]), float(up[1]), float(up[2])});
         continue;

@@ -11,6 +11,7 @@
 #include "pointillist/io/obj.hpp"
 #include "pointillist/io/ply.hpp"
 #include "pointillist/io/xyz.hpp"
+#include "text_numbers.hpp"
 
 namespace pointillist {
 namespace {
@@ -84,18 +85,11 @@ std::optional<std::array<double, 3>> point_set_origin(const PointSet& points) {
   if (points.origin != std::array<double, 3>{}) return points.origin;
   constexpr std::string_view kPrefix = "origin: ";
   for (const std::string& comment : points.comments) {
-    if (!comment.starts_with(kPrefix)) continue;
     std::array<double, 3> origin{};
-    const char* p = comment.data() + kPrefix.size();
-    const char* end = comment.data() + comment.size();
-    bool ok = true;
-    for (double& v : origin) {
-      while (p < end && *p == ' ') ++p;
-      const auto r = std::from_chars(p, end, v);
-      ok = ok && r.ec == std::errc();
-      p = r.ptr;
+    if (comment.starts_with(kPrefix) &&
+        io_detail::read_triple(comment, kPrefix.size(), origin)) {
+      return origin;
     }
-    if (ok) return origin;
   }
   return std::nullopt;
 }

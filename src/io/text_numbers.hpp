@@ -161,6 +161,21 @@ inline std::array<double, 3> text_origin(const double first[3]) {
   return origin;
 }
 
+// Three numbers after `skip` characters of `text` (blank-separated, finite); false otherwise.
+inline bool read_triple(const std::string& text, std::size_t skip, std::array<double, 3>& out) {
+  const char* p = text.data() + skip;
+  const char* end = text.data() + text.size();
+  std::array<double, 3> v{};
+  for (double& x : v) {
+    while (p < end && *p == ' ') ++p;
+    const auto r = std::from_chars(p, end, x);
+    if (r.ec != std::errc() || !std::isfinite(x)) return false;
+    p = r.ptr;
+  }
+  out = v;
+  return true;
+}
+
 // Normals --------------------------------------------------------------------------------------
 
 

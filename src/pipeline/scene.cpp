@@ -18,11 +18,6 @@ using nlohmann::json;
 namespace {
 
 
-Vec3f apply(const InstanceTransform& t, Vec3f p) {
-  return t.translate + Vec3f{dot(t.rotation[0], p), dot(t.rotation[1], p),
-                             dot(t.rotation[2], p)} * t.scale;
-}
-
 // Rows of a 3×3 product a·b.
 void multiply(const double a[3][3], const double b[3][3], double out[3][3]) {
   for (int i = 0; i < 3; ++i) {
@@ -133,15 +128,16 @@ Sphere Scene::view_sphere() const {
     const Aabb& b = inst.model->tree.bounds;
     if (b.empty()) continue;
     for (int corner = 0; corner < 8; ++corner) {
-      box.extend(apply(inst.transform, {corner & 1 ? b.hi.x : b.lo.x, corner & 2 ? b.hi.y : b.lo.y,
-                                        corner & 4 ? b.hi.z : b.lo.z}));
+      box.extend(inst.transform.apply({corner & 1 ? b.hi.x : b.lo.x,
+                                       corner & 2 ? b.hi.y : b.lo.y,
+                                       corner & 4 ? b.hi.z : b.lo.z}));
     }
   }
   if (box.empty()) return {};
   Sphere s{box.center(), 0.0f};
   for (const SceneInstance& inst : instances_) {
     const Sphere& v = inst.model->tree.view_sphere;
-    s.radius = std::max(s.radius, distance(s.center, apply(inst.transform, v.center)) +
+    s.radius = std::max(s.radius, distance(s.center, inst.transform.apply(v.center)) +
                                       inst.transform.scale * v.radius);
   }
   return s;
@@ -150,9 +146,7 @@ Sphere Scene::view_sphere() const {
 Vec3f Scene::up() const {
   if (instances_.empty()) return {0, 1, 0};
   const SceneInstance& first = instances_[0];
-  const Vec3f u = first.model->tree.up;
-  const InstanceTransform& t = first.transform;
-  return normalized(Vec3f{dot(t.rotation[0], u), dot(t.rotation[1], u), dot(t.rotation[2], u)});
+  return normalized(first.transform.rotate(first.model->tree.up));
 }
 
 Scene scene_of_models(std::span<const std::string> paths, const OpenModelOptions& options,

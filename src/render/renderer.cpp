@@ -23,22 +23,14 @@ namespace {
 constexpr std::uint64_t kInMemoryPageBytes = 64 * 1024;
 constexpr std::uint32_t kInMemoryPageLevels = 4;
 
-Vec3f rotate(const InstanceTransform& t, Vec3f v) {
-  return {dot(t.rotation[0], v), dot(t.rotation[1], v), dot(t.rotation[2], v)};
-}
-// Rᵀ·v: the inverse rotation.
-Vec3f rotate_back(const InstanceTransform& t, Vec3f v) {
-  return t.rotation[0] * v.x + t.rotation[1] * v.y + t.rotation[2] * v.z;
-}
-
 // The camera as the model sees it: the same image of the model at p as the world camera gives
 // of translate + scale·R·p. Sizes on screen are unchanged (radius and distance scale alike).
 Camera model_camera(const Camera& world, const InstanceTransform& t) {
   Camera c = world;
   const float inv_scale = 1.0f / t.scale;
-  c.eye = rotate_back(t, world.eye - t.translate) * inv_scale;
-  c.target = rotate_back(t, world.target - t.translate) * inv_scale;
-  c.up = rotate_back(t, world.up);
+  c.eye = t.rotate_back(world.eye - t.translate) * inv_scale;
+  c.target = t.rotate_back(world.target - t.translate) * inv_scale;
+  c.up = t.rotate_back(world.up);
   return c;
 }
 
@@ -46,9 +38,9 @@ Camera model_camera(const Camera& world, const InstanceTransform& t) {
 void to_world(const InstanceTransform& t, SplatChunk& chunk, bool with_discs) {
   for (std::size_t i = 0; i < chunk.count; ++i) {
     chunk.depth[i] *= t.scale;
-    chunk.normal[i] = rotate(t, chunk.normal[i]);
+    chunk.normal[i] = t.rotate(chunk.normal[i]);
     if (with_discs) {
-      chunk.center[i] = t.translate + rotate(t, chunk.center[i]) * t.scale;
+      chunk.center[i] = t.apply(chunk.center[i]);
       chunk.radius[i] *= t.scale;
     }
   }
@@ -79,6 +71,7 @@ struct Renderer::ModelState {
   std::optional<PagedRenderer> paged;
   std::optional<SequentialPointTree> spt;
   std::uint64_t frame = 0;  // the last frame that drew the model
+  std::uint64_t model_bytes = 0;  // storage bytes of a paged model (open + every page)
 };
 
 Renderer::Renderer(const RendererOptions& options) : options_(options) {}
@@ -86,13 +79,10 @@ Renderer::~Renderer() = default;
 
 Renderer::ModelState& Renderer::state_for(const RenderModel& model, ThreadPool& pool,
                                           const FrameSettings& fs) {
-  ModelState* state = nullptr;
-  for (auto& s : states_) {
-    if (s->model == &model) state = s.get();
-  }
-  if (!state) {
-    states_.push_back(std::make_unique<ModelState>());
-    state = states_.back().get();
+  std::unique_ptr<ModelState>& slot = states_[&model];
+  if (!slot) {
+    slot = std::make_unique<ModelState>();
+    ModelState* state = slot.get();
     state->model = &model;
     if (model.pages || options_.page_all) {
       state->pages = model.pages;
@@ -104,8 +94,13 @@ Renderer::ModelState& Renderer::state_for(const RenderModel& model, ThreadPool& 
       }
       state->paged.emplace(*state->pages,
                            options_.memory_cap > 0 ? options_.memory_cap : UINT64_MAX, pool);
+      state->model_bytes = state->pages->open_bytes();
+      for (std::uint32_t i = 0; i < state->pages->page_count(); ++i) {
+        state->model_bytes += state->pages->page_storage_bytes(i);
+      }
     }
   }
+  ModelState* state = slot.get();
   if (fs.lod == LodScheme::Spt && !state->spt) {
     state->spt = build_sequential_point_tree(sphere_tree_leaves(model.tree), pool);
   }
@@ -188,16 +183,8 @@ void Renderer::render(std::span<const SceneInstance> scene, const Camera& camera
       select_splats_spt(*state.spt, cam, settings,
                         {.epsilon_px = fs.epsilon_px, .chunk_culling = fs.spt_chunk_culling},
                         pool, into, spt);
-      selected = {.splats = spt.splats, .nodes_visited = spt.entries_scanned,
-                  .culled_frustum = spt.chunks_culled + spt.culled_frustum,
-                  .culled_backface = spt.culled_backface};
-      spt_stats_.splats += spt.splats;
-      spt_stats_.entries_scanned += spt.entries_scanned;
-      spt_stats_.entries_total += spt.entries_total;
-      spt_stats_.chunks_total += spt.chunks_total;
-      spt_stats_.chunks_culled += spt.chunks_culled;
-      spt_stats_.culled_backface += spt.culled_backface;
-      spt_stats_.culled_frustum += spt.culled_frustum;
+      selected = spt.as_selection();
+      spt_stats_ += spt;
     } else if (state.paged) {
       selected = state.paged->select(cam, settings, pool, into, !first_use);
     } else {
@@ -299,10 +286,7 @@ PagingStats Renderer::paging_stats() const {
     if (!s->paged) continue;
     p.paged = true;
     p.pages += s->pages->page_count();
-    p.model_bytes += s->pages->open_bytes();
-    for (std::uint32_t i = 0; i < s->pages->page_count(); ++i) {
-      p.model_bytes += s->pages->page_storage_bytes(i);
-    }
+    p.model_bytes += s->model_bytes;
     const PageCacheStats& c = s->paged->stats();
     p.cache.pages_requested += c.pages_requested;
     p.cache.bytes_read += c.bytes_read;

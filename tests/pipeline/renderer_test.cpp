@@ -83,7 +83,7 @@ TEST(Renderer, TransformedInstanceMatchesTheModelMovedInItsPoints) {
   PointSet moved = s.points;
   for (Vec3f& p : moved.positions) {
     p = t.translate + Vec3f{dot(t.rotation[0], p), dot(t.rotation[1], p),
-                            dot(t.rotation[2], p)} * t.scale;
+                            dot(t.rotation[2], p)} * t.scale;  // independent of apply()
   }
   write_ply(dir.file("moved.ply"), moved, {});
   ThreadPool pool(2);

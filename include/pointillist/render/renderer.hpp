@@ -8,6 +8,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "pointillist/core/camera.hpp"
@@ -51,6 +52,14 @@ struct InstanceTransform {
   Vec3f rotation[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};  // rows of the rotation matrix
   float scale = 1.0f;
   bool is_identity() const;
+  Vec3f rotate(Vec3f v) const {
+    return {dot(rotation[0], v), dot(rotation[1], v), dot(rotation[2], v)};
+  }
+  // Rᵀ·v: the inverse rotation.
+  Vec3f rotate_back(Vec3f v) const {
+    return rotation[0] * v.x + rotation[1] * v.y + rotation[2] * v.z;
+  }
+  Vec3f apply(Vec3f p) const { return translate + rotate(p) * scale; }
 };
 
 struct SceneInstance {
@@ -130,7 +139,7 @@ class Renderer {
   ModelState& state_for(const RenderModel& model, ThreadPool& pool, const FrameSettings& fs);
 
   RendererOptions options_;
-  std::vector<std::unique_ptr<ModelState>> states_;
+  std::unordered_map<const RenderModel*, std::unique_ptr<ModelState>> states_;
   std::vector<ModelState*> last_frame_;  // the models of the last frame, in instance order
   SplatStream scratch_stream_;
   QualityScratch quality_scratch_;

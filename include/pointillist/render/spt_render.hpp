@@ -9,6 +9,7 @@
 #include "pointillist/core/thread_pool.hpp"
 #include "pointillist/lod/sequential_point_tree.hpp"
 #include "pointillist/render/render.hpp"
+#include "pointillist/render/selection.hpp"
 #include "pointillist/render/settings.hpp"
 #include "pointillist/render/splat_stream.hpp"
 
@@ -22,6 +23,23 @@ struct SptSelectionStats {
   std::uint64_t chunks_total = 0;
   std::uint64_t culled_backface = 0;  // selected entries dropped for facing away
   std::uint64_t culled_frustum = 0;   // selected entries behind the eye or outside the image
+
+  // The counts as a frame reports them: nodes visited = entries scanned, frustum culls = chunks
+  // culled + entries dropped outside the view.
+  SelectionStats as_selection() const {
+    return {.splats = splats, .nodes_visited = entries_scanned,
+            .culled_frustum = chunks_culled + culled_frustum, .culled_backface = culled_backface};
+  }
+  SptSelectionStats& operator+=(const SptSelectionStats& o) {
+    splats += o.splats;
+    entries_scanned += o.entries_scanned;
+    entries_total += o.entries_total;
+    chunks_culled += o.chunks_culled;
+    chunks_total += o.chunks_total;
+    culled_backface += o.culled_backface;
+    culled_frustum += o.culled_frustum;
+    return *this;
+  }
 };
 
 struct SptRenderOptions {

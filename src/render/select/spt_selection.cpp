@@ -6,7 +6,6 @@
 // Parallel and deterministic: the scanned prefix of every visible range is cut into blocks of
 // kBlock entries; each block is one task writing one stream chunk, and chunks are in list order.
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -16,6 +15,7 @@
 #include "pointillist/core/error.hpp"
 #include "pointillist/render/spt_render.hpp"
 #include "pointillist/render/splat_raster.hpp"
+#include "frame_timing.hpp"
 #include "shading.hpp"
 
 namespace pointillist {
@@ -253,35 +253,17 @@ void select_splats_spt(const SequentialPointTree& tree, const CameraFrame& camer
 void render_spt(const SequentialPointTree& tree, const Camera& camera,
                 const RenderSettings& settings, const SptRenderOptions& options, ThreadPool& pool,
                 Frame& frame, SptSelectionStats* details) {
-  using clock = std::chrono::steady_clock;
-  auto ms = [](clock::time_point a, clock::time_point b) {
-    return std::chrono::duration<double, std::milli>(b - a).count();
-  };
-  const auto start = clock::now();
+  using render_detail::Clock;
+  const auto start = Clock::now();
   const CameraFrame cam = make_camera_frame(camera);
-  const std::size_t pixels = static_cast<std::size_t>(cam.width) * static_cast<std::size_t>(cam.height);
-  frame.width = cam.width;
-  frame.height = cam.height;
-  frame.color.resize(pixels);
-  frame.depth.resize(pixels);
+  render_detail::size_frame(frame, cam);
   SptSelectionStats selection;
   frame.splats.with_discs = false;  // the fast rasterizer does not read them
   select_splats_spt(tree, cam, settings, options, pool, frame.splats, selection);
-  const auto selected = clock::now();
+  const auto selected = Clock::now();
   rasterize_splats(frame.splats, cam, settings, pool, frame.scratch, frame.color, frame.depth);
-  const auto done = clock::now();
-  RenderStats& s = frame.stats;
-  s = {};
-  s.splats = selection.splats;
-  s.nodes_visited = selection.entries_scanned;
-  s.culled_frustum = selection.chunks_culled + selection.culled_frustum;
-  s.culled_backface = selection.culled_backface;
-  s.width = cam.width;
-  s.height = cam.height;
-  s.threads = pool.thread_count();
-  s.ms_select = ms(start, selected);
-  s.ms_raster = ms(selected, done);
-  s.ms_total = ms(start, done);
+  render_detail::fill_stats(frame, selection.as_selection(), cam, pool.thread_count(), start,
+                            selected, Clock::now());
   if (details) *details = selection;
 }
 
