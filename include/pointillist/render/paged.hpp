@@ -6,7 +6,6 @@
 #pragma once
 
 #include <cstdint>
-#include <deque>
 #include <memory>
 #include <vector>
 
@@ -29,8 +28,8 @@ class PagedRenderer {
  public:
   // Loads page 0. Throws OptionError when page 0 alone needs more than `memory_cap` bytes (the
   // message gives the size needed), and what the source throws.
-  PagedRenderer(const PageSource& source, std::uint64_t memory_cap, ThreadPool& pool)
-      : cache_(source, memory_cap, pool), summary_(source.summary()) {}
+  PagedRenderer(const PageSource& source, std::uint64_t memory_cap, ThreadPool& pool);
+  ~PagedRenderer();
   PagedRenderer(const PagedRenderer&) = delete;
   PagedRenderer& operator=(const PagedRenderer&) = delete;
 
@@ -76,21 +75,15 @@ class PagedRenderer {
                     const QualitySettings* quality, QualityScratch* scratch, ThreadPool& pool,
                     Frame& frame);
   struct Selection;
-  // The traversal over decoded or packed pages (Access: see paged_render.cpp).
-  template <class Access>
-  void select_pages(const Access& access, Selection& selection, ThreadPool& pool);
+  struct Tasks;  // each selection task's output of the last frame (paged_render.cpp)
+  // The traversal (select/qsplat_traversal.hpp) over decoded or packed pages.
+  template <class Access, class TaskStates>
+  void select_pages(const Access& access, Selection& selection, ThreadPool& pool,
+                    TaskStates& tasks);
 
   PageCache cache_;
   SphereTreeView summary_;
-  // What each selection task produced in the last frame.
-  struct TaskOut {
-    std::vector<const SphereNode*> emitted;  // the nodes of its splats, in its chunk's order
-    std::vector<SphereNode> values;          // the same for packed pages: decoded copies
-    std::deque<SphereNode> stand_ins;        // copies of stand-ins lit from the front
-    std::vector<PageRequest> requests;       // pages it wanted, in traversal order
-    std::vector<std::uint32_t> touched;      // resident pages it used below the top
-  };
-  std::vector<TaskOut> task_out_;
+  std::unique_ptr<Tasks> tasks_;
 };
 
 }  // namespace pointillist

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <string>
 #include <vector>
 
@@ -10,7 +11,7 @@
 #include "pointillist/render/paged.hpp"
 #include "frame_timing.hpp"
 #include "shading.hpp"
-#include "select/traversal_common.hpp"
+#include "select/qsplat_traversal.hpp"
 
 namespace pointillist {
 namespace {
@@ -19,24 +20,23 @@ using namespace render_detail;
 
 using PageTable = PageCache::PageTable;
 
-// Where the children of a refined node are: nodes [first, first + child_count) of `page`, which
-// may not be resident.
-struct ChildRef {
-  std::uint32_t page, first;
-  bool resident;
-};
-
-// The traversal's view of decoded pages: nodes are used where they lie.
+// The traversal's view of decoded pages: nodes are used where they lie; a splat's node id is the
+// index of its node's address in the task's list (a stand-in lit from the front is a copy).
 class DecodedAccess {
  public:
-  static constexpr bool kPacked = false;
+  static constexpr bool kPaged = true;
   struct Item {
     std::uint32_t page, node;
     std::uint8_t tests;
   };
+  struct Kept {
+    std::vector<const SphereNode*> emitted;
+    std::deque<SphereNode> flipped;
+  };
   explicit DecodedAccess(const PageTable& pages) : pages_(pages) {}
   Item root(std::uint8_t tests) const { return {0, 0, tests}; }
   const SphereNode& node(const Item& p) const { return pages_[p.page]->nodes[p.node]; }
+  std::uint32_t page(const Item& p) const { return p.page; }
   ChildRef children(const Item& p, const SphereNode& n) const {
     const std::uint32_t cp = pages_[p.page]->child_page[p.node];
     if (cp == kNoPage) return {p.page, n.first_child, true};
@@ -49,21 +49,37 @@ class DecodedAccess {
   Item item(ChildRef c, std::uint32_t k, const SphereNode*, std::uint8_t tests) const {
     return {c.page, c.first + k, tests};
   }
+  std::uint32_t keep(Kept& kept, const SphereNode& n, bool flip) const {
+    if (flip) {
+      kept.flipped.push_back(n);
+      kept.flipped.back().normal = -n.normal;
+      kept.emitted.push_back(&kept.flipped.back());
+    } else {
+      kept.emitted.push_back(&n);
+    }
+    return static_cast<std::uint32_t>(kept.emitted.size() - 1);
+  }
+  const SphereNode& kept(const Kept& kept, std::uint32_t id) const { return *kept.emitted[id]; }
+  static void clear(Kept& kept) {
+    kept.emitted.clear();
+    kept.flipped.clear();
+  }
 
  private:
   const PageTable& pages_;
 };
 
 // The traversal's view of packed pages: each node is decoded from its record against its
-// decoded parent when the parent is refined, and travels by value.
+// decoded parent when the parent is refined, and travels by value; a splat keeps a copy.
 class PackedAccess {
  public:
-  static constexpr bool kPacked = true;
+  static constexpr bool kPaged = true;
   struct Item {
     SphereNode node;
     std::uint32_t page, index;
     std::uint8_t tests;
   };
+  using Kept = std::vector<SphereNode>;
   PackedAccess(const PageTable& pages, bool has_colors)
       : pages_(pages), has_colors_(has_colors) {}
   Item root(std::uint8_t tests) const {
@@ -73,6 +89,7 @@ class PackedAccess {
     return root;
   }
   const SphereNode& node(const Item& p) const { return p.node; }
+  std::uint32_t page(const Item& p) const { return p.page; }
   ChildRef children(const Item& p, const SphereNode&) const {
     const PackedPage& pk = pages_[p.page]->packed;
     const std::uint32_t link = pk.link(p.index);
@@ -88,6 +105,13 @@ class PackedAccess {
   Item item(ChildRef c, std::uint32_t k, const SphereNode* kids, std::uint8_t tests) const {
     return {kids[k], c.page, c.first + k, tests};
   }
+  std::uint32_t keep(Kept& kept, const SphereNode& n, bool flip) const {
+    kept.push_back(n);
+    if (flip) kept.back().normal = -n.normal;
+    return static_cast<std::uint32_t>(kept.size() - 1);
+  }
+  const SphereNode& kept(const Kept& kept, std::uint32_t id) const { return kept[id]; }
+  static void clear(Kept& kept) { kept.clear(); }
 
  private:
   template <class Parent>
@@ -102,6 +126,16 @@ class PackedAccess {
 };
 
 }  // namespace
+
+struct PagedRenderer::Tasks {
+  std::vector<TaskState<DecodedAccess>> decoded;
+  std::vector<TaskState<PackedAccess>> packed;
+};
+
+PagedRenderer::PagedRenderer(const PageSource& source, std::uint64_t memory_cap, ThreadPool& pool)
+    : cache_(source, memory_cap, pool), summary_(source.summary()),
+      tasks_(std::make_unique<Tasks>()) {}
+PagedRenderer::~PagedRenderer() = default;
 
 struct PagedRenderer::Selection {
   const ViewConstants& v;
@@ -143,9 +177,9 @@ SelectionStats PagedRenderer::select(const CameraFrame& cam, const RenderSetting
       with_colors, stream, {}};
   if (!pages.empty() && pages[0]) {
     if (pages[0]->is_packed()) {
-      select_pages(PackedAccess(pages, with_colors), selection, pool);
+      select_pages(PackedAccess(pages, with_colors), selection, pool, tasks_->packed);
     } else {
-      select_pages(DecodedAccess(pages), selection, pool);
+      select_pages(DecodedAccess(pages), selection, pool, tasks_->decoded);
     }
   }
   cache_.end_frame();
@@ -176,134 +210,18 @@ void PagedRenderer::render_frame(const Camera& camera, const RenderSettings& set
   fill_stats(frame, selection, cam, pool.thread_count(), start, selected, Clock::now());
 }
 
-template <class Access>
-void PagedRenderer::select_pages(const Access& access, Selection& s, ThreadPool& pool) {
-  using Item = typename Access::Item;
-  const ViewConstants& v = s.v;
-  const bool with_colors = s.with_colors;
-  SplatStream& stream = s.stream;
-  Counters& counters = s.counters;
-
-  // The top of the hierarchy expanded level by level (as the in-memory traversal does) into
-  // subtrees walked in parallel, each into its own chunk; chunks in order give the depth-first
-  // order whatever the thread count. A node is expanded here only when its children are
-  // resident; anything else is left for its task to visit.
-  std::vector<Item> items{access.root(s.tests)};
-  std::vector<Item> next;
-  SphereNode scratch[4];
-  while (items.size() < kTargetTasks) {
-    bool expanded = false;
-    next.clear();
-    for (const Item& p : items) {
-      const SphereNode& n = access.node(p);
-      Counters trial;
-      Vec3f d;
-      float z;
-      std::uint8_t tests = p.tests;
-      const Decision decision = visit(n, v, tests, trial, d, z);
-      const ChildRef c = decision == Decision::Refine ? access.children(p, n) : ChildRef{};
-      if (decision == Decision::Cull || (decision == Decision::Refine && c.resident)) {
-        counters.visited += trial.visited;
-        counters.culled_frustum += trial.culled_frustum;
-        counters.culled_backface += trial.culled_backface;
-        if (decision == Decision::Cull) continue;
-        if (c.page != p.page) cache_.mark_used(c.page);
-        const SphereNode* kids = access.load_children(c, n, scratch);
-        for (std::uint32_t k = 0; k < n.child_count; ++k) {
-          next.push_back(access.item(c, k, kids, tests));
-        }
-        expanded = true;
-      } else {
-        next.push_back(p);  // drawn, or a stand-in: its task visits it
-      }
-    }
-    items.swap(next);
-    if (!expanded) break;
-  }
-
-  if (stream.chunks.size() < items.size()) stream.chunks.resize(items.size());
-  stream.chunk_count = items.size();
-  if (task_out_.size() < items.size()) task_out_.resize(items.size());
-  std::vector<Counters> task_counters(items.size());
-  pool.run(items.size(), [&](std::size_t t) {
-    TaskOut& out = task_out_[t];
-    Counters task_count;  // local: the hot loop keeps it in registers
-    out.emitted.clear();
-    out.values.clear();
-    out.stand_ins.clear();
-    out.requests.clear();
-    out.touched.clear();
-    SplatChunk& chunk = stream.chunks[t];
-    chunk.count = 0;
-    chunk.reserve(kInitialChunkCapacity, with_colors);
-    {
-      Emitter emitter(chunk, with_colors);
-      std::uint32_t emitted = 0;
-      // A stand-in is drawn even when its mean normal faces away (its subtree may hold surfaces
-      // facing the eye); it is then lit from the front, not drawn black.
-      const auto emit = [&](const SphereNode& n, Vec3f d, float z, bool stand_in) {
-        emitter.emit(n, emitted++, d, z, v, task_count, !stand_in);
-        const bool flip = stand_in && dot(d, n.normal) > 0;
-        if constexpr (Access::kPacked) {
-          out.values.push_back(n);
-          if (flip) out.values.back().normal = -n.normal;
-        } else if (flip) {
-          out.stand_ins.push_back(n);
-          out.stand_ins.back().normal = -n.normal;
-          out.emitted.push_back(&out.stand_ins.back());
-        } else {
-          out.emitted.push_back(&n);
-        }
-      };
-      SphereNode kid_scratch[4];
-      std::vector<Item> stack{items[t]};
-      while (!stack.empty()) {
-        const Item p = stack.back();
-        stack.pop_back();
-        const SphereNode& n = access.node(p);
-        Vec3f d;
-        float z;
-        std::uint8_t tests = p.tests;
-        const Decision decision = visit(n, v, tests, task_count, d, z);
-        if (decision == Decision::Draw) emit(n, d, z, false);
-        if (decision != Decision::Refine) continue;
-        const ChildRef c = access.children(p, n);
-        if (!c.resident) {
-          // Not resident: this node stands in for its subtree, and the page is wanted.
-          emit(n, d, z, true);
-          out.requests.push_back({c.page, p.page, z > 0 ? n.radius / z : 0.0f});
-          continue;
-        }
-        if (c.page != p.page) out.touched.push_back(c.page);
-        // Leading leaf children are visited right here (most nodes near the bottom have only
-        // leaves), in order; the rest go on the stack last to first.
-        const SphereNode* kids = access.load_children(c, n, kid_scratch);
-        std::uint32_t k = 0;
-        for (; k < n.child_count && kids[k].child_count == 0; ++k) {
-          std::uint8_t leaf_tests = tests;
-          if (visit(kids[k], v, leaf_tests, task_count, d, z) == Decision::Draw) {
-            emit(kids[k], d, z, false);
-          }
-        }
-        for (std::uint32_t j = n.child_count; j-- > k;) {
-          stack.push_back(access.item(c, j, kids, tests));
-        }
-      }
-    }
-    if constexpr (Access::kPacked) {
-      finish_chunk([&](std::uint32_t i) -> const SphereNode& { return out.values[i]; }, v,
-                   with_colors, chunk);
-    } else {
-      finish_chunk([&](std::uint32_t i) -> const SphereNode& { return *out.emitted[i]; }, v,
-                   with_colors, chunk);
-    }
-    task_counters[t] = task_count;
-  });
-  for (std::size_t t = 0; t < items.size(); ++t) {
-    const TaskOut& out = task_out_[t];
-    counters.visited += task_counters[t].visited;
-    counters.culled_frustum += task_counters[t].culled_frustum;
-    counters.culled_backface += task_counters[t].culled_backface;
+template <class Access, class TaskStates>
+void PagedRenderer::select_pages(const Access& access, Selection& s, ThreadPool& pool,
+                                 TaskStates& tasks) {
+  std::vector<std::uint32_t> top_pages;
+  select_qsplat(access, s.v, s.tests, s.with_colors, pool, s.stream, tasks, s.counters,
+                top_pages);
+  for (const std::uint32_t page : top_pages) cache_.mark_used(page);
+  for (std::size_t t = 0; t < s.stream.chunk_count; ++t) {
+    const auto& out = tasks[t];
+    s.counters.visited += out.counters.visited;
+    s.counters.culled_frustum += out.counters.culled_frustum;
+    s.counters.culled_backface += out.counters.culled_backface;
     for (const std::uint32_t page : out.touched) cache_.mark_used(page);
     for (const PageRequest& r : out.requests) cache_.request(r);
   }

@@ -1,24 +1,21 @@
-// QSplat traversal: level-of-detail selection with frustum and normal-cone backface culling
-// (Rusinkiewicz & Levoy, "QSplat: A Multiresolution Point Rendering System for Large Meshes",
-// SIGGRAPH 2000, section 3.2; the per-node tests follow the original viewer, see
-// shared/specs/qsplat-qs-format.md section 9, without its approximate shortcuts).
-//
-// Parallel and deterministic: the top of the tree is expanded level by level, in depth-first
-// order, until there are about kTargetTasks pending subtrees; each subtree is then walked by one
-// task into its own chunk of the stream, and the chunks are read in order, so the stream is the
-// plain depth-first order whatever the thread count.
+// QSplat selection on a hierarchy held whole in memory: the one traversal of
+// qsplat_traversal.hpp over a single page that is always resident (Rusinkiewicz & Levoy,
+// "QSplat: A Multiresolution Point Rendering System for Large Meshes", SIGGRAPH 2000, section
+// 3.2; the per-node tests follow the original viewer, see shared/specs/qsplat-qs-format.md
+// section 9, without its approximate shortcuts).
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "pointillist/core/error.hpp"
 #include "pointillist/render/selection.hpp"
 #include "shading.hpp"
-#include "select/traversal_common.hpp"
+#include "select/qsplat_traversal.hpp"
 
 namespace pointillist {
 
@@ -41,89 +38,35 @@ namespace {
 
 using namespace render_detail;
 
-void walk_subtree(std::span<const SphereNode> nodes, Pending start, const ViewConstants& v,
-                  bool with_colors, std::vector<Pending>& stack, SplatChunk& out,
-                  Counters& total) {
-  Counters counters;
-  Emitter emitter(out, with_colors);
-  if (start.tests & kDecidedDraw) {
-    const SphereNode& n = nodes[start.node];
-    const Vec3f d = n.center - v.eye;
-    emitter.emit(n, start.node, d, dot(d, v.forward), v, counters);
-  } else {
-    stack.clear();
-    stack.push_back(start);
-    while (!stack.empty()) {
-      Pending p = stack.back();
-      stack.pop_back();
-      // Follow the first child without a round trip through the stack.
-      for (;;) {
-        const SphereNode& n = nodes[p.node];
-        Vec3f d;
-        float z;
-        const Decision decision = visit(n, v, p.tests, counters, d, z);
-        if (decision == Decision::Draw) emitter.emit(n, p.node, d, z, v, counters);
-        if (decision != Decision::Refine) break;
-        // Leading leaf children are visited right here (most interior nodes near the bottom
-        // have only leaves); from the first interior child on, the order is kept by going on
-        // with it and pushing the others last to first.
-        std::uint32_t c = 0;
-        for (; c < n.child_count; ++c) {
-          const std::uint32_t index = n.first_child + c;
-          const SphereNode& child = nodes[index];
-          if (child.child_count != 0) break;
-          std::uint8_t tests = p.tests;
-          if (visit(child, v, tests, counters, d, z) == Decision::Draw) {
-            emitter.emit(child, index, d, z, v, counters);
-          }
-        }
-        if (c == n.child_count) break;
-        for (std::uint32_t k = n.child_count; k-- > c + 1;) {
-          stack.push_back({n.first_child + k, p.tests});
-        }
-        p.node = n.first_child + c;
-      }
-    }
+// The whole hierarchy in memory: one page, always resident; a splat's node id is its index.
+class FlatAccess {
+ public:
+  static constexpr bool kPaged = false;
+  struct Item {
+    std::uint32_t node;
+    std::uint8_t tests;
+  };
+  struct Kept {};
+  explicit FlatAccess(std::span<const SphereNode> nodes) : nodes_(nodes) {}
+  Item root(std::uint8_t tests) const { return {0, tests}; }
+  const SphereNode& node(const Item& p) const { return nodes_[p.node]; }
+  std::uint32_t page(const Item&) const { return 0; }
+  ChildRef children(const Item&, const SphereNode& n) const { return {0, n.first_child, true}; }
+  const SphereNode* load_children(ChildRef c, const SphereNode&, SphereNode*) const {
+    return nodes_.data() + c.first;
   }
-  total.visited += counters.visited;
-  total.culled_frustum += counters.culled_frustum;
-  total.culled_backface += counters.culled_backface;
-}
+  Item item(ChildRef c, std::uint32_t k, const SphereNode*, std::uint8_t tests) const {
+    return {c.first + k, tests};
+  }
+  std::uint32_t keep(Kept&, const SphereNode& n, bool) const {
+    return static_cast<std::uint32_t>(&n - nodes_.data());
+  }
+  const SphereNode& kept(const Kept&, std::uint32_t id) const { return nodes_[id]; }
+  static void clear(Kept&) {}
 
-// Expands the top of the tree, level by level, into pending subtrees in depth-first order.
-std::vector<Pending> split_top(std::span<const SphereNode> nodes, const ViewConstants& v,
-                               std::uint8_t tests, Counters& counters) {
-  std::vector<Pending> items{{0, tests}}, next;
-  while (items.size() < kTargetTasks) {
-    bool expanded = false;
-    next.clear();
-    for (Pending p : items) {
-      const SphereNode& n = nodes[p.node];
-      if ((p.tests & kDecidedDraw) || n.child_count == 0) {
-        next.push_back(p);
-        continue;
-      }
-      Vec3f d;
-      float z;
-      switch (visit(n, v, p.tests, counters, d, z)) {
-        case Decision::Cull:
-          break;
-        case Decision::Draw:
-          next.push_back({p.node, static_cast<std::uint8_t>(p.tests | kDecidedDraw)});
-          break;
-        case Decision::Refine:
-          for (std::uint32_t c = 0; c < n.child_count; ++c) {
-            next.push_back({n.first_child + c, p.tests});
-          }
-          expanded = true;
-          break;
-      }
-    }
-    items.swap(next);
-    if (!expanded) break;
-  }
-  return items;
-}
+ private:
+  std::span<const SphereNode> nodes_;
+};
 
 }  // namespace
 
@@ -145,31 +88,19 @@ void select_splats(const SphereTreeView& tree, const CameraFrame& camera,
   const std::uint8_t tests =
       static_cast<std::uint8_t>((settings.frustum_culling ? kTestFrustum : 0) |
                                 (settings.backface_culling ? kTestBackface : 0));
+  std::vector<TaskState<FlatAccess>> tasks;
   Counters top;
-  const std::vector<Pending> items = split_top(tree.nodes, v, tests, top);
-
-  if (stream.chunks.size() < items.size()) stream.chunks.resize(items.size());
-  stream.chunk_count = items.size();
-  std::vector<Counters> counters(items.size());
-  const bool with_colors = tree.has_colors;
-  pool.run(items.size(), [&](std::size_t t) {
-    SplatChunk& chunk = stream.chunks[t];
-    chunk.count = 0;
-    chunk.reserve(kInitialChunkCapacity, with_colors);
-    std::vector<Pending> stack;
-    stack.reserve(64);
-    walk_subtree(tree.nodes, items[t], v, with_colors, stack, chunk, counters[t]);
-    finish_chunk([&](std::uint32_t i) -> const SphereNode& { return tree.nodes[i]; }, v,
-                 with_colors, chunk);
-  });
+  std::vector<std::uint32_t> top_pages;
+  select_qsplat(FlatAccess(tree.nodes), v, tests, tree.has_colors, pool, stream, tasks, top,
+                top_pages);
 
   stats.nodes_visited = top.visited;
   stats.culled_frustum = top.culled_frustum;
   stats.culled_backface = top.culled_backface;
-  for (std::size_t t = 0; t < items.size(); ++t) {
-    stats.nodes_visited += counters[t].visited;
-    stats.culled_frustum += counters[t].culled_frustum;
-    stats.culled_backface += counters[t].culled_backface;
+  for (std::size_t t = 0; t < stream.chunk_count; ++t) {
+    stats.nodes_visited += tasks[t].counters.visited;
+    stats.culled_frustum += tasks[t].counters.culled_frustum;
+    stats.culled_backface += tasks[t].counters.culled_backface;
     stats.splats += stream.chunks[t].count;
   }
 }
