@@ -1,25 +1,43 @@
-// The renderer's entry point: selection, then rasterization, timed.
+// The entry points for a hierarchy held whole: the QSplat selection, then the fast or the
+// quality rasterizer (frame_pass.hpp).
+#include "pointillist/render/quality.hpp"
 #include "pointillist/render/render.hpp"
 
-#include "frame_timing.hpp"
+#include "frame_pass.hpp"
 
 namespace pointillist {
 
-using render_detail::Clock;
+namespace {
+
+auto qsplat(const SphereTreeView& tree, const RenderSettings& settings, ThreadPool& pool) {
+  return [&](const CameraFrame& cam, SplatStream& stream) {
+    SelectionStats selection;
+    select_splats(tree, cam, settings, pool, stream, selection);
+    return selection;
+  };
+}
+
+}  // namespace
 
 void render(const SphereTreeView& tree, const Camera& camera, const RenderSettings& settings,
             ThreadPool& pool, Frame& frame) {
-  const auto start = Clock::now();
-  const CameraFrame cam = make_camera_frame(camera);
-  render_detail::size_frame(frame, cam);
+  render_detail::frame_pass(camera, settings, nullptr, nullptr, pool, frame,
+                            qsplat(tree, settings, pool));
+}
 
-  SelectionStats selection;
-  frame.splats.with_discs = false;  // the fast rasterizer does not read them
-  select_splats(tree, cam, settings, pool, frame.splats, selection);
-  const auto selected = Clock::now();
-  rasterize_splats(frame.splats, cam, settings, pool, frame.scratch, frame.color, frame.depth);
-  render_detail::fill_stats(frame, selection, cam, pool.thread_count(), start, selected,
-                            Clock::now());
+void render_quality(const SphereTreeView& tree, const Camera& camera,
+                    const RenderSettings& settings, const QualitySettings& quality,
+                    ThreadPool& pool, Frame& frame, QualityScratch& scratch) {
+  validate_quality_settings(quality);
+  render_detail::frame_pass(camera, settings, &quality, &scratch, pool, frame,
+                            qsplat(tree, settings, pool));
+}
+
+void render_quality(const SphereTreeView& tree, const Camera& camera,
+                    const RenderSettings& settings, const QualitySettings& quality,
+                    ThreadPool& pool, Frame& frame) {
+  QualityScratch scratch;
+  render_quality(tree, camera, settings, quality, pool, frame, scratch);
 }
 
 }  // namespace pointillist

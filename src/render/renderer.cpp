@@ -7,15 +7,13 @@
 #include <optional>
 #include <utility>
 
-#include "frame_timing.hpp"
+#include "frame_pass.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/render/mesh_reference.hpp"
 #include "pointillist/render/paged.hpp"
 #include "pointillist/render/selection.hpp"
 
 namespace pointillist {
-
-using render_detail::Clock;
 
 namespace {
 
@@ -143,25 +141,29 @@ void Renderer::render(std::span<const SceneInstance> scene, const Camera& camera
     }
   }
 
-  const auto start = Clock::now();
-  const CameraFrame world = make_camera_frame(camera);
-  render_detail::size_frame(frame, world);
   last_frame_.clear();
   spt_stats_ = {};
   ++frame_number_;
-
   if (fs.rasterizer == Rasterizer::Reference) {
     render_mesh_reference(*scene[0].model->mesh, camera, settings, frame);
     return;
   }
+  const bool quality = fs.rasterizer == Rasterizer::Quality;
+  render_detail::frame_pass(camera, settings, quality ? &fs.quality : nullptr,
+                            &quality_scratch_, pool, frame,
+                            [&](const CameraFrame& world, SplatStream& stream) {
+                              return select(scene, camera, world, settings, fs, pool, stream);
+                            });
+}
 
-  // Selection, instance after instance; the first instance selects straight into the frame's
-  // stream, the others into a scratch stream whose chunks are then moved behind.
-  SplatStream& stream = frame.splats;
-  const bool with_discs = fs.rasterizer == Rasterizer::Quality;
+// Selection, instance after instance; the first instance selects straight into the frame's
+// stream, the others into a scratch stream whose chunks are then moved behind.
+SelectionStats Renderer::select(std::span<const SceneInstance> scene, const Camera& camera,
+                                const CameraFrame& world, const RenderSettings& settings,
+                                const FrameSettings& fs, ThreadPool& pool, SplatStream& stream) {
+  const bool with_discs = stream.with_discs;
   stream.chunk_count = 0;
   stream.has_colors = false;
-  stream.with_discs = with_discs;
   SelectionStats total;
   bool any_colors = false;
   for (const SceneInstance& inst : scene) any_colors = any_colors || inst.model->tree.has_colors;
@@ -225,15 +227,7 @@ void Renderer::render(std::span<const SceneInstance> scene, const Camera& camera
       }
     }
   }
-  const auto selected_at = Clock::now();
-  if (fs.rasterizer == Rasterizer::Quality) {
-    rasterize_quality(stream, world, settings, fs.quality, pool, quality_scratch_, frame.color,
-                      frame.depth);
-  } else {
-    rasterize_splats(stream, world, settings, pool, frame.scratch, frame.color, frame.depth);
-  }
-  render_detail::fill_stats(frame, total, world, pool.thread_count(), start, selected_at,
-                            Clock::now());
+  return total;
 }
 
 std::size_t Renderer::load_requested(ThreadPool& pool, std::size_t max_pages,

@@ -137,6 +137,9 @@ class Renderer {
  private:
   struct ModelState;
   ModelState& state_for(const RenderModel& model, ThreadPool& pool, const FrameSettings& fs);
+  SelectionStats select(std::span<const SceneInstance> scene, const Camera& camera,
+                        const CameraFrame& world, const RenderSettings& settings,
+                        const FrameSettings& fs, ThreadPool& pool, SplatStream& stream);
 
   RendererOptions options_;
   std::unordered_map<const RenderModel*, std::unique_ptr<ModelState>> states_;

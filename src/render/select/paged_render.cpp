@@ -9,7 +9,7 @@
 
 #include "pointillist/core/error.hpp"
 #include "pointillist/render/paged.hpp"
-#include "frame_timing.hpp"
+#include "frame_pass.hpp"
 #include "shading.hpp"
 #include "select/qsplat_traversal.hpp"
 
@@ -194,20 +194,10 @@ SelectionStats PagedRenderer::select(const CameraFrame& cam, const RenderSetting
 void PagedRenderer::render_frame(const Camera& camera, const RenderSettings& settings,
                                  const QualitySettings* quality, QualityScratch* scratch,
                                  ThreadPool& pool, Frame& frame) {
-  const auto start = Clock::now();
-  const CameraFrame cam = make_camera_frame(camera);
-  size_frame(frame, cam);
-  SplatStream& stream = frame.splats;
-  stream.with_discs = quality != nullptr;
-  const SelectionStats selection = select(cam, settings, pool, stream);
-  const auto selected = Clock::now();
-  if (quality) {
-    rasterize_quality(stream, cam, settings, *quality, pool, *scratch, frame.color,
-                      frame.depth);
-  } else {
-    rasterize_splats(stream, cam, settings, pool, frame.scratch, frame.color, frame.depth);
-  }
-  fill_stats(frame, selection, cam, pool.thread_count(), start, selected, Clock::now());
+  render_detail::frame_pass(camera, settings, quality, scratch, pool, frame,
+                            [&](const CameraFrame& cam, SplatStream& stream) {
+                              return select(cam, settings, pool, stream);
+                            });
 }
 
 template <class Access, class TaskStates>

@@ -15,7 +15,7 @@
 #include "pointillist/core/error.hpp"
 #include "pointillist/render/spt_render.hpp"
 #include "pointillist/render/splat_raster.hpp"
-#include "frame_timing.hpp"
+#include "frame_pass.hpp"
 #include "shading.hpp"
 
 namespace pointillist {
@@ -253,17 +253,13 @@ void select_splats_spt(const SequentialPointTree& tree, const CameraFrame& camer
 void render_spt(const SequentialPointTree& tree, const Camera& camera,
                 const RenderSettings& settings, const SptRenderOptions& options, ThreadPool& pool,
                 Frame& frame, SptSelectionStats* details) {
-  using render_detail::Clock;
-  const auto start = Clock::now();
-  const CameraFrame cam = make_camera_frame(camera);
-  render_detail::size_frame(frame, cam);
   SptSelectionStats selection;
-  frame.splats.with_discs = false;  // the fast rasterizer does not read them
-  select_splats_spt(tree, cam, settings, options, pool, frame.splats, selection);
-  const auto selected = Clock::now();
-  rasterize_splats(frame.splats, cam, settings, pool, frame.scratch, frame.color, frame.depth);
-  render_detail::fill_stats(frame, selection.as_selection(), cam, pool.thread_count(), start,
-                            selected, Clock::now());
+  render_detail::frame_pass(camera, settings, nullptr, nullptr, pool, frame,
+                            [&](const CameraFrame& cam, SplatStream& stream) {
+                              select_splats_spt(tree, cam, settings, options, pool, stream,
+                                                selection);
+                              return selection.as_selection();
+                            });
   if (details) *details = selection;
 }
 
