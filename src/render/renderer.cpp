@@ -202,7 +202,7 @@ SelectionStats Renderer::select(std::span<const SceneInstance> scene, const Came
         // A model without colours beside coloured ones: its base colour, as the others carry.
         const Rgb8 base{to_byte(settings.base_color.x), to_byte(settings.base_color.y),
                         to_byte(settings.base_color.z)};
-        chunk.reserve(chunk.count, true);
+        chunk.reserve(chunk.count, true, with_discs);
         std::fill(chunk.color.begin(), chunk.color.begin() + chunk.count, base);
       }
     }

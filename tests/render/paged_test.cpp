@@ -290,7 +290,7 @@ TEST(PagedRender, ImageDoesNotDependOnTheThreadCount) {
       paged.render(view(310), RenderSettings{}, pool, frame);
       if (i < 2) paged.load_requested(pool, 6);
     }
-    images[threads - 1] = frame.color;
+    images[threads - 1].assign(frame.color.begin(), frame.color.end());
     requested[threads - 1] = paged.stats().pages_requested;
   }
   EXPECT_GT(requested[0], 0u);

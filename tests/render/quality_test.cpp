@@ -88,7 +88,7 @@ std::vector<Rgb8> reference_image(const AnalyticScene& scene, const Camera& came
   return img;
 }
 
-ImageRgb8View view_of(const std::vector<Rgb8>& px, int w, int h) { return {w, h, px}; }
+ImageRgb8View view_of(std::span<const Rgb8> px, int w, int h) { return {w, h, px}; }
 
 // Scene samples as a scanner would give them: positions only, then PCA normals and cloud radii
 // (prepare_splats), then the hierarchy.

@@ -31,8 +31,9 @@ struct RenderStats {
 // Frame per view and pass it to every render call.
 struct Frame {
   int width = 0, height = 0;
-  std::vector<Rgb8> color;
-  std::vector<float> depth;
+  // Written whole by every render (not zeroed when they grow: see core/buffer.hpp).
+  Buffer<Rgb8> color;
+  Buffer<float> depth;
   RenderStats stats;
   SplatStream splats;     // the splats drawn in this frame, in stream order
   RasterScratch scratch;  // rasterizer work buffers (contents unspecified)

@@ -5,6 +5,7 @@
 #include <span>
 #include <vector>
 
+#include "pointillist/core/buffer.hpp"
 #include "pointillist/core/camera.hpp"
 #include "pointillist/core/thread_pool.hpp"
 #include "pointillist/render/settings.hpp"
@@ -16,11 +17,11 @@ namespace pointillist {
 // allocate. The contents between calls are unspecified.
 struct RasterScratch {
   struct Chunk {
-    std::vector<float> ellipse;  // 6 floats per splat (Ellipse shape only)
+    Buffer<float> ellipse;  // 6 floats per splat (Ellipse shape only)
     float y_min_px = 0, y_max_px = 0;  // rows the chunk's splats may touch (several bands only)
   };
   std::vector<Chunk> chunks;
-  std::vector<std::vector<std::uint32_t>> band_colors;  // one packed-color band per thread
+  std::vector<Buffer<std::uint32_t>> band_colors;  // one packed-color band per thread
 };
 
 // Clears color to settings.background and depth to +infinity, then draws every splat of

@@ -6,35 +6,39 @@
 #include <cstdint>
 #include <vector>
 
+#include "pointillist/core/buffer.hpp"
 #include "pointillist/core/math.hpp"
 
 namespace pointillist {
 
 // A run of consecutive splats, structure of arrays. The arrays are buffers whose size is the
-// capacity; only the first `count` entries are splats. Buffers keep their memory across frames.
+// capacity; only the first `count` entries are splats. Buffers keep their memory across frames,
+// are not zeroed when they grow, and the discs (center, radius) and colours are sized only when
+// the stream carries them.
 // Positions and sizes are finite, below 1e9 px in magnitude (selection drops other splats).
 struct SplatChunk {
   std::size_t count = 0;
-  std::vector<float> x_px;       // centre in pixels: column, 0 = left edge of the image
-  std::vector<float> y_px;       // centre in pixels: row, 0 = top edge (pixel centres at +0.5)
-  std::vector<float> depth;      // eye-space depth of the centre (> 0, world units)
-  std::vector<float> size_px;    // projected diameter 2·r·f/z in pixels
+  Buffer<float> x_px;       // centre in pixels: column, 0 = left edge of the image
+  Buffer<float> y_px;       // centre in pixels: row, 0 = top edge (pixel centres at +0.5)
+  Buffer<float> depth;      // eye-space depth of the centre (> 0, world units)
+  Buffer<float> size_px;    // projected diameter 2·r·f/z in pixels
   // Lit color (RenderSettings shading, evaluated once per splat), packed r | g << 8 | b << 16.
-  std::vector<std::uint32_t> shaded;
+  Buffer<std::uint32_t> shaded;
   // The splat itself, in world space, so a rasterizer needs nothing but the stream: the disc
   // of centre `center`, radius `radius` and unit normal `normal` (for a stand-in of a subtree
   // that is not loaded, the normal turned toward the eye), and its colour.
-  std::vector<Vec3f> center;
-  std::vector<float> radius;
-  std::vector<Vec3f> normal;
-  std::vector<Rgb8> color;       // filled only when the stream has_colors
-  std::vector<std::uint32_t> node;  // index of the node in its hierarchy (or SPT entry)
+  Buffer<Vec3f> center;
+  Buffer<float> radius;
+  Buffer<Vec3f> normal;
+  Buffer<Rgb8> color;       // filled only when the stream has_colors
+  Buffer<std::uint32_t> node;  // index of the node in its hierarchy (or SPT entry)
   // Which instance of the scene the chunk's splats belong to (a chunk holds one instance's).
   std::uint32_t instance = 0;
 
   std::size_t capacity() const { return x_px.size(); }
-  // Grows every buffer to at least `n` entries (keeping the first `count`).
-  void reserve(std::size_t n, bool with_colors);
+  // Grows the buffers to at least `n` entries (keeping the first `count`): the colours only
+  // `with_colors`, the discs only `with_discs`.
+  void reserve(std::size_t n, bool with_colors, bool with_discs);
 };
 
 // The 8-bit channels of a packed color (SplatChunk::shaded).

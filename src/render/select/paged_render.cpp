@@ -141,6 +141,7 @@ struct PagedRenderer::Selection {
   const ViewConstants& v;
   std::uint8_t tests;  // tests of the root
   bool with_colors;
+  std::uint64_t expected;  // splats, for sizing new chunks
   SplatStream& stream;
   Counters counters;
 };
@@ -174,7 +175,7 @@ SelectionStats PagedRenderer::select(const CameraFrame& cam, const RenderSetting
       v,
       static_cast<std::uint8_t>((settings.frustum_culling ? kTestFrustum : 0) |
                                 (settings.backface_culling ? kTestBackface : 0)),
-      with_colors, stream, {}};
+      with_colors, expected_splats(summary_.leaf_count, cam), stream, {}};
   if (!pages.empty() && pages[0]) {
     if (pages[0]->is_packed()) {
       select_pages(PackedAccess(pages, with_colors), selection, pool, tasks_->packed);
@@ -204,8 +205,8 @@ template <class Access, class TaskStates>
 void PagedRenderer::select_pages(const Access& access, Selection& s, ThreadPool& pool,
                                  TaskStates& tasks) {
   std::vector<std::uint32_t> top_pages;
-  select_qsplat(access, s.v, s.tests, s.with_colors, pool, s.stream, tasks, s.counters,
-                top_pages);
+  select_qsplat(access, s.v, s.tests, s.with_colors, s.expected, pool, s.stream, tasks,
+                s.counters, top_pages);
   for (const std::uint32_t page : top_pages) cache_.mark_used(page);
   for (std::size_t t = 0; t < s.stream.chunk_count; ++t) {
     const auto& out = tasks[t];

@@ -62,7 +62,7 @@ void walk_subtree(const Access& access, const typename Access::Item& start,
   using Item = typename Access::Item;
   Counters counters;  // local: the hot loop keeps it in registers
   {
-    Emitter emitter(chunk, with_colors);
+    Emitter emitter(chunk, with_colors, v.with_discs);
     const auto emit = [&](const SphereNode& n, Vec3f d, float z, bool stand_in) {
       const bool flip = stand_in && dot(d, n.normal) > 0;
       emitter.emit(n, access.keep(out.kept, n, flip), d, z, v, counters, !stand_in);
@@ -117,10 +117,11 @@ void walk_subtree(const Access& access, const typename Access::Item& start,
 
 // Selects the splats of the view `v` into `stream` (its chunks from 0). `tasks` holds each
 // task's output afterwards (requests and touched pages for the caller to pass on); `top` counts
-// the nodes visited while expanding the top, and `top_pages` the pages used there.
+// the nodes visited while expanding the top, and `top_pages` the pages used there. `expected`
+// sizes chunks that are new (expected_splats).
 template <class Access>
 void select_qsplat(const Access& access, const ViewConstants& v, std::uint8_t tests,
-                   bool with_colors, ThreadPool& pool, SplatStream& stream,
+                   bool with_colors, std::uint64_t expected, ThreadPool& pool, SplatStream& stream,
                    std::vector<TaskState<Access>>& tasks, Counters& top,
                    std::vector<std::uint32_t>& top_pages) {
   using Item = typename Access::Item;
@@ -166,6 +167,7 @@ void select_qsplat(const Access& access, const ViewConstants& v, std::uint8_t te
   if (stream.chunks.size() < items.size()) stream.chunks.resize(items.size());
   stream.chunk_count = items.size();
   if (tasks.size() < items.size()) tasks.resize(items.size());
+  const std::size_t first_capacity = first_chunk_capacity(expected, items.size());
   pool.run(items.size(), [&](std::size_t t) {
     TaskState<Access>& out = tasks[t];
     Access::clear(out.kept);
@@ -174,7 +176,8 @@ void select_qsplat(const Access& access, const ViewConstants& v, std::uint8_t te
     out.counters = {};
     SplatChunk& chunk = stream.chunks[t];
     chunk.count = 0;
-    chunk.reserve(kInitialChunkCapacity, with_colors);
+    if (chunk.capacity() == 0) chunk.reserve(first_capacity, with_colors, v.with_discs);
+    chunk.reserve(kInitialChunkCapacity, with_colors, v.with_discs);
     std::vector<Item> stack;
     stack.reserve(64);
     walk_subtree(access, items[t], v, with_colors, stack, chunk, out);

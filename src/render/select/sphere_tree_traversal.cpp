@@ -19,19 +19,23 @@
 
 namespace pointillist {
 
-void SplatChunk::reserve(std::size_t n, bool with_colors) {
-  if (n <= capacity() && (!with_colors || color.size() >= n)) return;
-  const std::size_t cap = std::max(n, 2 * capacity());
-  x_px.resize(cap);
-  y_px.resize(cap);
-  depth.resize(cap);
-  size_px.resize(cap);
-  shaded.resize(cap);
-  center.resize(cap);
-  radius.resize(cap);
-  normal.resize(cap);
-  node.resize(cap);
-  if (with_colors) color.resize(cap);
+void SplatChunk::reserve(std::size_t n, bool with_colors, bool with_discs) {
+  const bool grow = n > capacity();
+  const std::size_t cap = grow ? std::max(n, 2 * capacity()) : capacity();
+  if (grow) {
+    x_px.resize(cap);
+    y_px.resize(cap);
+    depth.resize(cap);
+    size_px.resize(cap);
+    shaded.resize(cap);
+    normal.resize(cap);
+    node.resize(cap);
+  }
+  if (with_colors && color.size() < cap) color.resize(cap);
+  if (with_discs && center.size() < cap) {
+    center.resize(cap);
+    radius.resize(cap);
+  }
 }
 
 namespace {
@@ -91,8 +95,8 @@ void select_splats(const SphereTreeView& tree, const CameraFrame& camera,
   std::vector<TaskState<FlatAccess>> tasks;
   Counters top;
   std::vector<std::uint32_t> top_pages;
-  select_qsplat(FlatAccess(tree.nodes), v, tests, tree.has_colors, pool, stream, tasks, top,
-                top_pages);
+  select_qsplat(FlatAccess(tree.nodes), v, tests, tree.has_colors,
+                expected_splats(tree.leaf_count, camera), pool, stream, tasks, top, top_pages);
 
   stats.nodes_visited = top.visited;
   stats.culled_frustum = top.culled_frustum;

@@ -117,7 +117,7 @@ void run_block(const SequentialPointTree& t, Block b, const ViewConstants& v,
     if (k == 0) continue;
     // Pad to whole groups with the last selected entry (its lanes are dropped below).
     for (std::uint32_t p = k; p % kLanes; ++p) selected[p] = selected[k - 1];
-    out.reserve(out.count + k + kLanes, with_colors);
+    out.reserve(out.count + k + kLanes, with_colors, with_discs);
     for (std::uint32_t g = 0; g < k; g += kLanes) {
       const std::uint32_t* idx = selected + g;
       const Float4 dx = Float4{cx[idx[0]], cx[idx[1]], cx[idx[2]], cx[idx[3]]} - v.eye.x;

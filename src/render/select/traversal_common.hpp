@@ -21,6 +21,19 @@ constexpr std::uint8_t kTestBackface = 2;
 constexpr std::uint8_t kDecidedDraw = 4;  // top-level item already visited: just draw it
 constexpr std::size_t kTargetTasks = 128;
 constexpr std::size_t kInitialChunkCapacity = 128;
+// A chunk's first capacity: an even share of `expected` splats (Buffer memory that is never
+// written is never touched, so a first frame sized generously costs no page faults for what it
+// does not draw, and no regrowth copies).
+inline std::size_t first_chunk_capacity(std::uint64_t expected, std::size_t chunks) {
+  return std::max<std::size_t>(kInitialChunkCapacity,
+                               static_cast<std::size_t>(expected / std::max<std::size_t>(chunks, 1)));
+}
+// The splats a view is expected to draw at most, for sizing a first frame: no more than the
+// model's leaves, and no more than a few per pixel.
+inline std::uint64_t expected_splats(std::uint64_t leaves, const CameraFrame& camera) {
+  const std::uint64_t pixels = static_cast<std::uint64_t>(camera.width) * camera.height;
+  return std::min(leaves, 2 * pixels);
+}
 constexpr float kMaxCoordinate = 1e9f;  // pixels; larger (or NaN) splat coordinates are dropped
 
 struct Pending {
@@ -92,7 +105,8 @@ inline Decision visit(const SphereNode& n, const ViewConstants& v, std::uint8_t&
 // traversal has at hand is written; finish_chunk fills in the rest.
 class Emitter {
  public:
-  Emitter(SplatChunk& out, bool with_colors) : out_(out), with_colors_(with_colors) {
+  Emitter(SplatChunk& out, bool with_colors, bool with_discs)
+      : out_(out), with_colors_(with_colors), with_discs_(with_discs) {
     refresh();
   }
   ~Emitter() { out_.count = count_; }
@@ -134,7 +148,7 @@ class Emitter {
  private:
   void grow() {
     out_.count = count_;
-    out_.reserve(count_ + 1, with_colors_);
+    out_.reserve(count_ + 1, with_colors_, with_discs_);
     refresh();
   }
   void refresh() {
@@ -148,7 +162,7 @@ class Emitter {
   }
 
   SplatChunk& out_;
-  bool with_colors_;
+  bool with_colors_, with_discs_;
   std::size_t count_ = 0, capacity_ = 0;
   float *x_ = nullptr, *y_ = nullptr, *depth_ = nullptr, *size_ = nullptr;
   std::uint32_t* node_ = nullptr;
