@@ -14,14 +14,13 @@ work=${1:-$(mktemp -d)}
 mkdir -p "$work"
 frames=${LOD_FRAMES:-24}
 
-# median FIELD FILE: median over the "path" frames of a stats JSON of one numeric field
-# (frames entries are one JSON object per line).
+# median FIELD FILE: median over the "path" frames of a stats JSON of one numeric field.
 median() {
-  grep '"phase": "path"' "$2" | sed -n "s/.*\"$1\": \([0-9.e+-]*\).*/\1/p" | sort -g |
-    awk '{ v[NR] = $1 } END { if (NR == 0) print "nan"; else print v[int((NR + 1) / 2)] }'
+  jq -r --arg f "$1" '[.frames[] | select(.phase == "path") | .[$f]] | sort |
+    if length == 0 then "nan" else .[((length + 1) / 2 | floor) - 1] end' "$2"
 }
-field() {  # field NAME FILE: a top-level numeric field of a stats JSON
-  sed -n "s/^  \"$1\": \([0-9.e+-]*\).*/\1/p" "$2" | head -1
+field() {  # field NAME FILE: a top-level field of a stats JSON
+  jq -r --arg f "$1" '.[$f] // "nan"' "$2"
 }
 
 model_rows() {  # model_rows NAME MODEL.ptl FRAME_MS

@@ -18,12 +18,9 @@ seconds() {  # seconds CMD...: wall time of one run
   t0=$(date +%s.%N); "$@" >/dev/null; t1=$(date +%s.%N)
   awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.3f", b - a }'
 }
-field() {  # field NAME FILE: a top-level numeric field of a stats JSON
-  sed -n "s/^  \"$1\": \([0-9.e+-]*\).*/\1/p" "$2" | head -1
-}
 median_ms() {  # median of the frames' "ms" from the 10th frame on
-  grep '"phase"' "$1" | tail -n +10 | sed -n 's/.*"ms": \([0-9.]*\).*/\1/p' | sort -g |
-    awk '{ v[NR] = $1 } END { print (NR ? v[int((NR + 1) / 2)] : "nan") }'
+  jq -r '[.frames[9:][] | .ms] | sort |
+    if length == 0 then "nan" else .[((length + 1) / 2 | floor) - 1] end' "$1"
 }
 
 rows() {  # rows NAME MODEL.ptl POINTS
@@ -37,7 +34,7 @@ rows() {  # rows NAME MODEL.ptl POINTS
   full=$(seconds "$cli" render "$model" -o "$work/p.png" --memory 1000G -q)
   whole=$(seconds "$cli" render "$model" -o "$work/p.png" -q)
   printf '%-10s %-42s %12s\n' "" "first frame, s (bytes read for it)" \
-    "$first ($(grep '"phase"' "$work/first.json" | sed -n 's/.*"bytes_read": \([0-9]*\).*/\1/p'))"
+    "$first ($(jq -r '.frames[0].bytes_read' "$work/first.json"))"
   printf '%-10s %-42s %12s\n' "" "full detail page by page, s" "$full"
   printf '%-10s %-42s %12s\n' "" "baseline: decode whole + render, s" "$whole"
   # Steady-state frames: the same view 40 times, paged (everything resident after a few frames)

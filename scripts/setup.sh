@@ -7,6 +7,7 @@ packages=(
   build-essential cmake pkg-config git
   libnanoflann-dev libeigen3-dev libcli11-dev libspng-dev zlib1g-dev
   nlohmann-json3-dev
+  jq
   libgtest-dev libgmock-dev googletest libbenchmark-dev
   nodejs npm
 )

@@ -8,10 +8,10 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "stats_json.hpp"
 #include "terminal_progress.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/io/png.hpp"
+#include "pointillist/pipeline/report.hpp"
 #include "pointillist/pipeline/scene.hpp"
 #include "pointillist/render/depth_image.hpp"
 #include "pointillist/render/sequence.hpp"
@@ -100,58 +100,6 @@ void check_options(const RenderOptions& o) {
   }
 }
 
-// Extra --stats lines for the last frame.
-std::string extra_json(const RenderOptions& o, const Renderer& renderer) {
-  const FrameSettings& f = o.frame;
-  const char* mode = f.rasterizer == Rasterizer::Quality     ? "quality"
-                     : f.rasterizer == Rasterizer::Reference ? "reference"
-                                                             : "fast";
-  if (renderer.paging()) {
-    const PagingStats p = renderer.paging_stats();
-    char buf[768];
-    std::snprintf(buf, sizeof buf,
-                  "  \"lod\": \"qsplat\",\n  \"mode\": \"%s\",\n  \"paged\": true,\n"
-                  "  \"pages\": %u,\n  \"model_bytes\": %llu,\n  \"memory_cap\": %llu,\n"
-                  "  \"bytes_read\": %llu,\n  \"resident_bytes\": %llu,\n"
-                  "  \"resident_bytes_peak\": %llu,\n  \"pages_loaded\": %llu,\n"
-                  "  \"pages_evicted\": %llu,\n  \"complete\": %s,\n",
-                  mode, p.pages, static_cast<unsigned long long>(p.model_bytes),
-                  static_cast<unsigned long long>(o.memory_cap),
-                  static_cast<unsigned long long>(p.cache.bytes_read),
-                  static_cast<unsigned long long>(p.cache.resident_bytes),
-                  static_cast<unsigned long long>(p.cache.resident_bytes_peak),
-                  static_cast<unsigned long long>(p.cache.pages_loaded),
-                  static_cast<unsigned long long>(p.cache.pages_evicted),
-                  p.complete ? "true" : "false");
-    return buf;
-  }
-  if (f.rasterizer == Rasterizer::Reference) return "  \"mode\": \"reference\",\n";
-  if (f.lod == LodScheme::QSplat && f.rasterizer == Rasterizer::Fast) {
-    return "  \"lod\": \"qsplat\",\n  \"mode\": \"fast\",\n";
-  }
-  if (f.lod == LodScheme::QSplat) {
-    char buf[256];
-    std::snprintf(buf, sizeof buf,
-                  "  \"lod\": \"qsplat\",\n  \"mode\": \"quality\",\n  \"reconstruction\": \"%s\",\n"
-                  "  \"opacity\": %g,\n",
-                  f.quality.reconstruction == Reconstruction::ZRange ? "zrange" : "zthreshold",
-                  double(f.quality.opacity));
-    return buf;
-  }
-  const SptSelectionStats& s = renderer.spt_stats();
-  char buf[512];
-  std::snprintf(buf, sizeof buf,
-                "  \"lod\": \"spt\",\n  \"mode\": \"%s\",\n  \"list_length\": %llu,\n"
-                "  \"entries_scanned\": %llu,\n  \"fraction_scanned\": %.4f,\n"
-                "  \"chunks\": %llu,\n  \"chunks_culled\": %llu,\n",
-                mode, static_cast<unsigned long long>(s.entries_total),
-                static_cast<unsigned long long>(s.entries_scanned),
-                s.entries_total ? double(s.entries_scanned) / double(s.entries_total) : 0.0,
-                static_cast<unsigned long long>(s.chunks_total),
-                static_cast<unsigned long long>(s.chunks_culled));
-  return buf;
-}
-
 }  // namespace
 
 int run_render(const RenderOptions& o) {
@@ -204,10 +152,12 @@ int run_render(const RenderOptions& o) {
   }
   const float finest = std::min(1.0f, initial_detail(o.settings, o.frame));
   if (!o.stats_output.empty()) {
-    const std::string extra = extra_json(o, renderer);
-    write_text(o.stats_output, sequence ? sequence_to_json(frames, o.frame_ms,
-                                                           kSettleFrames, finest, extra)
-                                        : stats_to_json(frame.stats, extra));
+    write_text(o.stats_output,
+               render_report_json({.scene = &scene, .renderer = &renderer, .frame = o.frame,
+                                   .memory_cap = o.memory_cap, .last = frame.stats,
+                                   .sequence = sequence, .frames = frames,
+                                   .target_ms = o.frame_ms, .settle = kSettleFrames,
+                                   .finest = finest}));
   }
   if (o.quiet || o.stats_output == "-") return 0;
   std::string names;

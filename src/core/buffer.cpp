@@ -26,7 +26,7 @@ namespace {
 constexpr std::size_t kHugePage = std::size_t{2} << 20;
 constexpr std::size_t kRegion = std::size_t{64} << 20;
 constexpr unsigned kMinShift = 12;  // 4 KiB
-constexpr unsigned kMaxShift = 26;  // blocks up to a region
+constexpr unsigned kMaxShift = 25;  // blocks up to half a region
 
 // A mapping of `bytes` (a multiple of kHugePage) aligned to kHugePage, advised for huge pages.
 void* map_aligned(std::size_t bytes) {
@@ -58,12 +58,17 @@ class Regions {
       list.pop_back();
       return p;
     }
-    if (next_ + size > end_) {
+    // Each block starts a different number of cache lines into its slot: blocks of equal
+    // power-of-two sizes would otherwise start at the same offset modulo 4 KiB, and the arrays
+    // of one splat chunk, written at the same index together, would all compete for the same
+    // cache sets (a third slower selection).
+    const std::size_t slot = size + kColours * kLine;
+    if (next_ + slot > end_) {
       next_ = reinterpret_cast<std::uintptr_t>(map_aligned(kRegion));
       end_ = next_ + kRegion;
     }
-    void* p = reinterpret_cast<void*>(next_);
-    next_ += size;
+    void* p = reinterpret_cast<void*>(next_ + (colour_++ % kColours) * kLine);
+    next_ += slot;
     return p;
   }
 
@@ -89,7 +94,9 @@ class Regions {
   }
 
   std::mutex mutex_;
+  static constexpr std::size_t kLine = 64, kColours = 31;
   std::uintptr_t next_ = 0, end_ = 0;
+  std::size_t colour_ = 0;
   std::array<std::vector<void*>, kMaxShift - kMinShift + 1> free_;
 };
 

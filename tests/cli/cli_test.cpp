@@ -3,10 +3,13 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
+
+#include <nlohmann/json.hpp>
 
 #include "pointillist/io/ply.hpp"
 #include "pointillist/io/png.hpp"
@@ -148,18 +151,18 @@ TEST(Cli, OrbitPathWithRefinementWritesEveryFrameAndEndsAtFullDetail) {
                        frames + " --stats -");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   // 4 path frames at azimuths 0, 90, 180, 270 (threshold 6), then 3 refining to 1 px: 6, √6, 1.
-  for (const char* s : {"\"azimuth\": 0.000", "\"azimuth\": 90.000", "\"azimuth\": 180.000",
-                        "\"azimuth\": 270.000"}) {
-    EXPECT_THAT(r.output, HasSubstr(s));
+  const auto stats = nlohmann::json::parse(r.output);
+  const auto& f = stats.at("frames");
+  ASSERT_EQ(f.size(), 7u);
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_EQ(f[i].at("phase"), "path");
+    EXPECT_DOUBLE_EQ(f[i].at("azimuth").get<double>(), 90.0 * i);
+    EXPECT_DOUBLE_EQ(f[i].at("detail").get<double>(), 6.0);
   }
-  std::size_t path = 0, refine = 0;
-  for (std::size_t at = 0; (at = r.output.find("\"phase\": \"path\"", at)) != std::string::npos; ++at) ++path;
-  for (std::size_t at = 0; (at = r.output.find("\"phase\": \"refine\"", at)) != std::string::npos; ++at) ++refine;
-  EXPECT_EQ(path, 4u);
-  EXPECT_EQ(refine, 3u);
-  EXPECT_THAT(r.output, HasSubstr("\"threshold\": 2.4495"));
-  const std::size_t last = r.output.rfind("\"phase\"");
-  EXPECT_NE(r.output.find("\"threshold\": 1.0000", last), std::string::npos);
+  for (int i = 4; i < 7; ++i) EXPECT_EQ(f[i].at("phase"), "refine");
+  EXPECT_NEAR(f[4].at("detail").get<double>(), 6.0, 1e-5);
+  EXPECT_NEAR(f[5].at("detail").get<double>(), std::sqrt(6.0), 1e-5);
+  EXPECT_NEAR(f[6].at("detail").get<double>(), 1.0, 1e-6);
   for (int i = 0; i < 7; ++i) {
     char name[32];
     std::snprintf(name, sizeof name, "/frame_%05d.png", i);
@@ -181,8 +184,9 @@ TEST(Cli, FrameTimeControlReportsAHitRate) {
   const Result r = run("render " + ply + " -o " + dir.file("x.png") +
                        " --size 64x48 --path orbit:12 --frame-ms 1000 --stats -");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_THAT(r.output, HasSubstr("\"target_ms\": 1000.000"));
-  EXPECT_THAT(r.output, HasSubstr("\"hit_rate\": 1.0000"));
+  const auto stats = nlohmann::json::parse(r.output);
+  EXPECT_EQ(stats.at("target_ms").get<double>(), 1000.0);
+  EXPECT_EQ(stats.at("hit_rate").get<double>(), 1.0);
 }
 
 TEST(Cli, BadSequenceOptionsAreExplained) {

@@ -1,0 +1,100 @@
+#include "pointillist/pipeline/report.hpp"
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+namespace pointillist {
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+double ms(double v) { return std::round(v * 1000.0) / 1000.0; }
+
+const char* kind_name(ModelKind k) {
+  switch (k) {
+    case ModelKind::Scan: return "scan";
+    case ModelKind::PtlV1: return "ptl v1";
+    case ModelKind::PtlV2: return "ptl v2";
+    case ModelKind::Qsplat: return "qs";
+  }
+  return "?";
+}
+
+}  // namespace
+
+std::string render_report_json(const RenderReport& r) {
+  const RenderStats& s = r.last;
+  const FrameSettings& f = r.frame;
+  Json j;
+  j["splats"] = s.splats;
+  j["nodes_visited"] = s.nodes_visited;
+  j["culled_frustum"] = s.culled_frustum;
+  j["culled_backface"] = s.culled_backface;
+  j["width"] = s.width;
+  j["height"] = s.height;
+  j["threads"] = s.threads;
+  const bool reference = f.rasterizer == Rasterizer::Reference;
+  if (!reference) j["lod"] = f.lod == LodScheme::Spt ? "spt" : "qsplat";
+  j["mode"] = reference ? "reference" : f.rasterizer == Rasterizer::Quality ? "quality" : "fast";
+  if (f.rasterizer == Rasterizer::Quality) {
+    j["reconstruction"] =
+        f.quality.reconstruction == Reconstruction::ZRange ? "zrange" : "zthreshold";
+    j["opacity"] = f.quality.opacity;
+  }
+  if (r.renderer && f.lod == LodScheme::Spt && !reference) {
+    const SptSelectionStats& spt = r.renderer->spt_stats();
+    j["list_length"] = spt.entries_total;
+    j["entries_scanned"] = spt.entries_scanned;
+    j["fraction_scanned"] =
+        spt.entries_total ? double(spt.entries_scanned) / double(spt.entries_total) : 0.0;
+    j["chunks"] = spt.chunks_total;
+    j["chunks_culled"] = spt.chunks_culled;
+  }
+  if (r.renderer && r.renderer->paging()) {
+    const PagingStats p = r.renderer->paging_stats();
+    j["paged"] = true;
+    j["pages"] = p.pages;
+    j["model_bytes"] = p.model_bytes;
+    j["memory_cap"] = r.memory_cap;
+    j["bytes_read"] = p.cache.bytes_read;
+    j["resident_bytes"] = p.cache.resident_bytes;
+    j["resident_bytes_peak"] = p.cache.resident_bytes_peak;
+    j["pages_loaded"] = p.cache.pages_loaded;
+    j["pages_evicted"] = p.cache.pages_evicted;
+    j["complete"] = p.complete;
+  }
+  if (r.scene) {
+    Json models = Json::array();
+    for (const auto& m : r.scene->models()) {
+      models.push_back({{"path", m->path()}, {"kind", kind_name(m->kind())},
+                        {"paging", m->paging_reason()}});
+    }
+    j["models"] = std::move(models);
+  }
+  j["ms"] = {{"select", ms(s.ms_select)}, {"raster", ms(s.ms_raster)}, {"total", ms(s.ms_total)}};
+  if (r.sequence) {
+    if (r.target_ms > 0) {
+      j["target_ms"] = r.target_ms;
+      j["hit_rate"] = hit_rate(r.frames, r.target_ms, r.settle, r.finest);
+    }
+    Json frames = Json::array();
+    for (const SequenceFrame& fr : r.frames) {
+      Json o{{"phase", fr.phase},
+             {"azimuth", fr.azimuth_deg},
+             {"detail", fr.detail},
+             {"splats", fr.stats.splats},
+             {"ms", ms(fr.stats.ms_total)},
+             {"ms_select", ms(fr.stats.ms_select)},
+             {"ms_raster", ms(fr.stats.ms_raster)}};
+      if (fr.bytes_read >= 0) {
+        o["bytes_read"] = fr.bytes_read;
+        o["resident_bytes"] = fr.resident_bytes;
+      }
+      frames.push_back(std::move(o));
+    }
+    j["frames"] = std::move(frames);
+  }
+  return j.dump(2) + "\n";
+}
+
+}  // namespace pointillist
