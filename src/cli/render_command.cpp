@@ -1,5 +1,6 @@
 // `pointillist render`: opens the models (or a scene file), then the library's Renderer draws a
 // settled image or a frame sequence; writes the PNG, the depth image and the statistics.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -111,12 +112,14 @@ int run_render(const RenderOptions& o) {
   TerminalProgress progress(!o.quiet && TerminalProgress::stderr_is_terminal());
   const bool paging_asked = o.memory_cap > 0 || o.progressive_frames > 0;
   const bool paging_possible =
-      o.frame.rasterizer == Rasterizer::Fast && o.frame.lod == LodScheme::QSplat;
+      o.frame.rasterizer != Rasterizer::Reference && o.frame.lod == LodScheme::QSplat;
   OpenModelOptions open;
   open.prepare = o.prepare;
   open.columns = o.columns;
   open.keep_source = o.frame.rasterizer == Rasterizer::Reference;
   open.paging = paging_asked ? Paging::Always : (paging_possible ? Paging::Auto : Paging::Never);
+  open.frames = std::max<std::uint64_t>(1, std::uint64_t(o.orbit_frames) + o.refine_frames);
+  open.frame_pixels = std::uint64_t(o.view.width) * std::uint64_t(o.view.height);
   const Scene scene = o.inputs.size() == 1 && is_scene_file(o.inputs[0])
                           ? read_scene(o.inputs[0], open, pool, progress)
                           : scene_of_models(o.inputs, open, pool, progress);

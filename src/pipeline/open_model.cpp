@@ -28,6 +28,11 @@ std::uint64_t physical_memory_bytes() {
 }
 
 std::string megabytes(double bytes) { return std::to_string(std::uint64_t(bytes / 1e6)) + " MB"; }
+std::string milliseconds(double ns) { return std::to_string(std::uint64_t(ns / 1e6 + 0.5)) + " ms"; }
+
+// The costs Paging::Auto weighs (see OpenModelOptions::frames).
+constexpr double kDecodeNsPerNode = 100.0;
+constexpr double kPagingNsPerPixel = 2.7;
 
 }  // namespace
 
@@ -55,13 +60,30 @@ Model Model::open_file(const std::string& path, const OpenModelOptions& options,
       case Paging::Never:
         model.paging_reason_ = "decoded whole: the frames need the whole hierarchy";
         break;
-      case Paging::Auto:
-        paged = decoded_bytes > memory / 4;
-        model.paging_reason_ =
-            std::string(paged ? "paged" : "decoded whole") + ": the decoded hierarchy takes " +
-            megabytes(decoded_bytes) + (paged ? ", more" : ", less") +
-            " than a quarter of the memory (" + megabytes(memory) + ")";
+      case Paging::Auto: {
+        const double decode_ns = kDecodeNsPerNode * double(model.v2_->node_count());
+        const double paging_ns =
+            kPagingNsPerPixel * double(options.frames) * double(options.frame_pixels);
+        const std::string frames = std::to_string(options.frames) +
+                                   (options.frames == 1 ? " frame" : " frames");
+        if (decoded_bytes > memory / 4) {
+          paged = true;
+          model.paging_reason_ = "paged: the decoded hierarchy would take " +
+                                 megabytes(decoded_bytes) + ", more than a quarter of the memory (" +
+                                 megabytes(memory) + ")";
+        } else if (options.frames > 1) {
+          model.paging_reason_ =
+              "decoded whole: the " + frames + " of a sequence draw from the whole hierarchy "
+              "(paged, they would show pages still loading)";
+        } else {
+          paged = paging_ns < decode_ns;
+          model.paging_reason_ =
+              std::string(paged ? "paged" : "decoded whole") + ": for " + frames +
+              ", drawing from pages adds about " + milliseconds(paging_ns) + (paged ? ", less" : ", more") +
+              " than decoding the whole hierarchy takes (about " + milliseconds(decode_ns) + ")";
+        }
         break;
+      }
     }
     if (paged) {
       model.pages_ = ptl_v2_page_source(*model.v2_);

@@ -3,6 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <string>
@@ -13,6 +14,7 @@
 #include "pointillist/io/ply.hpp"
 #include "pointillist/pipeline/convert.hpp"
 #include "pointillist/pipeline/model.hpp"
+#include "pointillist/render/sequence.hpp"
 #include "pointillist/scene/analytic.hpp"
 #include "testing/testing.hpp"
 
@@ -157,6 +159,41 @@ TEST(OpenModel, AutoPagingPagesWhatWouldTakeMoreThanAQuarterOfTheMemory) {
   EXPECT_EQ(big_machine.tree().leaf_count, 3000u);
   EXPECT_GT(big_machine.tree().nodes.size(), 3000u);
   EXPECT_TRUE(open_model(dir.file("s.ptl"), paging(Paging::Always), pool, Progress::none()).paged());
+}
+
+TEST(OpenModel, AutoPagingPagesASingleImageWhenDecodingCostsMoreAndDecodesASequence) {
+  pointillist::testing::TempDir dir;
+  const std::vector<std::string> in = {write_sphere(dir, 3000)};
+  ThreadPool pool(2);
+  convert(in, dir.file("s.ptl"), {}, pool, Progress::none());
+  // About 4000 nodes: decoding them (~0.4 ms) costs more than paging adds to one 64x48 image
+  // (~8 us), less than paging adds to one 1280x720 image (~2.5 ms).
+  OpenModelOptions small = paging(Paging::Auto, 1'000'000'000);
+  small.frame_pixels = 64 * 48;
+  const Model paged = open_model(dir.file("s.ptl"), small, pool, Progress::none());
+  EXPECT_TRUE(paged.paged());
+  EXPECT_THAT(paged.paging_reason(), HasSubstr("less than decoding"));
+  OpenModelOptions large = small;
+  large.frame_pixels = 1280 * 720;
+  EXPECT_FALSE(open_model(dir.file("s.ptl"), large, pool, Progress::none()).paged());
+  // A sequence is decoded whole, whatever the sizes.
+  OpenModelOptions sequence = small;
+  sequence.frames = 2;
+  const Model whole = open_model(dir.file("s.ptl"), sequence, pool, Progress::none());
+  EXPECT_FALSE(whole.paged());
+  EXPECT_THAT(whole.paging_reason(), HasSubstr("sequence"));
+
+  // The single image is the same either way: the paged model, settled, against the decoded one.
+  Frame a, b;
+  const Camera cam = orbit_camera(whole.tree().view_sphere, {.width = 64, .height = 48});
+  Renderer ra, rb;
+  const SceneInstance ia{&paged.renderable(), {}}, ib{&whole.renderable(), {}};
+  render_settled(ra, {&ia, 1}, cam, RenderSettings{}, FrameSettings{}, pool, a);
+  render_settled(rb, {&ib, 1}, cam, RenderSettings{}, FrameSettings{}, pool, b);
+  EXPECT_TRUE(ra.paging());
+  EXPECT_FALSE(rb.paging());
+  ASSERT_GT(b.stats.splats, 100u);
+  EXPECT_TRUE(std::equal(a.color.begin(), a.color.end(), b.color.begin(), b.color.end()));
 }
 
 TEST(OpenModel, KeepsTheScanOnlyWhenAsked) {
