@@ -1,5 +1,7 @@
 #include "bench_data.hpp"
 
+#include "pointillist/core/model_cache.hpp"
+
 #include <cstdlib>
 #include <filesystem>
 #include <map>
@@ -12,19 +14,7 @@ namespace pointillist::bench {
 
 bool smoke_mode() { return std::getenv("POINTILLIST_BENCH_SMOKE") != nullptr; }
 
-std::string dragon_path() {
-  std::filesystem::path dir;
-  // As scripts/fetch-models.sh and the tests: $POINTILLIST_MODELS, else the XDG cache.
-  if (const char* env = std::getenv("POINTILLIST_MODELS"); env && *env) {
-    dir = env;
-  } else if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) {
-    dir = std::filesystem::path(xdg) / "pointillist" / "models";
-  } else if (const char* home = std::getenv("HOME"); home && *home) {
-    dir = std::filesystem::path(home) / ".cache" / "pointillist" / "models";
-  }
-  const auto path = dir / "dragon_vrip.ply.gz";
-  return std::filesystem::exists(path) ? path.string() : std::string{};
-}
+std::string dragon_path() { return cached_model_path("dragon_vrip.ply.gz"); }
 
 const PointSet& dragon_raw() {
   static const PointSet points = [] {

@@ -8,12 +8,12 @@
 #include "commands.hpp"
 #include "options.hpp"
 #include "util.hpp"
-#include "pointillist/io/merge.hpp"
-#include "pointillist/pipeline/model.hpp"
 #include "terminal_progress.hpp"
 #include "pointillist/core/error.hpp"
-#include "pointillist/format/ptl_v2.hpp"
+#include "pointillist/core/model_cache.hpp"
 #include "pointillist/io/ply.hpp"
+#include "pointillist/pipeline/convert.hpp"
+#include "pointillist/pipeline/model.hpp"
 #include "pointillist/io/png.hpp"
 #include "pointillist/scene/analytic.hpp"
 
@@ -30,29 +30,16 @@ struct DemoView {
   float azimuth_deg, elevation_deg;
 };
 
-const char* shape_name(SplatShape s) {
-  switch (s) {
-    case SplatShape::Square: return "square";
-    case SplatShape::Circle: return "circle";
-    case SplatShape::Ellipse: return "ellipse";
-  }
-  return "?";
-}
-
 // Converts `input` to `output` (.ptl) and prints one summary row.
 void convert_for_demo(const std::string& input, const std::string& output, ThreadPool& pool,
                       Progress& progress) {
   const auto start = std::chrono::steady_clock::now();
   const std::string inputs[] = {input};
-  PointSet points = merge_inputs(inputs, pool, progress);
-  prepare_splats(points, pool, progress, {});
-  const SphereTree tree = build_sphere_tree(points, pool, progress);
-  write_ptl_v2(output, tree, "generator: pointillist demo\nsource: " + input + "\n");
+  const std::size_t points = convert(inputs, output, {}, pool, progress).output_points;
   const double s = seconds_since(start);
   std::printf("  convert %-28s %9zu points  %7.3f s  %6.2f M points/s  %5.1f bytes/point\n",
-              std::filesystem::path(input).filename().c_str(), points.size(), s,
-              points.size() / s / 1e6,
-              double(std::filesystem::file_size(output)) / double(points.size()));
+              std::filesystem::path(input).filename().c_str(), points, s, points / s / 1e6,
+              double(std::filesystem::file_size(output)) / double(points));
 }
 
 void render_views(const std::string& model_path, const std::string& stem,
@@ -71,9 +58,8 @@ void render_views(const std::string& model_path, const std::string& stem,
       RenderSettings settings;
       settings.shape = shape;
       settings.background = {24, 26, 32};
-      render(model.tree(), camera, settings, pool, frame);  // warm-up: page in, size buffers
       render(model.tree(), camera, settings, pool, frame);
-      const std::string file = stem + "_" + v.name + "_" + shape_name(shape) + ".png";
+      const std::string file = stem + "_" + v.name + "_" + name(shape) + ".png";
       write_png_rgb8((dir / file).string(), frame.width, frame.height, frame.color);
       std::printf("  render  %-38s %9llu splats  %7.2f ms  %6.1f M splats/s\n", file.c_str(),
                   static_cast<unsigned long long>(frame.stats.splats), frame.stats.ms_total,

@@ -34,8 +34,8 @@ std::string render_report_json(const RenderReport& r) {
   j["height"] = s.height;
   j["threads"] = s.threads;
   const bool reference = f.rasterizer == Rasterizer::Reference;
-  if (!reference) j["lod"] = f.lod == LodScheme::Spt ? "spt" : "qsplat";
-  j["mode"] = reference ? "reference" : f.rasterizer == Rasterizer::Quality ? "quality" : "fast";
+  if (!reference) j["lod"] = name(f.lod);
+  j["mode"] = name(f.rasterizer);
   if (f.rasterizer == Rasterizer::Quality) {
     j["reconstruction"] =
         f.quality.reconstruction == Reconstruction::ZRange ? "zrange" : "zthreshold";

@@ -12,17 +12,8 @@ namespace pointillist::testing {
 std::filesystem::path test_data_dir() { return POINTILLIST_TEST_DATA_DIR; }
 std::filesystem::path shared_testdata_dir() { return POINTILLIST_SHARED_TESTDATA_DIR; }
 
-std::filesystem::path model_cache_dir() {
-  if (const char* dir = std::getenv("POINTILLIST_MODELS"); dir && *dir) return dir;
-  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg)
-    return std::filesystem::path(xdg) / "pointillist" / "models";
-  const char* home = std::getenv("HOME");
-  return std::filesystem::path(home ? home : "/tmp") / ".cache" / "pointillist" / "models";
-}
-
 std::filesystem::path cached_model(const std::string& file_name) {
-  const auto path = model_cache_dir() / file_name;
-  return std::filesystem::exists(path) ? path : std::filesystem::path{};
+  return pointillist::cached_model_path(file_name);
 }
 
 TempDir::TempDir() {

@@ -5,7 +5,11 @@
 #include <filesystem>
 #include <string>
 
+#include "pointillist/core/model_cache.hpp"
+
 namespace pointillist::testing {
+
+using pointillist::model_cache_dir;  // core/model_cache.hpp
 
 // tests/data in the source tree (small files committed with the tests).
 std::filesystem::path test_data_dir();
@@ -19,10 +23,8 @@ std::filesystem::path shared_testdata_dir();
                << ::pointillist::testing::shared_testdata_dir()                           \
                << " (../shared/testdata beside the project)"
 
-// The model cache filled by scripts/fetch-models.sh: $POINTILLIST_MODELS, else
-// $XDG_CACHE_HOME/pointillist/models, else ~/.cache/pointillist/models.
-std::filesystem::path model_cache_dir();
-// Path of a fetched model (e.g. "dragon_vrip.ply.gz"), or empty when it has not been fetched.
+// The model cache filled by scripts/fetch-models.sh (core/model_cache.hpp): model_cache_dir(),
+// and the path of a fetched model (e.g. "dragon_vrip.ply.gz"), empty when it is not there.
 std::filesystem::path cached_model(const std::string& file_name);
 
 // A fresh, empty temporary folder removed when the object dies.

@@ -36,6 +36,13 @@ enum class Rasterizer {
   Reference,  // the source mesh's triangles (a scan with faces, single instance)
 };
 
+// The names the command line and the reports use: "qsplat", "spt"; "fast", "quality",
+// "reference".
+constexpr const char* name(LodScheme l) { return l == LodScheme::Spt ? "spt" : "qsplat"; }
+constexpr const char* name(Rasterizer r) {
+  return r == Rasterizer::Fast ? "fast" : r == Rasterizer::Quality ? "quality" : "reference";
+}
+
 // What the renderer needs of a model: its hierarchy (whole, or only its counts and boxes when it
 // is paged), its pages, and for the reference rasterizer its mesh. The pointed-to data must
 // outlive the renderer's use of it; the address identifies the model across frames.

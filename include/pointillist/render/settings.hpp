@@ -11,6 +11,11 @@ enum class SplatShape {
   Ellipse,  // disc seen at an angle: major axis = projected diameter, minor/major = max(|n·v|, 0.1)
 };
 
+// The name the command line and the reports use: "square", "circle", "ellipse".
+constexpr const char* name(SplatShape s) {
+  return s == SplatShape::Square ? "square" : s == SplatShape::Circle ? "circle" : "ellipse";
+}
+
 // Shading model (per splat, or per pixel for the triangle reference), with every vector in eye
 // space, n the unit normal, v the unit vector to the eye, l = normalized light_dir_eye and
 // h = normalize(l + v):
