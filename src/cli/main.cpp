@@ -8,17 +8,24 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "options.hpp"
+#include "pointillist/core/atomic_file.hpp"
 #include "pointillist/core/error.hpp"
 
 namespace pc = pointillist::cli;
 
 int main(int argc, char** argv) {
+  pointillist::remove_temporary_files_on_signals();
   CLI::App app{"Pointillist: multiresolution splat models from 3D scans, rendered fast on the CPU"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "pointillist 0.1.0");
   const std::vector<pc::Command> commands = {
       pc::add_convert_command(app), pc::add_render_command(app),  pc::add_info_command(app),
       pc::add_demo_command(app),    pc::add_generate_command(app), pc::add_compare_command(app)};
+  if (const std::string error = pc::unknown_word(app, argc, argv); !error.empty()) {
+    std::fprintf(stderr, "pointillist: error: %s\n", error.c_str());
+    return 2;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -2,10 +2,12 @@
 #include "options.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <sstream>
 
 #include "pointillist/core/error.hpp"
+#include "pointillist/core/thread_pool.hpp"
 
 namespace pointillist::cli {
 namespace {
@@ -111,7 +113,20 @@ void add_columns(CLI::App* app, std::string& columns) {
 }
 
 void add_threads(CLI::App* app, unsigned& threads) {
-  app->add_option("--threads", threads, "Worker threads (0 = one per core)")->default_val(0);
+  const unsigned cap = ThreadPool::max_threads();
+  app->add_option("--threads", threads,
+                  "Worker threads (0 = one per core; at most " + std::to_string(cap) +
+                      ", 4 per core, here)")
+      ->default_val(0)
+      ->each([cap](const std::string& value) {
+        // The pool caps the count; say so rather than silently.
+        if (value.find_first_not_of("0123456789") == std::string::npos && value.size() < 10 &&
+            std::stoul(value) > cap) {
+          std::fprintf(stderr,
+                       "pointillist: warning: --threads %s is more than 4 per core; using %u\n",
+                       value.c_str(), cap);
+        }
+      });
 }
 
 void add_prepare_options(CLI::App* app, PrepareOptions& p, bool with_radius_scale) {
@@ -130,7 +145,15 @@ void add_prepare_options(CLI::App* app, PrepareOptions& p, bool with_radius_scal
   if (with_radius_scale) {
     app->add_option("--radius-scale", p.radius_scale, "Multiply every splat radius by S")
         ->default_val(1.0f)
-        ->check(CLI::PositiveNumber)
+        ->check(CLI::Validator(
+            [](const std::string& v) {
+              char* end = nullptr;
+              const double x = std::strtod(v.c_str(), &end);
+              return end != v.c_str() && *end == 0 && x > 0 && std::isfinite(x)
+                         ? std::string()
+                         : "must be a positive number, found " + v;
+            },
+            "POSITIVE"))
         ->group(kGroupScan);
   }
   app->add_flag("--drop-outliers", p.drop_outliers,
@@ -142,6 +165,35 @@ void add_prepare_options(CLI::App* app, PrepareOptions& p, bool with_radius_scal
       ->default_val(3.0f)
       ->check(CLI::Range(1.0001f, 1e6f))
       ->group(kGroupScan);
+}
+
+std::string unknown_word(CLI::App& app, int argc, char** argv) {
+  if (argc < 2) return {};
+  const std::string first = argv[1];
+  if (first.empty() || first[0] == '-') return {};  // --help, --version: CLI11's
+  CLI::App* command = nullptr;
+  for (CLI::App* c : app.get_subcommands({})) {
+    if (c->check_name(first)) command = c;
+  }
+  if (!command) {
+    std::string names;
+    for (const CLI::App* c : app.get_subcommands({})) {
+      names += (names.empty() ? "" : ", ") + c->get_name();
+    }
+    return "unknown command '" + first + "'; the commands are " + names +
+           " (pointillist --help describes them)";
+  }
+  for (int i = 2; i < argc; ++i) {
+    const std::string word = argv[i];
+    if (word == "--") break;  // what follows is positional
+    if (word.size() < 3 || word.compare(0, 2, "--") != 0) continue;
+    const std::string name = word.substr(0, word.find('='));
+    if (!command->get_option_no_throw(name)) {
+      return "unknown option " + name + " for '" + first + "'; pointillist " + first +
+             " --help lists its options";
+    }
+  }
+  return {};
 }
 
 }  // namespace pointillist::cli

@@ -65,4 +65,9 @@ void add_threads(CLI::App* app, unsigned& threads);
 // --outlier-ratio); `render` has its own --radius-scale (the drawn size).
 void add_prepare_options(CLI::App* app, PrepareOptions& p, bool with_radius_scale = true);
 
+// What CLI11 would misreport in `argv` (an unknown command reads as "A subcommand is required";
+// an unknown --option before a value makes the value look like a missing input file), as a
+// message; "" when there is nothing of the kind.
+std::string unknown_word(CLI::App& app, int argc, char** argv);
+
 }  // namespace pointillist::cli

@@ -1,6 +1,7 @@
 // `pointillist render`: opens the models (or a scene file), then the library's Renderer draws a
 // settled image or a frame sequence; writes the PNG, the depth image and the statistics.
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -10,6 +11,7 @@
 
 #include "commands.hpp"
 #include "terminal_progress.hpp"
+#include "pointillist/core/atomic_file.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/io/png.hpp"
 #include "pointillist/pipeline/report.hpp"
@@ -73,6 +75,17 @@ SequenceOptions sequence_options(const RenderOptions& o) {
 
 // Checks what only the command line can get wrong (the library checks the rest).
 void check_options(const RenderOptions& o) {
+  check_outputs(o.inputs, {{"-o", o.output}, {"--depth", o.depth_output},
+                           {"--stats", o.stats_output}});
+  for (const auto& [option, path] : {std::pair<const char*, const std::string&>{"-o", o.output},
+                                     {"--depth", o.depth_output}}) {
+    std::string ext = std::filesystem::path(path).extension().string();
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (!path.empty() && ext != ".png") {
+      throw OptionError(std::string(option) + " " + path +
+                        ": render writes PNG images; give a path ending in .png");
+    }
+  }
   check_sequence_options(sequence_options(o));
   if (o.orbit_frames > 0 && (o.view.eye || o.view.target)) {
     throw OptionError("--path orbit:N moves the camera around the orbit; it cannot be combined "
@@ -123,6 +136,10 @@ int run_render(const RenderOptions& o) {
   const Scene scene = o.inputs.size() == 1 && is_scene_file(o.inputs[0])
                           ? read_scene(o.inputs[0], open, pool, progress)
                           : scene_of_models(o.inputs, open, pool, progress);
+  std::vector<std::string> models;  // a scene file's models are inputs too
+  for (const auto& m : scene.models()) models.push_back(m->path());
+  check_outputs(models, {{"-o", o.output}, {"--depth", o.depth_output},
+                         {"--stats", o.stats_output}});
   const Sphere view_sphere = scene.view_sphere();
   const Vec3f up = scene.up();
   Renderer renderer({.page_all = paging_asked, .memory_cap = o.memory_cap});

@@ -138,8 +138,10 @@ FileBytes FileBytes::load(const std::string& path,
 }
 
 FileBytes FileBytes::inflate(const FileBytes& compressed, const std::string& path,
-                             const std::function<void(std::uint64_t)>& on_compressed_bytes) {
+                             const std::function<void(std::uint64_t)>& on_compressed_bytes,
+                             std::function<std::uint64_t(std::string_view)> limit) {
   GzipInflater inflater(compressed.view(), path);
+  inflater.set_limit(std::move(limit));
   inflater.run(true, on_compressed_bytes);
   return inflater.release(compressed.file_size());
 }
@@ -203,6 +205,9 @@ void GzipInflater::run(bool may_grow,
   } finish{this, &zs, &used};
 
   constexpr std::size_t kInChunk = 1 << 20;  // progress and publishing granularity
+  constexpr std::size_t kOutChunk = 16 << 20;  // the most inflated between two limit checks
+  std::uint64_t limit = std::numeric_limits<std::uint64_t>::max();
+  std::size_t next_probe = 0;  // when to ask limit_fn_ again
   std::size_t in_pos = 0;
   bool member_done = false;
   for (;;) {
@@ -228,13 +233,24 @@ void GzipInflater::run(bool may_grow,
     zs.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(in_.data() + in_pos));
     zs.avail_in = static_cast<uInt>(in_chunk);
     const std::size_t out_chunk =
-        std::min<std::size_t>(capacity_ - used, std::numeric_limits<uInt>::max());
+        std::min<std::size_t>({capacity_ - used, std::numeric_limits<uInt>::max(), kOutChunk});
     zs.next_out = reinterpret_cast<Bytef*>(buffer_.get() + used);
     zs.avail_out = static_cast<uInt>(out_chunk);
     const int rc = ::inflate(&zs, Z_NO_FLUSH);
     const std::size_t consumed = in_chunk - zs.avail_in;
     in_pos += consumed;
     used += out_chunk - zs.avail_out;
+    if (limit_fn_ && limit == std::numeric_limits<std::uint64_t>::max() && used >= next_probe) {
+      limit = limit_fn_({buffer_.get(), used});
+      next_probe = used + kInChunk;
+    }
+    if (used > limit) {
+      throw FormatError(path_ + ": decompressed byte " + std::to_string(limit) +
+                        ": the data goes on past the " + std::to_string(limit) +
+                        " bytes its header describes (compressed byte " + std::to_string(in_pos) +
+                        " of " + std::to_string(in_.size()) +
+                        "); the file is corrupt or made to exhaust memory, and is not read");
+    }
     if (!may_grow) publish(used, false);
     if (on_compressed_bytes && consumed > 0) on_compressed_bytes(consumed);
     if (rc == Z_STREAM_END) {

@@ -4,9 +4,11 @@
 
 namespace pointillist {
 
+unsigned ThreadPool::max_threads() { return 4 * std::max(1u, std::thread::hardware_concurrency()); }
+
 ThreadPool::ThreadPool(unsigned thread_count) {
   if (thread_count == 0) thread_count = std::max(1u, std::thread::hardware_concurrency());
-  thread_count_ = thread_count;
+  thread_count_ = std::min(thread_count, max_threads());
   for (unsigned i = 1; i < thread_count_; ++i) workers_.emplace_back([this] { worker_loop(); });
 }
 

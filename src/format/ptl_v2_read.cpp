@@ -174,6 +174,11 @@ std::unique_ptr<PtlV2File> PtlV2File::open(const std::string& path) {
     info = {load_u64(e),      load_u32(e + 8),  load_u32(e + 12), load_u32(e + 16),
             load_u32(e + 20), load_u32(e + 24), load_u32(e + 28)};
     const std::string which = "page " + str(p) + " of " + str(page_count) + ": ";
+    if (info.byte_size > size) {
+      fail_at(path, at + 8,
+              which + "the page is " + str(info.byte_size) + " bytes long, more than the whole "
+              "file (" + str(size) + " bytes): the page table is corrupt");
+    }
     if (info.offset > size || info.byte_size > size - info.offset) {
       fail_at(path, size,
               which + "file ends early: the page needs bytes " + str(info.offset) + " to " +
@@ -223,6 +228,11 @@ std::unique_ptr<PtlV2File> PtlV2File::open(const std::string& path) {
   if (metadata_offset < header_size) {
     fail_at(path, offset::kMetadataOffset,
             "metadata offset " + str(metadata_offset) + " lies inside the header");
+  }
+  if (metadata_size > size) {
+    fail_at(path, offset::kMetadataSize,
+            "the metadata is " + str(metadata_size) + " bytes long, more than the whole file (" +
+                str(size) + " bytes): the header is corrupt");
   }
   if (metadata_offset > size || metadata_size > size - metadata_offset) {
     fail_at(path, size,

@@ -31,6 +31,12 @@ using namespace qs_detail;
 
 
 std::string str(std::uint64_t v) { return std::to_string(v); }
+// A signed 32-bit field as the spec reads it, with its raw bytes: "-1 (0xffffffff)".
+std::string int32_field(std::int32_t v) {
+  char hex[16];
+  std::snprintf(hex, sizeof hex, "%08x", static_cast<std::uint32_t>(v));
+  return std::to_string(v) + " (0x" + hex + ")";
+}
 
 // Reads the fragment header at `at` (spec §2.1-2.3) and checks it against the file.
 QsFragment read_fragment_header(const std::string& path, const std::uint8_t* file,
@@ -73,7 +79,7 @@ QsFragment read_fragment_header(const std::string& path, const std::uint8_t* fil
   const auto length = static_cast<std::int32_t>(load_be32(h + offset::kLength));
   if (length < static_cast<std::int32_t>(header_size)) {
     fail_at(path, at + offset::kLength,
-            "fragment length " + std::to_string(length) + " is shorter than the " +
+            "fragment length " + int32_field(length) + " is shorter than the " +
                 str(header_size) + "-byte " + (f.is_comment ? "comment" : "tree") +
                 " fragment header");
   }
@@ -89,7 +95,7 @@ QsFragment read_fragment_header(const std::string& path, const std::uint8_t* fil
   const auto leaves = static_cast<std::int32_t>(load_be32(h + offset::kLeafCount));
   if (leaves < 1) {
     fail_at(path, at + offset::kLeafCount,
-            "leaf count " + std::to_string(leaves) + ", expected at least 1");
+            "leaf count " + int32_field(leaves) + ", expected at least 1");
   }
   f.leaf_count = static_cast<std::uint32_t>(leaves);
   f.root.center = {load_be_float(h + offset::kCenter), load_be_float(h + offset::kCenter + 4),
@@ -106,7 +112,7 @@ QsFragment read_fragment_header(const std::string& path, const std::uint8_t* fil
   f.root_child_count = load_be32(h + offset::kRootChildren);
   if (f.root_child_count < 2 || f.root_child_count > 4) {
     fail_at(path, at + offset::kRootChildren,
-            "root child count " + std::to_string(static_cast<std::int32_t>(f.root_child_count)) +
+            "root child count " + int32_field(static_cast<std::int32_t>(f.root_child_count)) +
                 ", expected 2, 3 or 4");
   }
   return f;
@@ -177,7 +183,7 @@ DecodedTree decode_fragment(const std::string& path, const std::uint8_t* file, Q
       const auto pointer = static_cast<std::int32_t>(load_be32(file + cursor));
       if (pointer <= 0) {
         fail_at(path, cursor,
-                "group pointer " + std::to_string(pointer) +
+                "group pointer " + int32_field(pointer) +
                     ", expected a positive distance to the first grandchild group");
       }
       there = cursor + static_cast<std::uint64_t>(pointer);

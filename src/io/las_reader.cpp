@@ -235,6 +235,26 @@ PointSet read_las(const std::string& path, Progress& progress, const LasReadOpti
   RecordStats stats;
   for (const RecordStats& s : chunk_stats) stats.merge(s);
 
+  // Every decoded coordinate must be finite (a huge scale or offset can overflow): coordinates
+  // are linear in the record's integer, so the axis extremes decide; the message names the
+  // first record that overflows.
+  const auto check_finite = [&](const double (&shift_by)[3]) {
+    for (int a = 0; a < 3; ++a) {
+      for (const std::int32_t v : {stats.lo[a], stats.hi[a]}) {
+        const double w = double(v) * h.scale[a] + shift_by[a];
+        if (std::isfinite(w) && std::fabs(w) <= double(std::numeric_limits<float>::max())) continue;
+        std::size_t i = 0;
+        while (i + 1 < n && i32(records + i * stride + 4 * a) != v) ++i;
+        LasFile(path, data, gzip).fail(h.point_offset + i * stride + 4 * a,
+             "point record " + std::to_string(i) + ": " + std::string(1, "XYZ"[a]) +
+                 " coordinate " + std::to_string(v) + " x scale " + format_double(h.scale[a]) +
+                 " + offset " + format_double(h.offset[a]) +
+                 " is not a finite number a float can hold; the header's scale or offset is "
+                 "wrong (fix them, e.g. with las2las, or re-export the scan)");
+      }
+    }
+  };
+  if (n > 0) check_finite(h.offset);
   std::array<double, 3> origin{};
   if (options.shift_origin) {
     for (int a = 0; a < 3; ++a) {
@@ -247,6 +267,7 @@ PointSet read_las(const std::string& path, Progress& progress, const LasReadOpti
   }
   const double shift[3] = {h.offset[0] - origin[0], h.offset[1] - origin[1],
                            h.offset[2] - origin[2]};
+  if (n > 0) check_finite(shift);
   const bool has_colors = rgb >= 0 && stats.max_color > 0;
   const int color_shift = stats.max_color > 255 ? 8 : 0;
 

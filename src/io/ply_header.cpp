@@ -3,6 +3,8 @@
 
 #include <charconv>
 #include <limits>
+#include <string>
+#include <unordered_set>
 
 #include "pointillist/core/error.hpp"
 
@@ -168,12 +170,19 @@ class HeaderParser {
     if (ec != std::errc() || end != count.data() + count.size())
       fail(line_, "element " + element.name + ": count " + quoted(count) +
                       " is not a non-negative integer");
-    for (const Element& other : header_.elements) {
-      if (other.name == element.name && (element.name == "vertex" || element.name == "face"))
+    if (element.name == "vertex" || element.name == "face") {
+      std::size_t& first = element.name == "vertex" ? vertex_line_ : face_line_;
+      if (first != 0)
         fail(line_, "second '" + element.name + "' element (the first is on line " +
-                        std::to_string(other.header_line) + ")");
+                        std::to_string(first) + ")");
+      first = line_;
     }
+    if (header_.elements.size() == kMaxElements)
+      fail(line_, "more than " + std::to_string(kMaxElements) +
+                      " elements declared; no real PLY file has that many (the header is "
+                      "corrupt or hostile)");
     header_.elements.push_back(std::move(element));
+    property_names_.clear();
   }
 
   void parse_property(const std::vector<std::string_view>& words) {
@@ -205,15 +214,24 @@ class HeaderParser {
                  " (expected char uchar short ushort int uint float double or int8 ... float64)");
       property.name = std::string(words[2]);
     }
-    if (element.find(property.name) >= 0)
+    if (!property_names_.insert(property.name).second)
       fail(line_, "element " + element.name + ": property " + property.name + " declared twice");
+    if (element.properties.size() == kMaxProperties)
+      fail(line_, "element " + element.name + ": more than " + std::to_string(kMaxProperties) +
+                      " properties declared; no real PLY file has that many (the header is "
+                      "corrupt or hostile)");
     element.properties.push_back(std::move(property));
   }
+
+  // Limits no real file reaches; they keep a hostile header from costing minutes.
+  static constexpr std::size_t kMaxElements = 1024, kMaxProperties = 4096;
 
   std::string_view data_;
   const std::string& path_;
   std::size_t pos_ = 0;
   std::size_t line_ = 0;
+  std::size_t vertex_line_ = 0, face_line_ = 0;  // where those elements were declared
+  std::unordered_set<std::string> property_names_;  // of the last element: duplicates in O(1)
   Header header_;
 };
 
@@ -242,6 +260,30 @@ std::size_t Element::min_size(Format format) const {
   std::size_t size = 0;
   for (const Property& p : properties) size += scalar_size(p.is_list ? p.count_type : p.type);
   return size;
+}
+
+std::uint64_t Header::max_file_bytes() const {
+  constexpr std::uint64_t kMax = std::numeric_limits<std::uint64_t>::max();
+  const auto add = [](std::uint64_t a, std::uint64_t b) { return a > kMax - b ? kMax : a + b; };
+  const auto mul = [](std::uint64_t a, std::uint64_t b) {
+    return a != 0 && b > kMax / a ? kMax : a * b;
+  };
+  const auto largest_count = [](ScalarType t) -> std::uint64_t {
+    const std::size_t bytes = scalar_size(t);
+    return bytes >= 4 ? std::uint64_t{0xffffffff} : (std::uint64_t{1} << (8 * bytes)) - 1;
+  };
+  const bool ascii = format == Format::Ascii;
+  std::uint64_t total = body_offset;
+  for (const Element& e : elements) {
+    std::uint64_t per = ascii ? 2 : 0;  // a line end (CR LF)
+    for (const Property& p : e.properties) {
+      const std::uint64_t value = ascii ? kMaxAsciiValueBytes : scalar_size(p.type);
+      const std::uint64_t count = ascii ? kMaxAsciiValueBytes : scalar_size(p.count_type);
+      per = add(per, p.is_list ? add(count, mul(largest_count(p.count_type), value)) : value);
+    }
+    total = add(total, mul(e.count, per));
+  }
+  return total;
 }
 
 int Element::find(std::string_view property_name) const {

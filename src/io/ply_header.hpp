@@ -64,6 +64,12 @@ struct Header {
   std::vector<std::string> comments;  // text after "comment ", in file order
   std::size_t body_offset = 0;        // first byte after the end_header line
   std::size_t line_count = 0;         // lines in the header, end_header included
+
+  // The most bytes a file with this header can hold (header and body; saturating at
+  // UINT64_MAX): binary values at their size, lists at their count type's largest count, ascii
+  // values at kMaxAsciiValueBytes each. A gzip file that inflates to more is refused early.
+  std::uint64_t max_file_bytes() const;
+  static constexpr std::uint64_t kMaxAsciiValueBytes = 64;
 };
 
 // Parses the header at the start of `data`. `path` is only used in messages. Element counts are

@@ -267,6 +267,24 @@ bool has_header_end(std::string_view data) {
 
 struct StreamOverflow {};
 
+// For GzipInflater::set_limit: the most bytes the file's header allows once the header is in,
+// plus 1 MiB for what some writers leave after the body (a header that is not in the first
+// 16 MiB does not exist: the inflating stops there and the parser reports it).
+std::uint64_t header_limit(std::string_view prefix, const std::string& path) {
+  constexpr std::uint64_t kMaxHeaderBytes = 16 << 20;
+  if (!has_header_end(prefix.substr(0, kMaxHeaderBytes))) {
+    return prefix.size() >= kMaxHeaderBytes ? kMaxHeaderBytes
+                                            : std::numeric_limits<std::uint64_t>::max();
+  }
+  try {
+    const std::uint64_t most = parse_header(prefix, path).max_file_bytes();
+    constexpr std::uint64_t kSlack = 1 << 20;
+    return most > std::numeric_limits<std::uint64_t>::max() - kSlack ? most : most + kSlack;
+  } catch (const FormatError&) {
+    return std::numeric_limits<std::uint64_t>::max();  // the parser reports it
+  }
+}
+
 // The reading side of read_gzip_streaming: waits for the header, then parses the body as it
 // is inflated.
 PointSet parse_stream(GzipInflater& inflater,
@@ -309,6 +327,7 @@ std::optional<PointSet> read_gzip_streaming(const FileBytes& raw,
                                             ReadProgress& progress,
                                             const std::function<void(std::uint64_t)>& on_inflate) {
   GzipInflater inflater(raw.view(), path);
+  inflater.set_limit([&](std::string_view prefix) { return header_limit(prefix, path); });
   const auto wait = [&](std::size_t bytes) {
     bool finished = false;
     const std::size_t available = inflater.wait_for(bytes, finished);
@@ -357,7 +376,8 @@ PointSet read_ply(const std::string& path, Progress& progress, const PlyReadOpti
   const FileBytes bytes =
       gzip
           ? FileBytes::inflate(
-                raw, path, inflated == 0 ? std::function<void(std::uint64_t)>(on_inflate) : nullptr)
+                raw, path, inflated == 0 ? std::function<void(std::uint64_t)>(on_inflate) : nullptr,
+                [&](std::string_view prefix) { return header_limit(prefix, path); })
           : std::move(raw);
   PlyRead read(path, options, read_progress);
   read.prepare(bytes.view(), bytes.was_compressed());

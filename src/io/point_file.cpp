@@ -76,9 +76,10 @@ PointSet read_point_file(const std::string& path, Progress& progress,
     case Kind::Unknown:
       break;
   }
-  throw FormatError(path + ": unknown point file type (supported: " +
+  throw FormatError(path + ": unknown point file type (scans: " +
                     supported_point_file_extensions() +
-                    "); rename the file if its extension is wrong, or convert it to PLY");
+                    "; models: .ptl, .qs); rename the file if its extension is wrong, or convert "
+                    "it to PLY");
 }
 
 std::optional<std::array<double, 3>> point_set_origin(const PointSet& points) {

@@ -1,6 +1,8 @@
 // pipeline::convert (see convert.hpp).
 #include "pointillist/pipeline/convert.hpp"
 
+#include "pointillist/core/atomic_file.hpp"
+
 #include <filesystem>
 #include <sstream>
 
@@ -44,6 +46,7 @@ ConvertResult convert(std::span<const std::string> inputs, const std::string& ou
                       "' has an unknown extension; use .ptl (Pointillist model), .qs (QSplat 1.1 "
                       "model) or .ply (points with normals and radii)");
   }
+  check_outputs({inputs.begin(), inputs.end()}, {{"-o", output}});
   if (o.ascii && !to_ply) throw OptionError("convert: --ascii applies only to .ply output");
   if (o.ptl_version != 1 && o.ptl_version != 2) {
     throw OptionError("convert: --ptl-version " + std::to_string(o.ptl_version) +

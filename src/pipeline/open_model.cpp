@@ -95,7 +95,13 @@ Model Model::open_file(const std::string& path, const OpenModelOptions& options,
     }
     return model;
   }
-  if (is_ptl_file(path)) {
+  // A .ptl or .qs name without the signature goes to its reader, whose error says what the
+  // first bytes should have been.
+  const auto named = [&](const char* ext) {
+    const std::string e(ext);
+    return path.size() >= e.size() && path.compare(path.size() - e.size(), e.size(), e) == 0;
+  };
+  if (is_ptl_file(path) || named(".ptl")) {
     model.kind_ = ModelKind::PtlV1;
     model.v1_ = PtlFile::open(path);
     model.view_ = model.v1_->tree();
@@ -103,7 +109,7 @@ Model Model::open_file(const std::string& path, const OpenModelOptions& options,
     model.paging_reason_ = "mapped: .ptl version 1 files are read through a memory map";
     return model;
   }
-  if (is_qs_file(path)) {
+  if (is_qs_file(path) || named(".qs")) {
     ProgressPhase phase(progress, "decode", 0);
     QsModel qs = read_qs(path);
     model.kind_ = ModelKind::Qsplat;

@@ -263,6 +263,17 @@ TEST(LasReader, RejectsBadScale) {
                "Z offset is not a finite number");
 }
 
+TEST(LasReader, RejectsCoordinatesThatOverflow) {
+  // A finite but absurd scale: the records' X integers (1000, -7, 0) times 1e306 are beyond
+  // what a float holds (1000e306 beyond a double too). The smallest, -7, is checked first: the
+  // message names its record (1) and byte (header 227 bytes, 20-byte records, X first: 247).
+  expect_error(build_las({.scale = {1e306, 0.01, 0.01}}, kPoints), "byte 247",
+               "point record 1: X coordinate -7 x scale");
+  // A finite double offset that no float holds: Y's smallest, -2000, is record 0's (byte 231).
+  expect_error(build_las({.offset = {0, 1e300, 0}}, kPoints), "byte 231",
+               "point record 0: Y coordinate -2000");
+}
+
 TEST(LasReader, RejectsTruncatedRecords) {
   // 3 records of 20 bytes from byte 227: cut 13 bytes into the third one.
   const std::string bytes = build_las({}, kPoints);

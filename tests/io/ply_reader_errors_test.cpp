@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <limits>
 #include <random>
 
@@ -98,6 +99,38 @@ TEST(PlyReader, RejectsBadPropertyLine) {
       "line 4", "unknown list item type 'int32_t'");
   expect_error("ply\nformat ascii 1.0\nelement vertex 1\n" + kXyz + "property double y\n", "line 7",
                "property y declared twice");
+}
+
+TEST(PlyReader, RejectsHeadersNoRealFileHas) {
+  // 4097 properties on one element (4096 is the most allowed): line 3 + 4097 = 4100.
+  std::string many = "ply\nformat ascii 1.0\nelement vertex 0\n";
+  for (int i = 0; i < 4097; ++i) many += "property float p" + std::to_string(i) + "\n";
+  expect_error(many + "end_header\n", "line 4100", "more than 4096 properties");
+  // 1025 elements (1024 allowed): the 1025th is on line 2 + 1025.
+  std::string elements = "ply\nformat ascii 1.0\n";
+  for (int i = 0; i < 1025; ++i) elements += "element e" + std::to_string(i) + " 0\n";
+  expect_error(elements + "end_header\n", "line 1027", "more than 1024 elements");
+  // A duplicate among many properties is still found, with its line.
+  std::string twice = "ply\nformat ascii 1.0\nelement vertex 0\n";
+  for (int i = 0; i < 3000; ++i) twice += "property float p" + std::to_string(i) + "\n";
+  twice += "property float p17\n";
+  expect_error(twice + "end_header\n", "line 3004", "property p17 declared twice");
+}
+
+TEST(PlyReader, ReadsAHeaderWithTheMostPropertiesAllowed) {
+  // 4096 properties: x, y, z and 4093 others; one vertex.
+  std::string header = "ply\nformat ascii 1.0\nelement vertex 1\n" + kXyz;
+  std::string body = "1 2 3";
+  for (int i = 3; i < 4096; ++i) {
+    header += "property uchar extra" + std::to_string(i) + "\n";
+    body += " 7";
+  }
+  TempDir dir;
+  const std::string path = dir.file("wide.ply");
+  { std::ofstream(path, std::ios::binary) << header << "end_header\n" << body << "\n"; }
+  const PointSet p = read_ply(path);
+  ASSERT_EQ(p.size(), 1u);
+  EXPECT_EQ(p.positions[0], (Vec3f{1, 2, 3}));
 }
 
 TEST(PlyReader, RejectsPropertyBeforeElement) {

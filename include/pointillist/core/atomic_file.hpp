@@ -3,12 +3,16 @@
 
 #include <cstddef>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace pointillist {
 
 // Writes go to `path + ".tmp-XXXXXX"` in the same folder; commit() renames it over `path`.
-// Destroyed without commit() (an exception, say), the temporary file is removed.
+// Destroyed without commit() (an exception, say), the temporary file is removed; so is it on
+// SIGINT, SIGTERM or SIGHUP once remove_temporary_files_on_signals() was called. A temporary file
+// of the same output left by a process that died (kill -9, power loss) is removed by the next
+// AtomicFile of that output: the live ones hold a lock on theirs.
 class AtomicFile {
  public:
   // Throws IoError when the temporary file cannot be created.
@@ -33,6 +37,17 @@ class AtomicFile {
   bool committed_ = false;
   std::vector<char> buffer_;
   std::size_t used_ = 0;
+  int slot_ = -1;  // in the registry the signal handler reads
 };
+
+// Installs handlers for SIGINT, SIGTERM and SIGHUP that remove the temporary files of every live
+// AtomicFile, then let the signal end the process as it would have. Call once, early (main).
+void remove_temporary_files_on_signals();
+
+// Throws OptionError, before any work, when an output would replace an input or another output:
+// `outputs` are (option, path) pairs such as {"-o", "x.png"}; paths naming the same file after
+// resolving links and "." / ".." count as the same. Empty output paths and "-" are ignored.
+void check_outputs(const std::vector<std::string>& inputs,
+                   const std::vector<std::pair<std::string, std::string>>& outputs);
 
 }  // namespace pointillist

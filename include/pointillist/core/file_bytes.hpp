@@ -36,8 +36,10 @@ class FileBytes {
   // The inflated contents of `compressed` (a gzip file read from `path`). `on_compressed_bytes`
   // (may be empty) hears how many compressed bytes were consumed, in chunks. Throws FormatError
   // for corrupt or truncated data.
+  // `limit` (may be empty): see GzipInflater::set_limit.
   static FileBytes inflate(const FileBytes& compressed, const std::string& path,
-                           const std::function<void(std::uint64_t)>& on_compressed_bytes = {});
+                           const std::function<void(std::uint64_t)>& on_compressed_bytes = {},
+                           std::function<std::uint64_t(std::string_view)> limit = {});
   // map(), then inflate() when the file starts with the gzip magic bytes.
   static FileBytes load(const std::string& path,
                         const std::function<void(std::uint64_t)>& on_compressed_bytes = {});
@@ -72,12 +74,24 @@ class GzipInflater {
   // of valid bytes and whether run() has finished.
   std::size_t wait_for(std::size_t bytes, bool& finished);
 
-  // Makes run() return soon (a reader has failed and needs no more data).
+  // Makes run() return soon (a reader has failed, or has all it needs).
   void cancel() { cancelled_.store(true, std::memory_order_relaxed); }
+
+  // Bounds the inflated size by what the file's own header says it can hold, so that a small
+  // file inflating to gigabytes (a "gzip bomb") fails in a moment: run() calls `limit` with the
+  // bytes inflated so far (at most once a megabyte, until it answers) and it returns the most
+  // bytes the file can need, or UINT64_MAX while it cannot tell yet (the header is incomplete).
+  // Inflating past the bound throws FormatError naming the file and the decompressed byte.
+  // Call before run().
+  void set_limit(std::function<std::uint64_t(std::string_view)> limit) {
+    limit_fn_ = std::move(limit);
+  }
 
   const char* data() const { return buffer_.get(); }
   std::size_t capacity() const { return capacity_; }
   bool overflowed() const { return overflowed_; }
+  // Bytes inflated when run() stopped (the buffer may be larger).
+  std::size_t inflated() const { return available_; }
   // The buffer as FileBytes (call after run() has returned).
   FileBytes release(std::uint64_t file_size);
 
@@ -94,6 +108,7 @@ class GzipInflater {
   std::condition_variable changed_;
   std::size_t available_ = 0;  // guarded by mutex_
   bool finished_ = false;      // guarded by mutex_
+  std::function<std::uint64_t(std::string_view)> limit_fn_;
 };
 
 }  // namespace pointillist

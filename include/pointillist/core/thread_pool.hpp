@@ -17,9 +17,12 @@ namespace pointillist {
 
 class ThreadPool {
  public:
-  // `thread_count` = 0 means one per hardware thread. The calling thread takes part in `run`,
-  // so a pool of N threads starts N - 1 workers.
+  // `thread_count` = 0 means one per hardware thread; more than max_threads() is capped there
+  // (thousands of threads only slow the work down, and can exhaust the machine's process limit).
+  // The calling thread takes part in `run`, so a pool of N threads starts N - 1 workers.
   explicit ThreadPool(unsigned thread_count = 0);
+  // 4 per hardware thread.
+  static unsigned max_threads();
   ~ThreadPool();
   ThreadPool(const ThreadPool&) = delete;
   ThreadPool& operator=(const ThreadPool&) = delete;
