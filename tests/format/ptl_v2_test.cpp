@@ -515,6 +515,19 @@ TEST(PtlV2, RejectsTruncatedFiles) {
   }
 }
 
+TEST(PtlV2, AMetadataSizeBeyondTheFileIsNamedAsSuch) {
+  // A size near 2^64 made "needs bytes A to B" wrap (B < A); the message now compares the size
+  // with the file's. The size field is at byte 72 of the header.
+  TempDir dir;
+  const std::string path = dir.file("meta.ptl");
+  write_ptl_v2(path, scene_tree(300, 5, false), "meta", {});
+  Bytes b = read_bytes(path);
+  for (int i = 0; i < 8; ++i) b[72 + i] = 0xff;
+  b[72] = 0xf0;  // 2^64 - 16
+  const std::string m = open_error(path, b);
+  expect_names(m, path, 72, "the metadata is 18446744073709551600 bytes long, more than the whole file");
+}
+
 TEST(PtlV2, RejectsBadPageTablesAndRecords) {
   TempDir dir;
   const std::string path = dir.file("bad.ptl");

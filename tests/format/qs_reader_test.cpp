@@ -436,7 +436,10 @@ TEST(QsReader, RejectsCorruptRecordsAndHeaders) {
   expect_error_at(b, 12, "header says 3 leaves, the tree has 2");
   b = two_leaf_file();
   put_be32(b, 36, 5);
-  expect_error_at(b, 36, "root child count 5");
+  expect_error_at(b, 36, "root child count 5 (0x00000005)");
+  b = two_leaf_file();
+  put_be32(b, 36, 0xffffffffu);  // int32 in the spec: -1, shown with its bytes
+  expect_error_at(b, 36, "root child count -1 (0xffffffff)");
   b = two_leaf_file();
   put_be32(b, 16, 4);
   expect_error_at(b, 16, "unknown bits");
