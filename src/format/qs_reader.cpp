@@ -196,10 +196,11 @@ DecodedTree decode_fragment(const std::string& path, const std::uint8_t* file, Q
       const std::uint16_t w0 = load_be16(r), w1 = load_be16(r + 2);
       const std::uint32_t s = w0 >> 3, g = (w0 >> 2) & 1u, c = w0 & 3u, q = w1 >> 2,
                           cone = w1 & 3u;
-      if (s >= kSphereCodeCount) {
+      if (s >= kSphereCodeCount && s != kOutOfTableSphereCode) {
         fail_at(path, cursor,
                 "sphere code " + str(s) + " is outside the table (expected 0.." +
-                    str(kSphereCodeCount - 1) + "); the file is corrupt");
+                    str(kSphereCodeCount - 1) + ", or " + str(kOutOfTableSphereCode) +
+                    " as QSplat 1.0 writes for a cube not in the table); the file is corrupt");
       }
       if (c == 0 && g != 0) {
         fail_at(path, cursor, "a leaf record (child-count code 0) has its grandchild bit set");
@@ -207,7 +208,9 @@ DecodedTree decode_fragment(const std::string& path, const std::uint8_t* file, Q
       if (nodes.size() >= std::size_t{1} << 32) {
         fail_at(path, cursor, "more than 2^32 nodes");
       }
-      const Sphere decoded = decode_sphere({pc, pr}, s);
+      // QSplat 1.0's out-of-table code decodes as its viewer does (parent centre, radius 0).
+      if (s == kOutOfTableSphereCode) ++stats.out_of_table_records;
+      const Sphere decoded = decode_qs_sphere({pc, pr}, s);
       SphereNode n;
       n.center = decoded.center;
       n.radius = decoded.radius;
@@ -329,7 +332,11 @@ std::string QsModel::metadata() const {
     start = stop + 1;
   }
   s += "records: " + str(stats.record_count) + " (" + str(stats.leaf_count) + " leaves), " +
-       str(stats.records_outside_parent) + " not inside their parent as stored\n";
+       str(stats.records_outside_parent) + " not inside their parent as stored" +
+       (stats.out_of_table_records == 0
+            ? std::string()
+            : ", " + str(stats.out_of_table_records) + " with the out-of-table sphere code") +
+       "\n";
   s += "enclosure fix: " + str(stats.spheres_enlarged) + " spheres enlarged, " +
        str(stats.cones_widened) + " normal cones widened\n";
   return s;

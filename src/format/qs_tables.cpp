@@ -48,14 +48,10 @@ int encode_sphere(Vec3f p, float rho, Vec3f c, float r) {
       }
     }
   }
-  // QSplat 1.0 writes the invalid code 8191 when this cube is not in the table (a child sticking
-  // out of its parent, never seen in practice); grow the cube instead until it is.
-  for (int size = m;; ++size) {
-    const int last = kSphereGrid - size;
-    const int code =
-        sphere_code(size, std::min(lo[0], last), std::min(lo[1], last), std::min(lo[2], last));
-    if (code >= 0) return code;  // always by size 3: every in-range cube of 3+ cells is kept
-  }
+  // The cube is looked up as it is, not moved or grown into the table: QSplat 1.0 writes the
+  // out-of-table code for a cube that sticks out of the grid or that the table skips.
+  const int code = sphere_code(m, lo[0], lo[1], lo[2]);
+  return code >= 0 ? code : int(kOutOfTableSphereCode);
 }
 
 std::uint32_t encode_cone(float theta) {

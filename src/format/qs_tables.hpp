@@ -14,10 +14,24 @@ namespace pointillist::qs_detail {
 
 using namespace pointillist::quant;  // NOLINT(google-build-using-namespace): one vocabulary
 
+// The sphere code QSplat 1.0 writes when the cube it picked is not in the table (spec §4.3): the
+// low 13 bits of its lookup table's "no entry" value 0xFFFF. Its viewer takes the candidate from
+// the zero-filled memory past the table's end, so the code decodes to the parent's centre with
+// radius 0 (spec §4.1).
+constexpr std::uint32_t kOutOfTableSphereCode = 8191;
+
 // Code for a child sphere (centre c, radius r) quantized against its decoded parent (centre p,
-// radius rho) the way QSplat 1.0 does (spec §4.3). Where QSplat 1.0 would pick a cube that is not
-// in the table (and write the invalid code 8191), the cube is grown until it is.
+// radius rho) the way QSplat 1.0 does (spec §4.3), kOutOfTableSphereCode included: a child that
+// sticks out of its decoded parent can land in a corner cube the table skips (two leaves of the
+// twice-subdivided Stanford dragon do).
 int encode_sphere(Vec3f p, float rho, Vec3f c, float r);
+
+// Decoded sphere of a .qs sphere code (< kSphereCodeCount, or kOutOfTableSphereCode) against the
+// decoded parent, as QSplat 1.0 decodes it.
+inline Sphere decode_qs_sphere(const Sphere& parent, std::uint32_t code) {
+  return code == kOutOfTableSphereCode ? Sphere{parent.center, 0.0f}
+                                       : decode_sphere(parent, code);
+}
 
 // Code of a cone half-angle theta (radians, >= 0), as QSplat 1.0 writes it.
 std::uint32_t encode_cone(float theta);

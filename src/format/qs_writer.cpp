@@ -108,9 +108,11 @@ class TreeWriter {
 
  private:
   // Encodes `child` against its decoded parent and replaces its sphere by the decoded one (§4.4).
+  // The out-of-table code decodes to radius 0, as in QSplat 1.0; only leaves were seen with it,
+  // so what the original writes below an interior node with that code is unverified.
   void write_record(const MakeNode& parent, MakeNode& child, std::vector<std::uint8_t>& out) {
     const int code = encode_sphere(parent.center, parent.radius, child.center, child.radius);
-    const Sphere decoded = decode_sphere({parent.center, parent.radius}, std::uint32_t(code));
+    const Sphere decoded = decode_qs_sphere({parent.center, parent.radius}, std::uint32_t(code));
     child.center = decoded.center;
     child.radius = decoded.radius;
 

@@ -52,6 +52,10 @@ struct QsStats {
   // by float rounding (187 in the 5,205-point dragon; any tolerance from 1e-6 to 1e-3 counts
   // the same 1,428 records there).
   std::uint64_t records_outside_parent = 0;
+  // Records with sphere code 8191, which QSplat 1.0 writes when a child sticks out of its
+  // decoded parent into a cube its table lacks (spec §4.3); decoded, as QSplat 1.0's viewer
+  // does, to the parent's centre with radius 0. Two leaves of the twice-subdivided dragon.
+  std::uint64_t out_of_table_records = 0;
   // The enclosure fix (read_qs): interior nodes (roots included) whose radius was enlarged to
   // enclose their children, and whose normal cone was widened to cover their children's cones.
   std::uint64_t spheres_enlarged = 0;
@@ -83,8 +87,9 @@ struct QsModel {
 // Reads, validates and decodes a whole .qs file (every fragment). Validation covers magic,
 // version, fragment lengths, options, the root header, every group's position (each group must
 // begin where the previous one ended, where its parent's pointer says), record counts against
-// the fragment end, sphere codes (0..7620), child-count/grandchild bits and the header's leaf
-// count. Normal codes 16224..16383 decode to (0, 0, 1), as in QSplat 1.0.
+// the fragment end, sphere codes (0..7620, and 8191: see QsStats::out_of_table_records),
+// child-count/grandchild bits and the header's leaf count. Normal codes 16224..16383 decode to
+// (0, 0, 1), as in QSplat 1.0.
 // Throws FormatError "<path>: byte <offset>: <what was expected, what was found>" for any
 // malformed, truncated or corrupt input (never reads out of bounds, never loops), and IoError
 // when the file cannot be read.
@@ -123,7 +128,9 @@ struct QsWriteReport {
 //  - a point set without faces: its own normals (unit) and radii, which must be present (e.g.
 //    from prepare_splats); points of radius 0 are dropped.
 // Then the midpoint-split hierarchy (§8.3-8.4), quantized breadth-first against the decoded
-// parents (§4.3-4.4, §5.2, §6, §7), one tree fragment after an optional comment fragment.
+// parents (§4.3-4.4, §5.2, §6, §7), one tree fragment after an optional comment fragment. Like
+// the original, a child that sticks out of its decoded parent into a cube the sphere table lacks
+// gets sphere code 8191 (see QsStats::out_of_table_records); read_qs accepts it.
 // Written to a temporary file in the same folder and renamed, so a failure never leaves a
 // partial file. Throws Error when fewer than 2 points remain, an attribute array's length is
 // wrong, a triangle index is out of range, a coordinate, normal or radius is not finite, or the
