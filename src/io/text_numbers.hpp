@@ -14,7 +14,9 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
+#include <limits>
 #include <string>
 #include <string_view>
 #include <type_traits>
@@ -26,6 +28,13 @@
 #include "pointillist/core/progress.hpp"
 
 namespace pointillist::io_detail {
+
+// A number for a message: "1e+39", "0.5".
+inline std::string short_number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
 
 // Characters -----------------------------------------------------------------------------------
 
@@ -97,7 +106,10 @@ const char* parse_real(const char* p, const char* end, T& out) {
       const auto r = std::from_chars(s, end, wide);
       q = r.ptr;
       ec = r.ec;
-      out = static_cast<float>(wide);
+      // Converting a double beyond float's range is undefined: take the limit explicitly.
+      out = std::fabs(wide) > double(std::numeric_limits<float>::max())
+                ? (wide > 0 ? 1.0f : -1.0f) * std::numeric_limits<float>::infinity()
+                : static_cast<float>(wide);
     }
   }
   if (ec != std::errc() || !ends_number_at(q, end)) return nullptr;

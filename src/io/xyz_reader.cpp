@@ -254,6 +254,19 @@ class LineParser {
 
   std::size_t column_count() const { return layout_.slots.size(); }
 
+ // Fails naming the line when a coordinate less the origin is beyond what a float holds (a
+ // stray point ~1e39 away; converting it would be undefined).
+ void check_fits_float(const char* line, const double (&xyz)[3],
+                       const std::array<double, 3>& origin) const {
+   for (int a = 0; a < 3; ++a) {
+     if (!(std::fabs(xyz[a] - origin[a]) <= double(std::numeric_limits<float>::max()))) {
+       fail(line, std::string(1, "xyz"[a]) + " = " + io_detail::short_number(xyz[a]) +
+                      " is too far from the other points for a float coordinate (more than "
+                      "3.4e38 from " + io_detail::short_number(origin[a]) + "); remove the stray point");
+     }
+   }
+ }
+
  private:
   // Moves from the end of field c-1 to the start of field c.
   const char* next_field(const char* p, const char* le, std::size_t c) const {
@@ -549,6 +562,7 @@ PointSet read_xyz(const std::string& path, Progress& progress, const XyzReadOpti
       if (!is_point_line(t, le)) continue;
       LineValues v;
       parser.parse(t, le, v, stats);
+      parser.check_fits_float(t, v.xyz, origin);
       out.positions[i] = {static_cast<float>(v.xyz[0] - origin[0]),
                           static_cast<float>(v.xyz[1] - origin[1]),
                           static_cast<float>(v.xyz[2] - origin[2])};

@@ -268,3 +268,9 @@ TEST(ObjReader, RejectsFilesWithoutVertices) {
 
 }  // namespace
 }  // namespace pointillist
+
+TEST(ObjReader, RejectsAStrayVertexNoFloatCanHold) {
+  // Found by fuzzing: the first vertex (y = 1e39) sets the origin; the second lies 1e39 from it.
+  pointillist::expect_error("v 1 1e39 1\nv 1 1 1\n", "line 2",
+               "v: coordinate 2 is too far from the other vertices for a float");
+}

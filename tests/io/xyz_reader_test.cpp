@@ -437,3 +437,9 @@ TEST(XyzReader, RejectsMissingFile) {
 
 }  // namespace
 }  // namespace pointillist
+
+TEST(XyzReader, RejectsAStrayPointNoFloatCanHold) {
+  // Found by fuzzing: the first point (y = 1e39) sets the origin; the second lies 1e39 from it,
+  // beyond float's 3.4e38 (converting it was undefined behaviour).
+  pointillist::expect_error("1 1e39 1\n1 1 1\n1 2 1\n", "line 2", "y = 1 is too far from the other points");
+}
