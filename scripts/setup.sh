@@ -9,6 +9,9 @@ packages=(
   nlohmann-json3-dev
   jq
   libgtest-dev libgmock-dev googletest libbenchmark-dev
+  # make fuzz: clang 14, its libFuzzer and sanitizer runtimes (libclang-rt-14-dev), and
+  # llvm-symbolizer (llvm-14) for stacks with file and line
+  clang-14 libclang-rt-14-dev llvm-14
   nodejs npm
 )
 

@@ -298,21 +298,9 @@ class BinaryDecoder {
                                   std::to_string(ctx_.vertex_count) + " - 1)");
   }
 
-  std::size_t decode_simple_faces(std::size_t e, std::size_t pos) {
-    const Property& property = header_.elements[e].properties[0];
-    return with_type(property.count_type, [&](auto count_tag) {
-      return with_type(property.type, [&](auto index_tag) -> std::size_t {
-        using C = decltype(count_tag);
-        using I = decltype(index_tag);
-        if constexpr (std::is_integral_v<C> && std::is_integral_v<I>) {
-          return swap_ ? decode_faces<C, I, true>(e, pos) : decode_faces<C, I, false>(e, pos);
-        } else {
-          return walk_generic(e, pos);  // excluded by the plan; keeps the template well-formed
-        }
-      });
-    });
-  }
-
+  // Defined before decode_simple_faces, which calls it from a generic lambda: clang 14 does not
+  // instantiate a member template that such a lambda uses before the template's definition
+  // (undefined internal symbols at link time).
   template <class C, class I, bool Swap>
   std::size_t decode_faces(std::size_t e, std::size_t pos) {
     const std::uint64_t count = header_.elements[e].count;
@@ -357,6 +345,21 @@ class BinaryDecoder {
     triangles_.resize(used);
     report(p - reported);
     return p;
+  }
+
+  std::size_t decode_simple_faces(std::size_t e, std::size_t pos) {
+    const Property& property = header_.elements[e].properties[0];
+    return with_type(property.count_type, [&](auto count_tag) {
+      return with_type(property.type, [&](auto index_tag) -> std::size_t {
+        using C = decltype(count_tag);
+        using I = decltype(index_tag);
+        if constexpr (std::is_integral_v<C> && std::is_integral_v<I>) {
+          return swap_ ? decode_faces<C, I, true>(e, pos) : decode_faces<C, I, false>(e, pos);
+        } else {
+          return walk_generic(e, pos);  // excluded by the plan; keeps the template well-formed
+        }
+      });
+    });
   }
 
   // Any element, any layout: property by property, with a bounds check before every read.
