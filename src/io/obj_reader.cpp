@@ -86,11 +86,10 @@ class ObjParser {
     if (positions_.empty()) origin_ = text_origin(values);
     if (positions_.size() >= static_cast<std::size_t>(kMaxVertices))
       fail(p, "more than 2^32 - 1 vertices (triangles hold 32-bit indices)");
-    for (int a = 0; a < 3; ++a) {
-      if (!(std::fabs(values[a] - origin_[a]) <= double(std::numeric_limits<float>::max())))
-        fail(p, "v: coordinate " + std::to_string(a + 1) +
-                    " is too far from the other vertices for a float (more than 3.4e38 from " +
-                    io_detail::short_number(origin_[a]) + "); remove the stray vertex");
+    if (const int a = io_detail::axis_beyond_float(values, origin_); a >= 0) {
+      fail(p, "v: coordinate " + std::to_string(a + 1) +
+                  " is too far from the other vertices for a float (more than 3.4e38 from " +
+                  io_detail::short_number(origin_[a]) + "); remove the stray vertex");
     }
     positions_.push_back({static_cast<float>(values[0] - origin_[0]),
                           static_cast<float>(values[1] - origin_[1]),

@@ -173,6 +173,15 @@ inline std::array<double, 3> text_origin(const double first[3]) {
   return origin;
 }
 
+// The first axis (0 to 2) whose coordinate less the origin no float holds (a stray point ~1e39
+// away: converting it would be undefined), or -1.
+inline int axis_beyond_float(const double xyz[3], const std::array<double, 3>& origin) {
+  for (int a = 0; a < 3; ++a) {
+    if (!(std::fabs(xyz[a] - origin[a]) <= double(std::numeric_limits<float>::max()))) return a;
+  }
+  return -1;
+}
+
 // Three numbers after `skip` characters of `text` (blank-separated, finite); false otherwise.
 inline bool read_triple(const std::string& text, std::size_t skip, std::array<double, 3>& out) {
   const char* p = text.data() + skip;

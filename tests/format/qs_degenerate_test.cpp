@@ -18,25 +18,18 @@
 #include <vector>
 
 #include "pointillist/core/error.hpp"
+#include "format_test_support.hpp"
 #include "pointillist/format/qs.hpp"
 #include "testing/testing.hpp"
 
 namespace pointillist {
 namespace {
 
-using Bytes = std::vector<std::uint8_t>;
+using format_test::Bytes;
+using format_test::read_bytes;
+using format_test::write_bytes;
 
 constexpr int kOutOfTable = 8191;
-
-Bytes read_bytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-void write_bytes(const std::string& path, const Bytes& bytes) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
-}
 
 std::uint32_t be32(const Bytes& b, std::size_t at) {
   return std::uint32_t{b[at]} << 24 | std::uint32_t{b[at + 1]} << 16 |
