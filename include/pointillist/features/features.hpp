@@ -1,0 +1,157 @@
+// Sharp edges, corners and intersecting surfaces of a splat set, found from the splats alone
+// (Rafael Ivo's dissertation; specs/sharp-features.md is our specification, with the equation
+// numbers used below):
+//  1. the bounding-sphere neighbour graph (eq. 3.1, neighbour_graph.hpp);
+//  2. sharp edges: neighbours whose normals differ, n_i·n_j < w_s (eqs. 3.2–3.3);
+//  3. for each sharp edge, whether the discs really cross (eqs. 4.3–4.12) and whether the
+//     splat's surface ends at the other splat's surface (a crease: clip) or passes through it
+//     (an intersection: no clip, the surface ids separate them);
+//  4. the clip planes of each splat, oriented, de-duplicated and combined by union or
+//     intersection (eqs. 4.13–4.18, generalised for mixed corners);
+//  5. surface ids: breadth-first search over the continuous edges (§1.8).
+// The renderer discards a fragment of a splat where its clip planes say so (clip_discards) and
+// blends a pixel's front surface only from fragments of one surface id.
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "pointillist/core/math.hpp"
+#include "pointillist/core/progress.hpp"
+#include "pointillist/core/thread_pool.hpp"
+
+namespace pointillist {
+
+// How a sharp edge is told apart from an intersection of two surfaces that both continue.
+enum class EdgeTest {
+  // Per pair (spec §1.4 [P]): S_j may clip S_i iff S_i and its continuous neighbours do not lie
+  // on both sides of S_j's plane by more than 0.1·r_i.
+  Side,
+  // Linsen's gap test (dissertation §4.1): S_i is on the boundary of its surface (and every
+  // crossing partner clips it) iff the angular gap between its continuous neighbours, projected
+  // into its plane, exceeds FeatureOptions::linsen_alpha_deg somewhere.
+  Linsen,
+};
+
+// How the planes of several partners combine.
+enum class ClipRule {
+  // Pointillist's rule (spec §1.7 [I], §4.8 items 3–5): each partner's kept side is the side of
+  // its plane where the splat's own surface lies; partners are combined by union when every
+  // pair is convex, by intersection when every pair is reflex, and per fragment by the partner
+  // whose line is nearest where the pairs disagree (the mixed corner).
+  Classified,
+  // The dissertation (eqs. 4.13–4.15 and 4.17): orientation and union/intersection from the
+  // concave/convex classification; where it is undefined the splat is not clipped (counted).
+  Dissertation,
+  // Zwicker et al. 2004: every partner clips on its own (union), oriented by its own 4.14 sign.
+  Independent,
+  // Only the partner with the nearest centre (the dissertation's Fig. 6.4b).
+  NearestPartner,
+};
+
+struct FeatureOptions {
+  float sharp_threshold = 0.9f;  // w_s: an edge is sharp when n_i·n_j < w_s; in [-1, 1]
+  EdgeTest edge_test = EdgeTest::Side;
+  float linsen_alpha_deg = 90.0f;  // gap that makes a boundary, EdgeTest::Linsen; (0, 360)
+  ClipRule clip_rule = ClipRule::Classified;
+  // The radius the renderer draws over the splat radius (QualitySettings::radius_scale): the
+  // graph and the crossing tests use the drawn discs. In [1, 2].
+  float radius_scale = 1.1f;
+};
+
+// Throws OptionError naming the field when a value is out of range.
+void validate_feature_options(const FeatureOptions& options);
+
+// A clip plane in the splat's own frame of reference (model space): a point P on the splat
+// keeps its fragment on the plane's side n·P − h >= 0. Scaled so that, for P in the splat's
+// plane, n·P − h is the distance from P to the line where the two planes meet.
+struct ClipPlane {
+  Vec3f n;
+  float h = 0;
+};
+inline float plane_side(const ClipPlane& p, Vec3f point) { return dot(p.n, point) - p.h; }
+
+enum class ClipMode : std::uint8_t {
+  None,          // no planes
+  Union,         // discard where any plane says so (the kept region is convex at the splat)
+  Intersection,  // discard where every plane says so (a reflex corner)
+  Nearest,       // the plane whose line is nearest to the point decides (mixed corners)
+};
+
+// Whether `mode` and `planes` discard the fragment at `point` (on the splat's plane).
+inline bool clip_discards(std::span<const ClipPlane> planes, ClipMode mode, Vec3f point) {
+  switch (mode) {
+    case ClipMode::None: return false;
+    case ClipMode::Union:
+      for (const ClipPlane& p : planes) if (plane_side(p, point) < 0) return true;
+      return false;
+    case ClipMode::Intersection:
+      for (const ClipPlane& p : planes) if (plane_side(p, point) >= 0) return false;
+      return !planes.empty();
+    case ClipMode::Nearest: {
+      float best = INFINITY, side = 0;
+      for (const ClipPlane& p : planes) {
+        const float s = plane_side(p, point);
+        if (std::fabs(s) < best) best = std::fabs(s), side = s;
+      }
+      return side < 0;
+    }
+  }
+  return false;
+}
+
+// A surface id shared by no splat: an inner node of a hierarchy whose subtree has several ids.
+// Its fragments blend with any surface.
+constexpr std::uint32_t kMixedSurface = 0xffffffffu;
+// At most this many planes per splat (the nearest partners are kept).
+constexpr int kMaxClipPlanes = 16;
+
+// The dissertation's statistics (Tables 6.1–6.3) and ours.
+struct FeatureStats {
+  std::uint64_t splats = 0;
+  std::uint64_t edges = 0;          // |E|, undirected
+  std::uint64_t sharp_edges = 0;    // E_s
+  std::uint64_t crossing_edges = 0;  // E_ir: sharp edges whose discs cross
+  std::uint64_t antiparallel_edges = 0;  // sharp edges between (nearly) parallel planes
+  std::uint64_t candidates = 0;     // P_c: splats with a sharp edge
+  std::uint64_t clipped = 0;        // P_r: splats with a clip plane
+  std::uint64_t pass_through = 0;   // crossing partners rejected by the edge test (intersections)
+  std::uint64_t undefined_4_15 = 0;  // splats with partners where eqs. 4.13–4.15 are undefined
+  std::uint64_t nearest_rule = 0;   // splats clipped by ClipMode::Nearest
+  std::uint64_t capped = 0;         // splats that had more than kMaxClipPlanes distinct planes
+  std::uint64_t segments = 0;       // surface ids
+  std::uint64_t large_segments = 0;  // segments with at least 0.5 % of the splats
+  // [k] = splats with k clip planes, k = 1..kMaxClipPlanes ([0] unused).
+  std::array<std::uint64_t, kMaxClipPlanes + 1> plane_histogram{};
+
+  double mean_degree() const { return splats ? 2.0 * static_cast<double>(edges) / splats : 0; }
+};
+
+// What the features module computes, per splat of its input (structure of arrays).
+struct FeatureData {
+  std::vector<std::uint32_t> surface_id;
+  std::vector<ClipMode> clip_mode;
+  std::vector<std::uint32_t> clip_offset;  // size n + 1: planes of splat i are
+  std::vector<ClipPlane> clip_planes;      // clip_planes[clip_offset[i] .. clip_offset[i + 1])
+  FeatureOptions options;                  // what they were computed with
+  FeatureStats stats;
+
+  std::size_t size() const { return surface_id.size(); }
+  std::span<const ClipPlane> planes(std::size_t i) const {
+    return {clip_planes.data() + clip_offset[i], clip_planes.data() + clip_offset[i + 1]};
+  }
+};
+
+// Features of the splats (centres, unit normals, splat radii; the drawn radius is
+// options.radius_scale × radius). Normals must point outward consistently. Parallel; the result
+// does not depend on the thread count. Progress phases "neighbour graph", "sharp features".
+// Throws OptionError for invalid options.
+FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec3f> normals,
+                             std::span<const float> radii, ThreadPool& pool,
+                             const FeatureOptions& options = {},
+                             Progress& progress = Progress::none());
+
+}  // namespace pointillist

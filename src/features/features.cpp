@@ -1,0 +1,180 @@
+// compute_features: the graph, then every splat's sharp edges, partners and planes in parallel
+// blocks (concatenated in splat order), then the surface ids.
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "pointillist/core/error.hpp"
+#include "pointillist/features/features.hpp"
+#include "pointillist/features/neighbour_graph.hpp"
+#include "pointillist/features/rules.hpp"
+
+namespace pointillist {
+namespace {
+
+struct Block {
+  std::vector<ClipMode> modes;
+  std::vector<std::uint32_t> plane_counts;
+  std::vector<ClipPlane> planes;
+  FeatureStats stats;
+};
+
+void add(FeatureStats& to, const FeatureStats& from) {
+  to.sharp_edges += from.sharp_edges;
+  to.crossing_edges += from.crossing_edges;
+  to.antiparallel_edges += from.antiparallel_edges;
+  to.candidates += from.candidates;
+  to.clipped += from.clipped;
+  to.pass_through += from.pass_through;
+  to.undefined_4_15 += from.undefined_4_15;
+  to.nearest_rule += from.nearest_rule;
+  to.capped += from.capped;
+  for (std::size_t k = 0; k < to.plane_histogram.size(); ++k) {
+    to.plane_histogram[k] += from.plane_histogram[k];
+  }
+}
+
+// Breadth-first search over the continuous edges, seeded in increasing splat index (spec §1.8
+// [P]): ids are numbered in the order of each surface's smallest splat index.
+std::uint64_t segment(const NeighbourGraph& graph, std::span<const Vec3f> normals, float w_s,
+                      std::vector<std::uint32_t>& ids, std::uint64_t& large) {
+  const std::size_t n = graph.vertex_count();
+  constexpr std::uint32_t kNone = 0xffffffffu;
+  ids.assign(n, kNone);
+  std::vector<std::uint32_t> queue(n);
+  std::uint32_t next_id = 0;
+  large = 0;
+  const std::size_t large_size = std::max<std::size_t>(1, (n + 199) / 200);  // 0.5 %
+  for (std::size_t seed = 0; seed < n; ++seed) {
+    if (ids[seed] != kNone) continue;
+    std::size_t head = 0, tail = 0;
+    queue[tail++] = static_cast<std::uint32_t>(seed);
+    ids[seed] = next_id;
+    while (head < tail) {
+      const std::uint32_t s = queue[head++];
+      for (std::uint32_t j : graph.row(s)) {
+        if (ids[j] == kNone && dot(normals[s], normals[j]) >= w_s) {
+          ids[j] = next_id;
+          queue[tail++] = j;
+        }
+      }
+    }
+    if (tail >= large_size) ++large;
+    ++next_id;
+  }
+  return next_id;
+}
+
+}  // namespace
+
+void validate_feature_options(const FeatureOptions& o) {
+  if (!(o.sharp_threshold >= -1.0f && o.sharp_threshold <= 1.0f)) {
+    throw OptionError("--sharp-threshold must be in [-1, 1] (the cosine of the angle between two "
+                      "neighbours' normals below which their edge is sharp; 0.9 is about 26°), "
+                      "not " + std::to_string(o.sharp_threshold));
+  }
+  if (!(o.linsen_alpha_deg > 0.0f && o.linsen_alpha_deg < 360.0f)) {
+    throw OptionError("the Linsen gap angle must be in (0, 360) degrees, not " +
+                      std::to_string(o.linsen_alpha_deg));
+  }
+  if (!(o.radius_scale >= 1.0f && o.radius_scale <= 2.0f)) {
+    throw OptionError("the features' radius scale must be in [1, 2] (the renderer's "
+                      "--radius-scale), not " + std::to_string(o.radius_scale));
+  }
+}
+
+FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec3f> normals,
+                             std::span<const float> radii, ThreadPool& pool,
+                             const FeatureOptions& options, Progress& progress) {
+  validate_feature_options(options);
+  const std::size_t n = centers.size();
+  FeatureData out;
+  out.options = options;
+  std::vector<float> drawn(n);
+  for (std::size_t i = 0; i < n; ++i) drawn[i] = radii[i] * options.radius_scale;
+  const NeighbourGraph graph = build_neighbour_graph(centers, drawn, pool, progress);
+  out.stats.splats = n;
+  out.stats.edges = graph.edge_count();
+
+  constexpr std::size_t kBlock = 4096;
+  std::vector<Block> blocks((n + kBlock - 1) / kBlock);
+  {
+    ProgressPhase phase(progress, "sharp features", n);
+    pool.run(blocks.size(), [&](std::size_t b) {
+      Block& block = blocks[b];
+      const std::size_t first = b * kBlock, end = std::min(n, first + kBlock);
+      block.modes.resize(end - first);
+      block.plane_counts.resize(end - first);
+      std::vector<Vec3f> continuous;
+      std::vector<std::uint32_t> crossing;
+      std::vector<Disc> partners;
+      for (std::size_t i = first; i < end; ++i) {
+        const Disc s{centers[i], normals[i], drawn[i]};
+        continuous.clear();
+        crossing.clear();
+        bool candidate = false;
+        for (std::uint32_t j : graph.row(i)) {
+          if (dot(normals[i], normals[j]) >= options.sharp_threshold) {
+            continuous.push_back(centers[j]);
+            continue;
+          }
+          candidate = true;
+          const Crossing x = disc_crossing(s, Disc{centers[j], normals[j], drawn[j]});
+          if (j > i) {
+            ++block.stats.sharp_edges;
+            block.stats.crossing_edges += x == Crossing::Cross;
+            block.stats.antiparallel_edges += x == Crossing::Parallel;
+          }
+          if (x == Crossing::Cross) crossing.push_back(j);
+        }
+        block.stats.candidates += candidate;
+        // Partners: crossing discs at which this splat's surface ends, nearest first.
+        const bool boundary = options.edge_test == EdgeTest::Linsen && !crossing.empty() &&
+                              linsen_boundary(s, continuous, options.linsen_alpha_deg);
+        partners.clear();
+        for (std::uint32_t j : crossing) {
+          const Disc p{centers[j], normals[j], drawn[j]};
+          const bool ends = options.edge_test == EdgeTest::Linsen ? boundary
+                                                                   : surface_ends_at(s, continuous, p);
+          if (ends) {
+            partners.push_back(p);
+          } else {
+            ++block.stats.pass_through;
+          }
+        }
+        std::stable_sort(partners.begin(), partners.end(), [&](const Disc& a, const Disc& c) {
+          return length_squared(a.c - s.c) < length_squared(c.c - s.c);
+        });
+        const ClipResult clip = classify_partners(s, partners, continuous, options.clip_rule);
+        block.stats.undefined_4_15 += clip.undefined_4_15;
+        block.stats.capped += clip.capped;
+        block.modes[i - first] = clip.mode;
+        block.plane_counts[i - first] = static_cast<std::uint32_t>(clip.planes.size());
+        if (!clip.planes.empty()) {
+          ++block.stats.clipped;
+          ++block.stats.plane_histogram[clip.planes.size()];
+          block.stats.nearest_rule += clip.mode == ClipMode::Nearest;
+          block.planes.insert(block.planes.end(), clip.planes.begin(), clip.planes.end());
+        }
+      }
+      progress.advance(end - first);
+    });
+  }
+
+  out.clip_mode.reserve(n);
+  out.clip_offset.reserve(n + 1);
+  out.clip_offset.push_back(0);
+  for (const Block& block : blocks) {
+    add(out.stats, block.stats);
+    out.clip_mode.insert(out.clip_mode.end(), block.modes.begin(), block.modes.end());
+    for (std::uint32_t count : block.plane_counts) {
+      out.clip_offset.push_back(out.clip_offset.back() + count);
+    }
+    out.clip_planes.insert(out.clip_planes.end(), block.planes.begin(), block.planes.end());
+  }
+  out.stats.segments = segment(graph, normals, options.sharp_threshold, out.surface_id,
+                               out.stats.large_segments);
+  return out;
+}
+
+}  // namespace pointillist

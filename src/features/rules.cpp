@@ -1,0 +1,250 @@
+// The per-splat rules: disc crossing, side and gap tests, orientation, union or intersection.
+// All arithmetic is relative to the splat's centre, so that models far from the origin keep
+// their precision.
+#include <algorithm>
+#include <cmath>
+
+#include "pointillist/features/rules.hpp"
+
+namespace pointillist {
+namespace {
+
+// Tolerance of the classification's sign tests, in radii of the splat (spec Q4).
+constexpr float kClassifyTolerance = 1e-3f;
+// Tolerance of the side test, in radii of the splat (spec §1.4).
+constexpr float kSideTolerance = 0.1f;
+
+// Chord [t0, t1] of the line p + t·d through a disc centred at the origin of `q` coordinates
+// (q = p − c), radius r; false when the line misses it.
+bool chord(Vec3f q, Vec3f d, float r, double& t0, double& t1) {
+  const double a = dot(d, d), b = dot(q, d), c = static_cast<double>(dot(q, q)) - double(r) * r;
+  const double disc = b * b - a * c;
+  if (disc < 0) return false;
+  const double s = std::sqrt(disc);
+  t0 = (-b - s) / a;
+  t1 = (-b + s) / a;
+  return true;
+}
+
+// The plane of `partner` with its kept side toward `keep_positive`, as seen from the splat:
+// n·P − h, h = n·c_partner.
+ClipPlane oriented_plane(const Disc& partner, bool keep_positive) {
+  const float sign = keep_positive ? 1.0f : -1.0f;
+  return {partner.n * sign, dot(partner.n, partner.c) * sign};
+}
+
+// Pointillist's orientation: the kept side of the partner's plane is the side where the splat's
+// own surface lies: its centre, or the centroid of it and its continuous neighbours when the
+// centre is on the plane; the convex default (keep the back side) when both are.
+bool keep_positive_side(const Disc& s, const Disc& partner, std::span<const Vec3f> continuous) {
+  const float tol = kClassifyTolerance * s.r;
+  const float side = dot(s.c - partner.c, partner.n);
+  if (std::fabs(side) > tol) return side > 0;
+  Vec3f sum{0, 0, 0};
+  for (Vec3f c : continuous) sum += c - s.c;
+  const Vec3f centroid = s.c + sum / static_cast<float>(continuous.size() + 1);
+  const float cside = dot(centroid - partner.c, partner.n);
+  if (std::fabs(cside) > tol) return cside > 0;
+  return false;
+}
+
+// Sign of eq. 4.14's term for one partner: +1 concave, −1 convex, 0 within the tolerance.
+int concavity(const Disc& s, const Disc& partner) {
+  const float v = dot(partner.c - s.c, s.n);
+  const float tol = kClassifyTolerance * s.r;
+  return v > tol ? 1 : (v < -tol ? -1 : 0);
+}
+
+// Removes planes equal to an earlier one (spec §1.12: n·n′ > 1 − 1e-6, |h − h′| < 1e-4·r),
+// keeping the first (nearest) of each, with its partner's centre.
+void deduplicate(std::vector<ClipPlane>& planes, std::vector<Vec3f>& centres, float r) {
+  std::size_t kept = 0;
+  for (std::size_t k = 0; k < planes.size(); ++k) {
+    bool same = false;
+    for (std::size_t m = 0; m < kept && !same; ++m) {
+      same = dot(planes[k].n, planes[m].n) > 1.0f - 1e-6f &&
+             std::fabs(planes[k].h - planes[m].h) < 1e-4f * r;
+    }
+    if (!same) {
+      planes[kept] = planes[k];
+      centres[kept] = centres[k];
+      ++kept;
+    }
+  }
+  planes.resize(kept);
+  centres.resize(kept);
+}
+
+// Union or intersection from the pairs of planes (spec §4.8 item 4): b's centre projected into
+// the splat's plane lies on a's kept side (convex pair) or on its clipped side (reflex pair).
+ClipMode combine_pairs(const Disc& s, const std::vector<ClipPlane>& planes,
+                       const std::vector<Vec3f>& centres) {
+  if (planes.size() == 1) return ClipMode::Union;
+  const float tol = kClassifyTolerance * s.r;
+  bool convex = false, reflex = false;
+  for (std::size_t b = 0; b < planes.size(); ++b) {
+    const Vec3f x = centres[b] - s.n * dot(centres[b] - s.c, s.n);
+    for (std::size_t a = 0; a < planes.size(); ++a) {
+      if (a == b) continue;
+      // Relative to the splat's centre for precision: n·(x − c) − (h − n·c).
+      const float side = dot(planes[a].n, x - s.c) - (planes[a].h - dot(planes[a].n, s.c));
+      convex |= side > tol;
+      reflex |= side < -tol;
+    }
+  }
+  if (convex && reflex) return ClipMode::Nearest;
+  return reflex ? ClipMode::Intersection : ClipMode::Union;
+}
+
+// Whether eqs. 4.13–4.14 classify the partners, and their verdict: union when both sets have
+// the same type. Single partners use eq. 4.17 directly (union).
+struct Classification {
+  bool defined = false;
+  bool concave_with_s = false;  // S ∪ N_cp concave (eq. 4.14)
+  bool union_rule = true;
+};
+Classification classify_4_15(const Disc& s, std::span<const Disc> partners) {
+  Classification c;
+  int with_s = concavity(s, partners[0]);
+  for (const Disc& p : partners) {
+    if (concavity(s, p) != with_s) with_s = 0;
+  }
+  if (with_s == 0) return c;
+  c.concave_with_s = with_s > 0;
+  if (partners.size() == 1) {
+    c.defined = true;
+    return c;
+  }
+  Vec3f mean{0, 0, 0};
+  for (const Disc& p : partners) mean += p.c - s.c;
+  mean = s.c + mean / static_cast<float>(partners.size());
+  int among = 0;
+  bool first = true;
+  for (const Disc& p : partners) {
+    const float v = dot(mean - p.c, p.n);
+    const float tol = kClassifyTolerance * p.r;
+    const int sign = v > tol ? 1 : (v < -tol ? -1 : 0);
+    among = first ? sign : (sign == among ? among : 0);
+    first = false;
+  }
+  if (among == 0) return c;
+  c.defined = true;
+  c.union_rule = (among > 0) == c.concave_with_s;
+  return c;
+}
+
+}  // namespace
+
+Crossing disc_crossing(const Disc& a, const Disc& b) {
+  const Vec3f d = cross(a.n, b.n);
+  const float dd = dot(d, d);
+  if (dd < 1e-6f) return Crossing::Parallel;
+  // The line's point P_o = t_a·n_a + t_b·n_b (eqs. 4.5–4.7) with a's centre as the origin:
+  // h_a = 0, h_b = n_b·(c_b − c_a).
+  const double c = dot(a.n, b.n);
+  const double hb = dot(b.n, b.c - a.c);
+  const double denom = 1.0 - c * c;
+  const double ta = -c * hb / denom, tb = hb / denom;
+  const Vec3f po = a.n * static_cast<float>(ta) + b.n * static_cast<float>(tb);
+  double a0, a1, b0, b1;
+  if (!chord(po, d, a.r, a0, a1)) return Crossing::Apart;
+  if (!chord(po - (b.c - a.c), d, b.r, b0, b1)) return Crossing::Apart;
+  return std::max(a0, b0) <= std::min(a1, b1) ? Crossing::Cross : Crossing::Apart;
+}
+
+bool surface_ends_at(const Disc& s, std::span<const Vec3f> continuous, const Disc& partner) {
+  const float tol = kSideTolerance * s.r;
+  const float own = dot(s.c - partner.c, partner.n);
+  bool above = own > tol, below = own < -tol;
+  for (Vec3f c : continuous) {
+    const float side = dot(c - partner.c, partner.n);
+    above |= side > tol;
+    below |= side < -tol;
+  }
+  return !(above && below);
+}
+
+bool linsen_boundary(const Disc& s, std::span<const Vec3f> continuous, float alpha_deg) {
+  if (continuous.size() < 2) return true;
+  // A frame (u, v) of the splat's plane; v′_j = (c_j − c) × n (eq. 4.2) has the angular order of
+  // the projections.
+  const Vec3f helper = std::fabs(s.n.x) < 0.9f ? Vec3f{1, 0, 0} : Vec3f{0, 1, 0};
+  const Vec3f u = normalized(cross(s.n, helper));
+  const Vec3f v = cross(s.n, u);
+  std::vector<float> angles;
+  angles.reserve(continuous.size());
+  for (Vec3f c : continuous) {
+    const Vec3f w = cross(c - s.c, s.n);
+    if (dot(w, w) == 0) continue;  // a neighbour straight above or below: no direction
+    angles.push_back(std::atan2(dot(w, v), dot(w, u)));
+  }
+  if (angles.size() < 2) return true;
+  std::sort(angles.begin(), angles.end());
+  const float alpha = deg_to_rad(alpha_deg);
+  float gap = angles.front() + 2.0f * kPi - angles.back();
+  for (std::size_t k = 1; k < angles.size(); ++k) gap = std::max(gap, angles[k] - angles[k - 1]);
+  return gap > alpha;
+}
+
+ClipResult classify_partners(const Disc& s, std::span<const Disc> partners,
+                             std::span<const Vec3f> continuous, ClipRule rule) {
+  ClipResult result;
+  if (partners.empty()) return result;
+  const Classification c = classify_4_15(s, partners);
+  result.undefined_4_15 = !c.defined;
+  std::vector<ClipPlane> planes;
+  std::vector<Vec3f> centres;
+  switch (rule) {
+    case ClipRule::Classified:
+      for (const Disc& p : partners) {
+        planes.push_back(oriented_plane(p, keep_positive_side(s, p, continuous)));
+        centres.push_back(p.c);
+      }
+      break;
+    case ClipRule::Dissertation:
+      if (!c.defined) return result;
+      // Eq. 4.17: S ∪ N_cp concave keeps the positive side of every partner, convex the
+      // negative side.
+      for (const Disc& p : partners) {
+        planes.push_back(oriented_plane(p, c.concave_with_s));
+        centres.push_back(p.c);
+      }
+      break;
+    case ClipRule::Independent:
+    case ClipRule::NearestPartner:
+      for (const Disc& p : partners) {
+        const int sign = concavity(s, p);
+        if (sign == 0) continue;
+        planes.push_back(oriented_plane(p, sign > 0));
+        centres.push_back(p.c);
+        if (rule == ClipRule::NearestPartner) break;
+      }
+      break;
+  }
+  deduplicate(planes, centres, s.r);
+  if (planes.empty()) return result;
+  if (planes.size() > static_cast<std::size_t>(kMaxClipPlanes)) {
+    result.capped = true;
+    planes.resize(kMaxClipPlanes);
+    centres.resize(kMaxClipPlanes);
+  }
+  switch (rule) {
+    case ClipRule::Classified: result.mode = combine_pairs(s, planes, centres); break;
+    case ClipRule::Dissertation:
+      result.mode = c.union_rule ? ClipMode::Union : ClipMode::Intersection;
+      break;
+    default: result.mode = ClipMode::Union; break;
+  }
+  // Scale each plane so that, within the splat's plane, n·P − h is the distance to the line
+  // where the planes meet (ClipMode::Nearest compares these distances).
+  for (ClipPlane& p : planes) {
+    const float cos_angle = dot(p.n, s.n);
+    const float scale = 1.0f / std::sqrt(std::max(1e-6f, 1.0f - cos_angle * cos_angle));
+    p.n *= scale;
+    p.h *= scale;
+  }
+  result.planes = std::move(planes);
+  return result;
+}
+
+}  // namespace pointillist
