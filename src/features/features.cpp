@@ -107,7 +107,7 @@ FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec
       block.plane_counts.resize(end - first);
       std::vector<Vec3f> continuous;
       std::vector<std::uint32_t> crossing;
-      std::vector<Disc> partners;
+      std::vector<Disc> partners, through;
       for (std::size_t i = first; i < end; ++i) {
         const Disc s{centers[i], normals[i], drawn[i]};
         continuous.clear();
@@ -132,20 +132,37 @@ FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec
         const bool boundary = options.edge_test == EdgeTest::Linsen && !crossing.empty() &&
                               linsen_boundary(s, continuous, options.linsen_alpha_deg);
         partners.clear();
+        through.clear();
         for (std::uint32_t j : crossing) {
           const Disc p{centers[j], normals[j], drawn[j]};
           const bool ends = options.edge_test == EdgeTest::Linsen ? boundary
                                                                    : surface_ends_at(s, continuous, p);
-          if (ends) {
-            partners.push_back(p);
-          } else {
-            ++block.stats.pass_through;
-          }
+          (ends ? partners : through).push_back(p);
         }
-        std::stable_sort(partners.begin(), partners.end(), [&](const Disc& a, const Disc& c) {
+        // A reflex vertex of the splat's face: its surface passes through two partner planes,
+        // but not through both at once.
+        const std::size_t passing = through.size();
+        if (through.size() < 2) through.clear();
+        if (options.edge_test == EdgeTest::Side && options.clip_rule == ClipRule::Classified &&
+            through.size() >= 2) {
+          const std::vector<std::uint8_t> reflex = reflex_partners(s, continuous, through);
+          std::size_t kept = 0;
+          for (std::size_t k = 0; k < through.size(); ++k) {
+            if (reflex[k]) through[kept++] = through[k];
+          }
+          through.resize(kept);
+        }
+        if (options.edge_test != EdgeTest::Side || options.clip_rule != ClipRule::Classified) {
+          through.clear();
+        }
+        block.stats.pass_through += passing - through.size();
+        const auto nearer = [&](const Disc& a, const Disc& c) {
           return length_squared(a.c - s.c) < length_squared(c.c - s.c);
-        });
-        const ClipResult clip = classify_partners(s, partners, continuous, options.clip_rule);
+        };
+        std::stable_sort(partners.begin(), partners.end(), nearer);
+        std::stable_sort(through.begin(), through.end(), nearer);
+        const ClipResult clip =
+            classify_partners(s, partners, continuous, options.clip_rule, through);
         block.stats.undefined_4_15 += clip.undefined_4_15;
         block.stats.capped += clip.capped;
         block.modes[i - first] = clip.mode;

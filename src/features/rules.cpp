@@ -186,18 +186,54 @@ bool linsen_boundary(const Disc& s, std::span<const Vec3f> continuous, float alp
   return gap > alpha;
 }
 
+std::vector<std::uint8_t> reflex_partners(const Disc& s, std::span<const Vec3f> continuous,
+                                          std::span<const Disc> through) {
+  std::vector<std::uint8_t> flags(through.size(), 0);
+  const float tol = kSideTolerance * s.r;
+  // Signed distance beyond the plane's far side (> 0 beyond): the far side of a partner below
+  // s's plane (convex, eq. 4.14) is its front, of one above (concave) its back.
+  const auto beyond = [&](const Disc& p, int sign, Vec3f x) {
+    return dot(x - p.c, p.n) * static_cast<float>(sign);
+  };
+  for (std::size_t a = 0; a < through.size(); ++a) {
+    const int sa = -concavity(s, through[a]);
+    if (sa == 0) continue;
+    const Vec3f la = normalized(cross(through[a].n, s.n));
+    for (std::size_t b = a + 1; b < through.size(); ++b) {
+      const int sb = -concavity(s, through[b]);
+      if (sb == 0) continue;
+      const Vec3f lb = normalized(cross(through[b].n, s.n));
+      if (length(cross(la, lb)) < 0.5f) continue;  // lines within 30°: not a corner
+      bool empty = !(beyond(through[a], sa, s.c) > tol && beyond(through[b], sb, s.c) > tol);
+      for (std::size_t k = 0; k < continuous.size() && empty; ++k) {
+        empty = !(beyond(through[a], sa, continuous[k]) > tol &&
+                  beyond(through[b], sb, continuous[k]) > tol);
+      }
+      if (empty) flags[a] = flags[b] = 1;
+    }
+  }
+  return flags;
+}
+
 ClipResult classify_partners(const Disc& s, std::span<const Disc> partners,
-                             std::span<const Vec3f> continuous, ClipRule rule) {
+                             std::span<const Vec3f> continuous, ClipRule rule,
+                             std::span<const Disc> reflex) {
   ClipResult result;
-  if (partners.empty()) return result;
-  const Classification c = classify_4_15(s, partners);
-  result.undefined_4_15 = !c.defined;
+  if (partners.empty() && (rule != ClipRule::Classified || reflex.empty())) return result;
+  const Classification c = partners.empty() ? Classification{} : classify_4_15(s, partners);
+  result.undefined_4_15 = !partners.empty() && !c.defined;
   std::vector<ClipPlane> planes;
   std::vector<Vec3f> centres;
   switch (rule) {
     case ClipRule::Classified:
       for (const Disc& p : partners) {
         planes.push_back(oriented_plane(p, keep_positive_side(s, p, continuous)));
+        centres.push_back(p.c);
+      }
+      for (const Disc& p : reflex) {
+        const int sign = concavity(s, p);
+        if (sign == 0) continue;
+        planes.push_back(oriented_plane(p, sign > 0));
         centres.push_back(p.c);
       }
       break;

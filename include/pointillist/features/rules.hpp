@@ -39,6 +39,15 @@ bool surface_ends_at(const Disc& s, std::span<const Vec3f> continuous, const Dis
 // into s's plane larger than alpha_deg.
 bool linsen_boundary(const Disc& s, std::span<const Vec3f> continuous, float alpha_deg);
 
+// Of `through`, crossing discs whose plane the surface of `s` passes through (the side test
+// says so for each alone), those that form a reflex vertex of s's face with another: two
+// planes whose lines in s's plane cross at 30° or more, and where no point of s's surface (its
+// centre and `continuous`) lies beyond both by more than 0.1·s.r, each plane's far side being
+// the one eq. 4.14 clips. At the inner corner of an L-shaped face the face continues past each
+// of the two planes, but not past both. Returns a flag per disc of `through`.
+std::vector<std::uint8_t> reflex_partners(const Disc& s, std::span<const Vec3f> continuous,
+                                          std::span<const Disc> through);
+
 struct ClipResult {
   ClipMode mode = ClipMode::None;
   std::vector<ClipPlane> planes;  // oriented, de-duplicated, scaled (ClipPlane), at most 16
@@ -48,8 +57,11 @@ struct ClipResult {
 
 // The clip planes of `s` from its partners (discs that cross it and that its surface ends at,
 // nearest first) under `rule`. `continuous` are the centres of s's continuous neighbours (for
-// orienting a plane that passes through s's centre).
+// orienting a plane that passes through s's centre). `reflex` (ClipRule::Classified only) are
+// partners found by reflex_partners; they are oriented by their own eq. 4.14 sign instead of
+// by the side s lies on (s's surface is on both sides of each).
 ClipResult classify_partners(const Disc& s, std::span<const Disc> partners,
-                             std::span<const Vec3f> continuous, ClipRule rule);
+                             std::span<const Vec3f> continuous, ClipRule rule,
+                             std::span<const Disc> reflex = {});
 
 }  // namespace pointillist
