@@ -142,9 +142,8 @@ FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec
         // A reflex vertex of the splat's face: its surface passes through two partner planes,
         // but not through both at once.
         const std::size_t passing = through.size();
-        if (through.size() < 2) through.clear();
         if (options.edge_test == EdgeTest::Side && options.clip_rule == ClipRule::Classified &&
-            through.size() >= 2) {
+            !through.empty()) {
           const std::vector<std::uint8_t> reflex = reflex_partners(s, continuous, through);
           std::size_t kept = 0;
           for (std::size_t k = 0; k < through.size(); ++k) {

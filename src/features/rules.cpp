@@ -199,6 +199,23 @@ std::vector<std::uint8_t> reflex_partners(const Disc& s, std::span<const Vec3f> 
     const int sa = -concavity(s, through[a]);
     if (sa == 0) continue;
     const Vec3f la = normalized(cross(through[a].n, s.n));
+    // One plane: the surface continues past it, but only beside the disc's chord on the line
+    // where the planes meet (a splat near such a corner whose disc does not reach the other
+    // plane). Straight across the chord lies none of the surface beyond the plane.
+    if (const float d = -beyond(through[a], sa, s.c); d > tol) {
+      // Distance from s's centre to the line, within s's plane: d over the sine of the angle.
+      const float sin_angle = length(cross(through[a].n, s.n));
+      const float to_line = d / std::max(sin_angle, 1e-3f);
+      if (to_line < s.r) {
+        const float half = std::sqrt(s.r * s.r - to_line * to_line);
+        bool empty = true;
+        for (std::size_t k = 0; k < continuous.size() && empty; ++k) {
+          empty = !(beyond(through[a], sa, continuous[k]) > tol &&
+                    std::fabs(dot(continuous[k] - s.c, la)) < half);
+        }
+        if (empty) flags[a] = 1;
+      }
+    }
     for (std::size_t b = a + 1; b < through.size(); ++b) {
       const int sb = -concavity(s, through[b]);
       if (sb == 0) continue;

@@ -44,7 +44,9 @@ bool linsen_boundary(const Disc& s, std::span<const Vec3f> continuous, float alp
 // planes whose lines in s's plane cross at 30° or more, and where no point of s's surface (its
 // centre and `continuous`) lies beyond both by more than 0.1·s.r, each plane's far side being
 // the one eq. 4.14 clips. At the inner corner of an L-shaped face the face continues past each
-// of the two planes, but not past both. Returns a flag per disc of `through`.
+// of the two planes, but not past both. Also a single plane that s's centre is within s.r/2 of
+// while none of s's surface beyond it lies under s's disc (a splat beside such a corner whose
+// disc does not reach the other plane). Returns a flag per disc of `through`.
 std::vector<std::uint8_t> reflex_partners(const Disc& s, std::span<const Vec3f> continuous,
                                           std::span<const Disc> through);
 
