@@ -74,6 +74,8 @@ struct RenderOptions {
   unsigned progressive_frames = 0;  // --progressive N
   std::uint64_t read_per_frame = 1u << 20;  // --read-per-frame BYTES (progressive loading)
   std::vector<std::string> warnings;  // options given that do not apply (printed by run_render)
+  // Sharp features (README "Sharp edges and intersecting surfaces"): compute them in memory.
+  std::optional<FeatureOptions> features;
 };
 int run_render(const RenderOptions& options);
 
@@ -107,6 +109,8 @@ struct GenerateOptions {
   std::size_t points = 1'000'000;
   std::uint64_t seed = 1;
   bool with_normals = false;  // write the exact normals too
+  std::string sampling = "j";  // test scenes T*: j or r
+  unsigned threads = 0;
   bool quiet = false;
 };
 int run_generate(const GenerateOptions& options);

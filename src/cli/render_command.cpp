@@ -133,6 +133,8 @@ int run_render(const RenderOptions& o) {
   open.paging = paging_asked ? Paging::Always : (paging_possible ? Paging::Auto : Paging::Never);
   open.frames = std::max<std::uint64_t>(1, std::uint64_t(o.orbit_frames) + o.refine_frames);
   open.frame_pixels = std::uint64_t(o.view.width) * std::uint64_t(o.view.height);
+  open.features = o.features;
+  if (o.features) open.paging = Paging::Never;  // features need the hierarchy held whole
   const Scene scene = o.inputs.size() == 1 && is_scene_file(o.inputs[0])
                           ? read_scene(o.inputs[0], open, pool, progress)
                           : scene_of_models(o.inputs, open, pool, progress);

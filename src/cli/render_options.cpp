@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "pointillist/core/error.hpp"
 #include "options.hpp"
 #include "pointillist/pipeline/model.hpp"
 
@@ -15,6 +16,8 @@ struct RenderText {
   std::string size = "1280x720", view, eye, target, up, background = "0,0,0", path, memory,
               read_per_frame;
   bool no_chunk_culling = false;
+  bool features = false, no_features = false;
+  FeatureOptions feature;
 };
 
 void add_camera(CLI::App* cmd, RenderOptions& o, RenderText& t) {
@@ -75,6 +78,39 @@ void add_look(CLI::App* cmd, RenderOptions& o, RenderText& t) {
       ->default_val(1.0f)
       ->check(CLI::Range(0.001f, 1.0f))
       ->group(kGroupLook);
+}
+
+void add_features(CLI::App* cmd, RenderText& t) {
+  constexpr const char* kGroup = "Sharp edges and intersecting surfaces";
+  cmd->add_flag("--features", t.features,
+                "Find sharp edges, corners and intersecting surfaces of the models held whole "
+                "and draw them: discs clipped at creases, each pixel blended from one surface")
+      ->group(kGroup);
+  cmd->add_flag("--no-features", t.no_features, "Draw without the sharp features (to compare)")
+      ->group(kGroup);
+  cmd->add_option("--sharp-threshold", t.feature.sharp_threshold,
+                  "With --features: neighbours whose normals' cosine is below W are a sharp "
+                  "edge (0.9: about 26 degrees)")
+      ->default_val(0.9f)
+      ->check(CLI::Range(-1.0f, 1.0f))
+      ->group(kGroup);
+  add_enum<EdgeTest>(cmd, "--edge-test", t.feature.edge_test,
+                     {{"side", EdgeTest::Side}, {"linsen", EdgeTest::Linsen}},
+                     "With --features: how a crease is told from an intersection: side (per "
+                     "pair, whether the surface lies on both sides of the other's plane) or "
+                     "linsen (the dissertation's angular gap test)",
+                     "side")
+      ->group(kGroup);
+  add_enum<ClipRule>(cmd, "--clip-rule", t.feature.clip_rule,
+                     {{"classified", ClipRule::Classified},
+                      {"dissertation", ClipRule::Dissertation},
+                      {"independent", ClipRule::Independent},
+                      {"nearest", ClipRule::NearestPartner}},
+                     "With --features: how several clip planes combine: classified "
+                     "(Pointillist's rule), dissertation (Ivo's eqs. 4.13-4.15), independent "
+                     "(each plane on its own) or nearest (the nearest partner only)",
+                     "classified")
+      ->group(kGroup);
 }
 
 void add_detail(CLI::App* cmd, RenderOptions& o, RenderText& t) {
@@ -147,6 +183,11 @@ std::vector<std::string> ignored_options(const CLI::App& cmd, const RenderOption
     ignored("--epsilon", "it is the Sequential Point Tree's detail; add --lod spt");
     ignored("--no-chunk-culling", "it applies to --lod spt");
   }
+  if (!t.features) {
+    for (const char* name : {"--sharp-threshold", "--edge-test", "--clip-rule"}) {
+      ignored(name, "it applies with --features");
+    }
+  }
   if (!quality) {
     ignored("--reconstruction", "it applies to --mode quality");
     ignored("--opacity", "it applies to --mode quality");
@@ -186,6 +227,7 @@ Command add_render_command(CLI::App& app) {
   add_camera(cmd, *o, *t);
   add_look(cmd, *o, *t);
   add_detail(cmd, *o, *t);
+  add_features(cmd, *t);
   add_sequences_and_paging(cmd, *o, *t);
   add_prepare_options(cmd, o->prepare, /*with_radius_scale=*/false);
   add_columns(cmd, o->columns);
@@ -194,6 +236,14 @@ Command add_render_command(CLI::App& app) {
   return {cmd, [o, t, cmd] {
             o->warnings = ignored_options(*cmd, *o, *t);
             o->frame.spt_chunk_culling = !t->no_chunk_culling;
+            if (t->features && t->no_features) {
+              throw OptionError("--features and --no-features contradict each other; give one");
+            }
+            if (t->features) {
+              t->feature.radius_scale = o->frame.quality.radius_scale;
+              o->features = t->feature;
+            }
+            o->frame.features = !t->no_features;
             parse_size_and_view(t->size, t->view, o->view);
             if (!t->eye.empty()) o->view.eye = parse_vec3(t->eye, "--eye");
             if (!t->target.empty()) o->view.target = parse_vec3(t->target, "--target");

@@ -138,6 +138,11 @@ Model Model::open_file(const std::string& path, const OpenModelOptions& options,
 Model open_model(const std::string& path, const OpenModelOptions& options, ThreadPool& pool,
                  Progress& progress) {
   Model model = Model::open_file(path, options, pool, progress);
+  if (options.features && !model.paged()) {
+    model.features_ = std::make_unique<TreeFeatures>(
+        compute_tree_features(model.view_, pool, *options.features, progress));
+    model.view_.features = model.features_.get();
+  }
   model.renderable_ = std::make_unique<RenderModel>(
       RenderModel{.tree = model.view_,
                   .pages = model.pages_.get(),

@@ -59,6 +59,7 @@ void frame_pass(const Camera& camera, const RenderSettings& settings,
   const CameraFrame cam = make_camera_frame(camera);
   size_frame(frame, cam);
   frame.splats.with_discs = quality != nullptr;
+  frame.splats.has_features = false;  // set by a selection that attaches them
   const SelectionStats selection = select(cam, frame.splats);
   const auto selected = Clock::now();
   if (quality) {

@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "frame_pass.hpp"
+#include "select/stream_features.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/render/mesh_reference.hpp"
 #include "pointillist/render/paged.hpp"
@@ -161,12 +162,20 @@ void Renderer::render(std::span<const SceneInstance> scene, const Camera& camera
 SelectionStats Renderer::select(std::span<const SceneInstance> scene, const Camera& camera,
                                 const CameraFrame& world, const RenderSettings& settings,
                                 const FrameSettings& fs, ThreadPool& pool, SplatStream& stream) {
-  const bool with_discs = stream.with_discs;
   stream.chunk_count = 0;
   stream.has_colors = false;
   SelectionStats total;
-  bool any_colors = false;
-  for (const SceneInstance& inst : scene) any_colors = any_colors || inst.model->tree.has_colors;
+  bool any_colors = false, any_features = false;
+  for (const SceneInstance& inst : scene) {
+    any_colors = any_colors || inst.model->tree.has_colors;
+    any_features = any_features || inst.model->tree.features;
+  }
+  // Sharp features on the QSplat hierarchy held whole (node ids index the features); the
+  // clip test needs the discs in both rasterizers.
+  const bool features = fs.features && any_features && fs.lod == LodScheme::QSplat;
+  if (features) stream.with_discs = true;
+  const bool with_discs = stream.with_discs;
+  std::uint32_t id_base = 0;
   for (std::size_t i = 0; i < scene.size(); ++i) {
     const SceneInstance& inst = scene[i];
     ModelState& state = state_for(*inst.model, pool, fs);
@@ -193,11 +202,16 @@ SelectionStats Renderer::select(std::span<const SceneInstance> scene, const Came
       select_splats(inst.model->tree, cam, settings, pool, into, selected);
     }
     add(total, selected);
+    if (const TreeFeatures* f = inst.model->tree.features) id_base += f->surface_count;
     const bool colors = into.has_colors;
     for (std::size_t c = 0; c < into.chunk_count; ++c) {
       SplatChunk& chunk = into.chunks[c];
       chunk.instance = static_cast<std::uint32_t>(i);
       if (!identity) to_world(inst.transform, chunk, with_discs);
+      if (features) {
+        const TreeFeatures* f = state.paged ? nullptr : inst.model->tree.features;
+        render_detail::attach_features(f, identity ? nullptr : &inst.transform, id_base, chunk);
+      }
       if (any_colors && !colors) {
         // A model without colours beside coloured ones: its base colour, as the others carry.
         const Rgb8 base{to_byte(settings.base_color.x), to_byte(settings.base_color.y),
@@ -218,6 +232,7 @@ SelectionStats Renderer::select(std::span<const SceneInstance> scene, const Came
     }
   }
   stream.has_colors = any_colors;
+  stream.has_features = features;
   if (fs.splat_scale != 1.0f) {
     for (std::size_t c = 0; c < stream.chunk_count; ++c) {
       SplatChunk& chunk = stream.chunks[c];

@@ -18,6 +18,8 @@
 
 namespace pointillist {
 
+struct TreeFeatures;  // lod/tree_features.hpp
+
 // 40 bytes, no padding; written to .ptl files as is (little endian), so the layout is fixed.
 struct SphereNode {
   Vec3f center;             // bounding sphere of the subtree (world units)
@@ -43,6 +45,8 @@ struct SphereTreeView {
   Sphere view_sphere;       // centre of `bounds`, largest distance to a sample (orbit camera)
   std::array<double, 3> origin{};  // absolute position = origin + position (PointSet::origin)
   Vec3f up{0, 1, 0};               // the model's up axis (PointSet::up)
+  // Sharp features of the nodes (surface ids, clip planes), or null.
+  const TreeFeatures* features = nullptr;
 };
 
 // Owning hierarchy as built in memory.

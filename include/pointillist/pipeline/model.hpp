@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "pointillist/core/point_set.hpp"
@@ -12,6 +13,7 @@
 #include "pointillist/core/thread_pool.hpp"
 #include "pointillist/lod/pages.hpp"
 #include "pointillist/lod/sphere_tree.hpp"
+#include "pointillist/lod/tree_features.hpp"
 #include "pointillist/prep/prepare.hpp"
 #include "pointillist/render/renderer.hpp"
 
@@ -51,6 +53,9 @@ struct OpenModelOptions {
   // is tiny (the dragon 1.4x faster to its PNG, a 5M cloud 2.9x with 0.57x the memory).
   std::uint64_t frames = 1;
   std::uint64_t frame_pixels = 1280 * 720;
+  // Compute sharp features (surface ids, clip planes) on the leaves of a model held whole, with
+  // these options (render --features). A paged model gets none.
+  std::optional<FeatureOptions> features;
 };
 
 class Model {
@@ -76,6 +81,8 @@ class Model {
   // The file's metadata text (.ptl, .qs), one "key: value" per line.
   const std::string& metadata() const { return metadata_; }
   std::uint64_t file_size() const { return file_size_; }
+  // Sharp features of the hierarchy's nodes, or null.
+  const TreeFeatures* features() const { return features_.get(); }
   // .ptl files (null for other kinds).
   const PtlFile* ptl_v1() const { return v1_.get(); }
   const PtlV2File* ptl_v2() const { return v2_.get(); }
@@ -103,6 +110,7 @@ class Model {
   std::string metadata_;
   std::uint64_t file_size_ = 0;
   ScanInput scan_input_;
+  std::unique_ptr<TreeFeatures> features_;
 };
 
 // Opens the model at `path`, chosen by its contents (.ptl, .qs) or, for anything else, read as a

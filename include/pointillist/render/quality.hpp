@@ -114,6 +114,7 @@ std::vector<ReconstructedSurface> reconstruct_pixel(std::span<const Fragment> fr
 struct QualityScratch {
   std::vector<std::vector<float>> chunk_splats;         // per-splat setup, one array per chunk
   std::vector<std::vector<std::uint32_t>> chunk_bins;  // per chunk: its splats by band of rows
+  std::vector<std::vector<float>> chunk_planes;        // per chunk: clip planes, eye space
   std::vector<std::vector<float>> band_buffers;        // per-pixel accumulators, one per worker
 };
 

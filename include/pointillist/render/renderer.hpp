@@ -86,6 +86,9 @@ struct FrameSettings {
   // Every splat is drawn this many times its size (a point-size control); the level of detail
   // is chosen as at 1. > 0.
   float splat_scale = 1.0f;
+  // Draw the sharp features of models that have them (TreeFeatures: clip planes, surface ids;
+  // QSplat on hierarchies held whole). Off draws as without them.
+  bool features = true;
 };
 
 struct RendererOptions {

@@ -8,6 +8,7 @@
 
 #include "pointillist/core/buffer.hpp"
 #include "pointillist/core/math.hpp"
+#include "pointillist/features/features.hpp"
 
 namespace pointillist {
 
@@ -32,6 +33,14 @@ struct SplatChunk {
   Buffer<Vec3f> normal;
   Buffer<Rgb8> color;       // filled only when the stream has_colors
   Buffer<std::uint32_t> node;  // index of the node in its hierarchy (or SPT entry)
+  // Sharp features, filled only when the stream has_features: the splat's surface id, unique
+  // across the scene's instances (kMixedSurface blends with any surface), and its clip planes
+  // in world space, clip_planes[clip_first[i] ..] (clip_count(clip_code[i]) of them, combined
+  // by clip_mode(clip_code[i])).
+  Buffer<std::uint32_t> surface;
+  Buffer<std::uint32_t> clip_first;
+  Buffer<std::uint8_t> clip_code;
+  std::vector<ClipPlane> clip_planes;
   // Which instance of the scene the chunk's splats belong to (a chunk holds one instance's).
   std::uint32_t instance = 0;
 
@@ -40,6 +49,13 @@ struct SplatChunk {
   // `with_colors`, the discs only `with_discs`.
   void reserve(std::size_t n, bool with_colors, bool with_discs);
 };
+
+// A splat's plane count and clip mode packed in one byte (SplatChunk::clip_code).
+constexpr std::uint8_t clip_code(std::size_t count, ClipMode mode) {
+  return static_cast<std::uint8_t>(count | (static_cast<unsigned>(mode) << 5));
+}
+constexpr std::uint32_t clip_count(std::uint8_t code) { return code & 31u; }
+constexpr ClipMode clip_mode(std::uint8_t code) { return static_cast<ClipMode>(code >> 5); }
 
 // The 8-bit channels of a packed color (SplatChunk::shaded).
 constexpr Rgb8 unpack_rgb(std::uint32_t c) {
@@ -59,6 +75,9 @@ struct SplatStream {
   // only, and leaving the discs out saves 16 bytes of stores a splat (about a tenth of the
   // QSplat selection's time on the dragon).
   bool with_discs = true;
+  // Whether the chunks carry surface ids and clip planes (a model with sharp features, drawn
+  // with them).
+  bool has_features = false;
 
   std::size_t size() const {
     std::size_t n = 0;

@@ -69,8 +69,22 @@ enum SplatField : int {
   kKey, kBound,           // ZRange: the widened interval; ZThreshold: unused, ε·r
   kBaseR, kBaseG, kBaseB, // base color, linear 0..1
   kWx, kWy, kWz,          // unit normal in world space (blended for shading)
-  kStride = 24,
+  // Sharp features (SplatStream::has_features), uint32 bits: surface id, the first of the
+  // splat's clip planes in the chunk's eye-space planes (4 floats each), SplatChunk::clip_code.
+  kSurface, kClipFirst, kClipCode,
+  kStride = 28,
 };
+
+inline float bits_to_float(std::uint32_t u) {
+  float f;
+  std::memcpy(&f, &u, sizeof f);
+  return f;
+}
+inline std::uint32_t float_to_bits(float f) {
+  std::uint32_t u;
+  std::memcpy(&u, &f, sizeof u);
+  return u;
+}
 
 // What the per-splat setup needs to know about the view.
 struct SetupConstants {
@@ -85,8 +99,11 @@ struct SetupConstants {
 
 // Writes the setup of every splat of `chunk` into `splats` (kStride floats each) and bins the
 // splats by band: bins[b] .. bins[b + 1] − 1 (offsets counted from bins[band_count + 1]) are
-// the indices, in stream order, of the chunk's splats whose pixel box meets band b.
-void prepare_chunk(const SplatChunk& chunk, const SetupConstants& k,
-                   std::vector<float>& splats, std::vector<std::uint32_t>& bins);
+// the indices, in stream order, of the chunk's splats whose pixel box meets band b. With
+// `features`, also the splats' surface ids and clip planes, the planes moved into eye
+// coordinates (n_e, h_e: n_e·P − h_e for P in eye coordinates) into `planes`.
+void prepare_chunk(const SplatChunk& chunk, const SetupConstants& k, bool features,
+                   std::vector<float>& splats, std::vector<std::uint32_t>& bins,
+                   std::vector<float>& planes);
 
 }  // namespace pointillist::quality_detail

@@ -26,6 +26,8 @@
 #include <cmath>
 #include <limits>
 
+#include <cstring>
+
 #include "pointillist/core/error.hpp"
 #include "pointillist/render/quality.hpp"
 #include "raster/quality_kernel.hpp"
@@ -66,11 +68,26 @@ struct View {
   float kernel_k;  // 1 / (2σ²), σ in radii
 };
 
+// The front surface of a pixel when the stream has sharp features: the depth and surface id
+// of its nearest unclipped fragment.
+enum IdPlane : int { kFrontDepth, kFrontId, kIdPlanes };
+constexpr int kIdFloats = kIdPlanes * kLanes;
+constexpr std::int32_t kMixedId = static_cast<std::int32_t>(kMixedSurface);
+
+// What sharp features add to a pass: nothing; the clip test (layered rendering); the clip test
+// and the front surface's id (the visibility and accumulation passes of opaque rendering take
+// only fragments of that id); the pass that finds that id.
+enum Features : int { kNoFeatures, kClipOnly, kSameSurface, kFindFront };
+
 struct Band {
   int row0, row1;  // rows [row0, row1)
   int groups;      // 4-pixel groups per row
   float* acc;      // kGroupFloats per group
   float* layer;    // kLayerFloats per group (layered rendering only)
+  float* ids;      // kIdFloats per group (opaque rendering with features only)
+  float* ids_at(int j, int k) const {
+    return ids + (static_cast<std::size_t>(j - row0) * groups + k) * kIdFloats;
+  }
   float* acc_at(int j, int k) const {
     return acc + (static_cast<std::size_t>(j - row0) * groups + k) * kGroupFloats;
   }
@@ -79,12 +96,51 @@ struct Band {
   }
 };
 
+// Lanes whose fragment the splat's clip planes discard (Ivo, eq. 4.18; features.hpp): the
+// point P where the pixel's ray meets the splat's plane, pulled back to the disc's rim for a
+// fragment of the low-pass alone (u > 1), the centre when the ray misses the plane.
+inline Int4 clipped_lanes(const float* s, const float* planes, Float4 t, Float4 a, float b,
+                          Float4 u, Int4 valid) {
+  const std::uint32_t code = float_to_bits(s[kClipCode]);
+  const std::uint32_t count = clip_count(static_cast<std::uint8_t>(code));
+  const ClipMode mode = clip_mode(static_cast<std::uint8_t>(code));
+  const Float4 one = splat4(1.0f), zero = splat4(0.0f);
+  const Float4 pull = select4(u > one, 1.0f / render_detail::sqrt4(select4(u > one, u, one)), one);
+  const float cx = s[kCx], cy = s[kCy], cz = s[kCz];
+  const Float4 px = select4(valid, cx + (t * a - cx) * pull, splat4(cx));
+  const Float4 py = select4(valid, cy + (t * b - cy) * pull, splat4(cy));
+  const Float4 pz = select4(valid, cz + (t - cz) * pull, splat4(cz));
+  const float* p = planes + 4 * static_cast<std::size_t>(float_to_bits(s[kClipFirst]));
+  Int4 any{}, all = Int4{} - 1;
+  Float4 nearest = splat4(kInf), nearest_side = zero;
+  for (std::uint32_t k = 0; k < count; ++k, p += 4) {
+    const Float4 side = p[0] * px + p[1] * py + p[2] * pz - p[3];
+    const Int4 out = side < zero;
+    any |= out;
+    all &= out;
+    const Float4 dist = select4(out, -side, side);
+    const Int4 closer = dist < nearest;
+    nearest = select4(closer, dist, nearest);
+    nearest_side = select4(closer, side, nearest_side);
+  }
+  switch (mode) {
+    case ClipMode::Union: return any;
+    case ClipMode::Intersection: return all;
+    case ClipMode::Nearest: return nearest_side < zero;
+    case ClipMode::None: break;
+  }
+  return Int4{};
+}
+
 // One splat over its pixels in the band. Visibility pass (kAccumulate false): B = min(B, bound)
 // over covered lanes. Accumulation pass: lanes with key <= B add their weighted attributes, and
 // with kNext, lanes with key > B lower the next surface's bound. kPeel: only lanes with key >
-// lower (the previous surface's bound) take part.
-template <bool kAccumulate, bool kZRange, bool kPeel, bool kNext>
-void draw_splat(const float* s, const View& v, const Band& band) {
+// lower (the previous surface's bound) take part. kFeat (Features): clipped lanes take no part;
+// kFindFront keeps each pixel's nearest fragment depth and its surface id; kSameSurface lets
+// only fragments of that id (or of a mixed inner node, or any when the front is mixed) take
+// part.
+template <bool kAccumulate, bool kZRange, bool kPeel, bool kNext, int kFeat>
+void draw_splat(const float* s, const float* planes, const View& v, const Band& band) {
   const int i0 = static_cast<int>(s[kI0]), i1 = static_cast<int>(s[kI1]);
   const int j0 = std::max(static_cast<int>(s[kJ0]), band.row0);
   const int j1 = std::min(static_cast<int>(s[kJ1]), band.row1 - 1);
@@ -113,6 +169,32 @@ void draw_splat(const float* s, const View& v, const Band& band) {
       const Float4 m = select4(valid, min4(sd, u), sd);
       Int4 cover = in_box & (m <= one);
       if (!any4(cover)) continue;
+      if constexpr (kFeat != kNoFeatures) {
+        if (float_to_bits(s[kClipCode]) & 31u) {
+          cover &= ~clipped_lanes(s, planes, t, a, b, u, valid);
+          if (!any4(cover)) continue;
+        }
+      }
+      if constexpr (kFeat == kFindFront) {
+        float* ids = band.ids_at(j, k);
+        const Float4 frag = min4(splat4(hi), max4(splat4(lo), select4(valid, t, splat4(cz))));
+        const Float4 front = load4(ids + kFrontDepth * kLanes);
+        const Int4 closer = cover & (frag < front);
+        store4(ids + kFrontDepth * kLanes, select4(closer, frag, front));
+        Int4 id;
+        std::memcpy(&id, ids + kFrontId * kLanes, sizeof id);
+        const std::int32_t mine = static_cast<std::int32_t>(float_to_bits(s[kSurface]));
+        id = select4(closer, Int4{} + mine, id);
+        std::memcpy(ids + kFrontId * kLanes, &id, sizeof id);
+        continue;
+      }
+      if constexpr (kFeat == kSameSurface) {
+        Int4 id;
+        std::memcpy(&id, band.ids_at(j, k) + kFrontId * kLanes, sizeof id);
+        const std::int32_t mine = static_cast<std::int32_t>(float_to_bits(s[kSurface]));
+        if (mine != kMixedId) cover &= (id == mine) | (id == kMixedId);
+        if (!any4(cover)) continue;
+      }
       float* acc = band.acc_at(j, k);
       float* layer = kPeel || kNext ? band.layer_at(j, k) : nullptr;
       Float4 depth{}, key, bound;
@@ -154,12 +236,12 @@ void draw_splat(const float* s, const View& v, const Band& band) {
   }
 }
 
-using DrawFn = void (*)(const float*, const View&, const Band&);
+using DrawFn = void (*)(const float*, const float*, const View&, const Band&);
 
-template <bool kAccumulate, bool kPeel, bool kNext>
+template <bool kAccumulate, bool kPeel, bool kNext, int kFeat = kNoFeatures>
 DrawFn pick(bool z_range) {
-  return z_range ? &draw_splat<kAccumulate, true, kPeel, kNext>
-                 : &draw_splat<kAccumulate, false, kPeel, kNext>;
+  return z_range ? &draw_splat<kAccumulate, true, kPeel, kNext, kFeat>
+                 : &draw_splat<kAccumulate, false, kPeel, kNext, kFeat>;
 }
 
 // Calls draw for every splat binned into band `b`, chunk by chunk in stream order.
@@ -169,8 +251,9 @@ void band_pass(const SplatStream& stream, const QualityScratch& scratch, std::si
     const std::vector<std::uint32_t>& bins = scratch.chunk_bins[c];
     const std::uint32_t* index = bins.data() + band_count + 1;
     const float* splats = scratch.chunk_splats[c].data();
+    const float* planes = scratch.chunk_planes[c].data();
     for (std::uint32_t k = bins[b]; k < bins[b + 1]; ++k) {
-      draw(splats + static_cast<std::size_t>(kStride) * index[k], v, band);
+      draw(splats + static_cast<std::size_t>(kStride) * index[k], planes, v, band);
     }
   }
 }
@@ -291,12 +374,18 @@ class BandShader {
   float opacity_;
 };
 
-void clear_planes(const Band& band, bool layered) {
+void clear_planes(const Band& band, bool layered, bool ids) {
   const std::size_t groups = static_cast<std::size_t>(band.row1 - band.row0) * band.groups;
   for (std::size_t g = 0; g < groups; ++g) {
     float* acc = band.acc + g * kGroupFloats;
     std::fill(acc, acc + kLanes, kInf);
     std::fill(acc + kLanes, acc + kGroupFloats, 0.0f);
+    if (ids) {
+      float* id = band.ids + g * kIdFloats;
+      std::fill(id + kFrontDepth * kLanes, id + (kFrontDepth + 1) * kLanes, kInf);
+      std::fill(id + kFrontId * kLanes, id + (kFrontId + 1) * kLanes,
+                bits_to_float(kMixedSurface));
+    }
     if (layered) {
       float* layer = band.layer + g * kLayerFloats;
       std::fill(layer + kLower * kLanes, layer + (kLower + 1) * kLanes, -kInf);
@@ -362,8 +451,13 @@ void rasterize_quality(const SplatStream& stream, const CameraFrame& camera, con
     scratch.chunk_splats.resize(stream.chunk_count);
     scratch.chunk_bins.resize(stream.chunk_count);
   }
+  if (scratch.chunk_planes.size() < stream.chunk_count) {
+    scratch.chunk_planes.resize(stream.chunk_count);
+  }
+  const bool features = stream.has_features;
   pool.run(stream.chunk_count, [&](std::size_t c) {
-    prepare_chunk(stream.chunks[c], setup, scratch.chunk_splats[c], scratch.chunk_bins[c]);
+    prepare_chunk(stream.chunks[c], setup, features, scratch.chunk_splats[c],
+                  scratch.chunk_bins[c], scratch.chunk_planes[c]);
   });
 
   View v;
@@ -379,7 +473,11 @@ void rasterize_quality(const SplatStream& stream, const CameraFrame& camera, con
 
   const int groups = (camera.width + kLanes - 1) / kLanes;
   const std::size_t band_groups = static_cast<std::size_t>(bands.rows) * groups;
-  const std::size_t buffer_floats = band_groups * (kGroupFloats + (layered ? kLayerFloats : 0));
+  // Opaque rendering with features finds each pixel's front surface first (spec §1.12: the
+  // exact order-independent rule in three passes); layered rendering only clips.
+  const bool surface_rule = features && !layered;
+  const std::size_t buffer_floats =
+      band_groups * (kGroupFloats + (layered ? kLayerFloats : 0) + (surface_rule ? kIdFloats : 0));
   const std::size_t workers =
       std::min<std::size_t>(pool.thread_count(), static_cast<std::size_t>(bands.count));
   if (scratch.band_buffers.size() < workers) scratch.band_buffers.resize(workers);
@@ -393,9 +491,22 @@ void rasterize_quality(const SplatStream& stream, const CameraFrame& camera, con
     for (std::size_t b = next_band++; b < band_count; b = next_band++) {
       const int row0 = static_cast<int>(b) * bands.rows;
       const Band band{row0, std::min(camera.height, row0 + bands.rows), groups, buffer,
-                      buffer + band_groups * kGroupFloats};
-      clear_planes(band, layered);
-      band_pass(stream, scratch, b, band_count, v, band, pick<false, false, false>(z_range));
+                      buffer + band_groups * kGroupFloats,
+                      buffer + band_groups * (kGroupFloats + (layered ? kLayerFloats : 0))};
+      clear_planes(band, layered, surface_rule);
+      if (surface_rule) {
+        band_pass(stream, scratch, b, band_count, v, band,
+                  pick<false, false, false, kFindFront>(z_range));
+        band_pass(stream, scratch, b, band_count, v, band,
+                  pick<false, false, false, kSameSurface>(z_range));
+        band_pass(stream, scratch, b, band_count, v, band,
+                  pick<true, false, false, kSameSurface>(z_range));
+        band_shader.shade<false>(band, out, true);
+        continue;
+      }
+      band_pass(stream, scratch, b, band_count, v, band,
+                features ? pick<false, false, false, kClipOnly>(z_range)
+                         : pick<false, false, false>(z_range));
       if (!layered) {
         band_pass(stream, scratch, b, band_count, v, band, pick<true, false, false>(z_range));
         band_shader.shade<false>(band, out, true);
@@ -403,10 +514,16 @@ void rasterize_quality(const SplatStream& stream, const CameraFrame& camera, con
       }
       for (int surface = 0; surface < quality.max_layers; ++surface) {
         const bool last = surface + 1 == quality.max_layers;
-        DrawFn draw = surface == 0 ? (last ? pick<true, false, false>(z_range)
-                                           : pick<true, false, true>(z_range))
-                                   : (last ? pick<true, true, false>(z_range)
-                                           : pick<true, true, true>(z_range));
+        DrawFn draw =
+            features
+                ? (surface == 0 ? (last ? pick<true, false, false, kClipOnly>(z_range)
+                                        : pick<true, false, true, kClipOnly>(z_range))
+                                : (last ? pick<true, true, false, kClipOnly>(z_range)
+                                        : pick<true, true, true, kClipOnly>(z_range)))
+                : (surface == 0 ? (last ? pick<true, false, false>(z_range)
+                                        : pick<true, false, true>(z_range))
+                                : (last ? pick<true, true, false>(z_range)
+                                        : pick<true, true, true>(z_range)));
         band_pass(stream, scratch, b, band_count, v, band, draw);
         const bool more = band_shader.shade<true>(band, out, surface == 0);
         if (last || !more) break;

@@ -43,8 +43,9 @@ Range pixel_span(float lo, float hi, int n) {
 
 }  // namespace
 
-void prepare_chunk(const SplatChunk& chunk, const SetupConstants& k,
-                   std::vector<float>& splats, std::vector<std::uint32_t>& bins) {
+void prepare_chunk(const SplatChunk& chunk, const SetupConstants& k, bool features,
+                   std::vector<float>& splats, std::vector<std::uint32_t>& bins,
+                   std::vector<float>& planes) {
   const std::size_t n = chunk.count;
   if (splats.size() < kStride * n) splats.resize(std::max(kStride * n, 2 * splats.size()));
   const CameraFrame& cam = k.camera;
@@ -97,6 +98,11 @@ void prepare_chunk(const SplatChunk& chunk, const SetupConstants& k,
       s[kBaseG] = k.base_color.y;
       s[kBaseB] = k.base_color.z;
     }
+    if (features) {
+      s[kSurface] = bits_to_float(chunk.surface[i]);
+      s[kClipFirst] = bits_to_float(chunk.clip_first[i]);
+      s[kClipCode] = bits_to_float(chunk.clip_code[i]);
+    }
     // Pixel box: the sphere's projection (pixel x = W/2 + f·slope_x, y = H/2 − f·slope_y),
     // united with the low-pass disc around the projected centre.
     const Range sx = tangent_slopes(c.x, c.z, r), sy = tangent_slopes(c.y, c.z, r);
@@ -115,6 +121,17 @@ void prepare_chunk(const SplatChunk& chunk, const SetupConstants& k,
     if (pi.hi >= pi.lo && pj.hi >= pj.lo) {
       const int b0 = static_cast<int>(pj.lo) / k.band_rows, b1 = static_cast<int>(pj.hi) / k.band_rows;
       for (int b = b0; b <= b1; ++b) ++bins[static_cast<std::size_t>(b) + 1];
+    }
+  }
+  // Clip planes n·x − h >= 0 (world) in eye coordinates: x = eye + P.x·right + P.y·up +
+  // P.z·forward.
+  planes.clear();
+  if (features) {
+    for (const ClipPlane& p : chunk.clip_planes) {
+      planes.push_back(dot(p.n, cam.right));
+      planes.push_back(dot(p.n, cam.up));
+      planes.push_back(dot(p.n, cam.forward));
+      planes.push_back(p.h - dot(p.n, cam.eye));
     }
   }
   // Counting sort by band, stream order within each band: bins[b] serves as band b's write

@@ -1,0 +1,192 @@
+// Rendering with sharp features against the exact ray-cast reference of the CSG test scenes
+// (spec §4.5–4.6): with unlit colours (ambient 1, no diffuse or specular), a pixel shows exactly
+// its surface's colour unless it blends two surfaces, so label errors and mixed pixels can be
+// counted exactly.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <iostream>
+#include <map>
+#include <tuple>
+
+#include "pointillist/lod/tree_features.hpp"
+#include "pointillist/prep/radii.hpp"
+#include "pointillist/render/renderer.hpp"
+#include "pointillist/scene/csg.hpp"
+
+using namespace pointillist;
+
+namespace {
+
+constexpr Rgb8 kColors[8] = {{255, 0, 0},   {0, 160, 0},   {0, 0, 255},  {200, 200, 0},
+                             {0, 200, 200}, {200, 0, 200}, {255, 128, 0}, {128, 0, 255}};
+
+// A scene's samples with a colour per surface: faces on one plane share it (the step's front
+// faces are one surface), and the reference uses the same map.
+struct Model {
+  CsgScene scene;
+  SphereTree tree;
+  TreeFeatures features;
+  RenderModel render;
+  std::vector<int> colour_of_label;
+};
+
+int plane_key_colour(std::map<std::tuple<int, int, int, int>, int>& keys, Vec3f n, float h) {
+  const auto key = std::make_tuple(int(std::lround(n.x * 100)), int(std::lround(n.y * 100)),
+                                   int(std::lround(n.z * 100)), int(std::lround(h * 100)));
+  return keys.emplace(key, int(keys.size()) % 8).first->second;
+}
+
+std::unique_ptr<Model> make_model(const std::string& id, ThreadPool& pool) {
+  auto m = std::make_unique<Model>();
+  m->scene = csg_scene(id);
+  CsgSamples s = sample_csg(m->scene, SamplingMode::Jittered, 9);
+  CloudRadiusOptions radius;
+  radius.coverage = 1.0f;
+  s.points.radii = cloud_radii(s.points.positions, pool, Progress::none(), radius);
+  // Colour by plane for planar faces (curved faces: by label).
+  std::map<std::tuple<int, int, int, int>, int> keys;
+  m->colour_of_label.assign(m->scene.label_count(), -1);
+  for (std::size_t i = 0; i < s.labels.size(); ++i) {
+    const std::uint32_t l = s.labels[i];
+    if (m->colour_of_label[l] >= 0) continue;
+    const Vec3f n = s.points.normals[i];
+    m->colour_of_label[l] = csg_face_is_planar(m->scene, l)
+                                ? plane_key_colour(keys, n, dot(n, s.points.positions[i]))
+                                : int(l % 8);
+  }
+  for (std::uint32_t l : s.labels) s.points.colors.push_back(kColors[m->colour_of_label[l]]);
+  m->tree = build_sphere_tree(s.points, pool);
+  m->features = compute_tree_features(m->tree.view(), pool);
+  m->render.tree = m->tree.view();
+  m->render.tree.features = &m->features;
+  return m;
+}
+
+struct Image {
+  std::vector<Rgb8> color;
+  int width = 0, height = 0;
+};
+
+Image render(const Model& m, const Camera& camera, ThreadPool& pool, bool features,
+             Rasterizer rasterizer = Rasterizer::Quality) {
+  RenderSettings settings;
+  settings.ambient = 1.0f;
+  settings.diffuse = 0.0f;
+  settings.specular = 0.0f;
+  FrameSettings fs;
+  fs.rasterizer = rasterizer;
+  fs.features = features;
+  Renderer renderer;
+  Frame frame;
+  const SceneInstance instance{&m.render, {}};
+  renderer.render({&instance, 1}, camera, settings, fs, pool, frame);
+  return {std::vector<Rgb8>(frame.color.begin(), frame.color.end()), frame.width, frame.height};
+}
+
+struct LabelMetrics {
+  std::size_t covered = 0;  // reference pixels on a surface, away from the silhouette
+  std::size_t holes = 0;    // of those, background in the test
+  std::size_t wrong = 0;    // of those, a pure colour of another surface
+  std::size_t mixed = 0;    // of those, no pure colour at all (blended surfaces)
+};
+
+// Counts over reference pixels more than 2 px (Chebyshev) from the silhouette.
+LabelMetrics measure(const Model& m, const Camera& camera, const Image& img) {
+  const CsgImage ref = ray_cast_csg_image(m.scene, camera);
+  LabelMetrics out;
+  const auto covered = [&](int x, int y) {
+    return x >= 0 && y >= 0 && x < ref.width && y < ref.height &&
+           ref.label[std::size_t(y) * ref.width + x] != kNoLabel;
+  };
+  for (int y = 0; y < ref.height; ++y) {
+    for (int x = 0; x < ref.width; ++x) {
+      bool interior = true;
+      for (int dy = -2; dy <= 2 && interior; ++dy) {
+        for (int dx = -2; dx <= 2 && interior; ++dx) interior = covered(x + dx, y + dy);
+      }
+      if (!interior) continue;
+      const std::size_t p = std::size_t(y) * ref.width + x;
+      ++out.covered;
+      const Rgb8 got = img.color[p];
+      if (got == Rgb8{0, 0, 0}) {
+        ++out.holes;
+        continue;
+      }
+      const Rgb8 want = kColors[m.colour_of_label[ref.label[p]]];
+      if (got == want) continue;
+      bool pure = false;
+      for (Rgb8 c : kColors) pure = pure || c == got;
+      ++(pure ? out.wrong : out.mixed);
+    }
+  }
+  return out;
+}
+
+Camera look(Vec3f eye, Vec3f target, int size = 256) {
+  Camera c;
+  c.eye = eye;
+  c.target = target;
+  c.width = c.height = size;
+  return c;
+}
+
+TEST(FeaturesRender, CubeCornerIsSharpWithoutHolesOrBlends) {
+  ThreadPool pool(2);
+  const auto m = make_model("T1", pool);
+  // V2: 1.5 from the corner (1, 1, 1); V1: the overview.
+  for (const Camera& cam : {look({2.0f, 2.1f, 1.9f}, {1, 1, 1}), look({3.2f, 2.4f, 4.1f}, {0, 0, 0})}) {
+    const LabelMetrics with = measure(*m, cam, render(*m, cam, pool, true));
+    const LabelMetrics without = measure(*m, cam, render(*m, cam, pool, false));
+    std::cout << "covered " << with.covered << " wrong " << with.wrong << " mixed " << with.mixed << " holes " << with.holes << " / without: wrong " << without.wrong << " mixed " << without.mixed << " holes " << without.holes << "\n";
+    EXPECT_EQ(with.holes, 0u);
+    EXPECT_EQ(with.mixed, 0u);                        // A2: no blended pixels
+    EXPECT_LE(with.wrong, with.covered / 500);        // A2: label errors <= 0.2 %
+    EXPECT_GT(without.mixed, 50u);                    // what the features remove
+  }
+}
+
+TEST(FeaturesRender, StepCornersAreSharp) {
+  ThreadPool pool(2);
+  const auto m = make_model("T8", pool);
+  // Close-ups of the mixed corner (0, 0, 1) and of the reflex vertex of the front face.
+  for (const Camera& cam : {look({1.0f, 0.9f, 2.1f}, {0, 0, 1}), look({0.4f, 0.5f, 2.4f}, {0, 0, 1})}) {
+    const LabelMetrics with = measure(*m, cam, render(*m, cam, pool, true));
+    EXPECT_EQ(with.holes, 0u);
+    EXPECT_EQ(with.mixed, 0u);
+    EXPECT_LE(with.wrong, with.covered / 500);
+  }
+}
+
+TEST(FeaturesRender, InterpenetratingSpheresShowNoMagenta) {
+  ThreadPool pool(2);
+  const auto m = make_model("T9", pool);
+  // A point of the intersection curve x = 0, y² + z² = 0.64, seen from 1.5 away, and the
+  // overview.
+  for (const Camera& cam : {look({0.3f, 0.6f, 2.05f}, {0, 0, 0.8f}), look({1.2f, 1.5f, 3.4f}, {0, 0, 0})}) {
+    const LabelMetrics with = measure(*m, cam, render(*m, cam, pool, true));
+    const LabelMetrics without = measure(*m, cam, render(*m, cam, pool, false));
+    std::cout << "covered " << with.covered << " wrong " << with.wrong << " mixed " << with.mixed << " holes " << with.holes << " / without: wrong " << without.wrong << " mixed " << without.mixed << " holes " << without.holes << "\n";
+    EXPECT_EQ(with.holes, 0u);
+    EXPECT_EQ(with.mixed, 0u);  // A5
+    EXPECT_GT(without.mixed, 20u);
+  }
+}
+
+TEST(FeaturesRender, SmoothSphereIsBitIdenticalWithFeatures) {
+  ThreadPool pool(2);
+  const auto m = make_model("T13", pool);
+  ASSERT_EQ(m->features.stats.sharp_edges, 0u);
+  const Camera cam = look({1.5f, 1.2f, 2.5f}, {0, 0, 0});
+  const Image with = render(*m, cam, pool, true), without = render(*m, cam, pool, false);
+  EXPECT_TRUE(with.color == without.color);  // A7
+}
+
+TEST(FeaturesRender, ImagesDoNotDependOnTheThreadCount) {
+  ThreadPool one(1), two(2);
+  const auto m = make_model("T8", two);
+  const Camera cam = look({1.0f, 0.9f, 2.1f}, {0, 0, 1});
+  EXPECT_TRUE(render(*m, cam, one, true).color == render(*m, cam, two, true).color);  // A9
+}
+
+}  // namespace
