@@ -173,6 +173,23 @@ TEST(FeaturesRender, InterpenetratingSpheresShowNoMagenta) {
   }
 }
 
+TEST(FeaturesRender, FastModeClipsAtCreasesToo) {
+  ThreadPool pool(2);
+  for (const char* id : {"T1", "T8"}) {
+    const auto m = make_model(id, pool);
+    const Camera cam = std::string(id) == "T1" ? look({2.0f, 2.1f, 1.9f}, {1, 1, 1})
+                                               : look({1.0f, 0.9f, 2.1f}, {0, 0, 1});
+    const LabelMetrics with = measure(*m, cam, render(*m, cam, pool, true, Rasterizer::Fast));
+    const LabelMetrics without = measure(*m, cam, render(*m, cam, pool, false, Rasterizer::Fast));
+    std::cout << id << " fast: wrong " << with.wrong << " holes " << with.holes
+              << " / without: wrong " << without.wrong << "\n";
+    EXPECT_EQ(with.holes, 0u) << id;
+    EXPECT_EQ(with.mixed, 0u) << id;  // opaque splats never blend
+    EXPECT_GT(without.wrong, 200u) << id;  // discs of one face over the other
+    EXPECT_LE(with.wrong, with.covered / 500) << id;
+  }
+}
+
 TEST(FeaturesRender, SmoothSphereIsBitIdenticalWithFeatures) {
   ThreadPool pool(2);
   const auto m = make_model("T13", pool);

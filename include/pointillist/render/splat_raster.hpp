@@ -19,6 +19,8 @@ struct RasterScratch {
   struct Chunk {
     Buffer<float> ellipse;  // 6 floats per splat (Ellipse shape only)
     float y_min_px = 0, y_max_px = 0;  // rows the chunk's splats may touch (several bands only)
+    std::vector<float> planes;  // sharp features: the chunk's clip planes, eye coordinates
+    const CameraFrame* camera = nullptr;  // the frame's camera (sharp features)
   };
   std::vector<Chunk> chunks;
   std::vector<Buffer<std::uint32_t>> band_colors;  // one packed-color band per thread
@@ -34,6 +36,9 @@ struct RasterScratch {
 //  * Circle: (px − x)² + (py − y)² ≤ (d/2)²;
 //  * Ellipse: semi-major axis d/2, semi-minor axis (d/2)·max(|n·v|, 0.1) along the screen
 //    projection of the normal n (v: unit vector from the splat to the eye).
+// When the stream has_features, a splat with clip planes skips the pixels whose ray meets its
+// plane (its centre, where the ray misses the plane) on the side its planes discard (one plane
+// test per covered pixel and plane; features.hpp clip_discards).
 // Splats are drawn in their `shaded` color. The image bits depend only on the arguments, not
 // on pool.thread_count(): rows are split into bands, and each band draws the splats that may
 // touch it in stream order.

@@ -30,6 +30,7 @@
 
 #include "pointillist/core/error.hpp"
 #include "pointillist/render/quality.hpp"
+#include "raster/clip_lanes.hpp"
 #include "raster/quality_kernel.hpp"
 #include "shading.hpp"
 
@@ -96,40 +97,21 @@ struct Band {
   }
 };
 
-// Lanes whose fragment the splat's clip planes discard (Ivo, eq. 4.18; features.hpp): the
-// point P where the pixel's ray meets the splat's plane, pulled back to the disc's rim for a
-// fragment of the low-pass alone (u > 1), the centre when the ray misses the plane.
+// Lanes whose fragment the splat's clip planes discard (features.hpp): the point P where the
+// pixel's ray meets the splat's plane, pulled back to the disc's rim for a fragment of the
+// low-pass alone (u > 1), the centre when the ray misses the plane.
 inline Int4 clipped_lanes(const float* s, const float* planes, Float4 t, Float4 a, float b,
                           Float4 u, Int4 valid) {
-  const std::uint32_t code = float_to_bits(s[kClipCode]);
-  const std::uint32_t count = clip_count(static_cast<std::uint8_t>(code));
-  const ClipMode mode = clip_mode(static_cast<std::uint8_t>(code));
-  const Float4 one = splat4(1.0f), zero = splat4(0.0f);
+  const auto code = static_cast<std::uint8_t>(float_to_bits(s[kClipCode]));
+  const Float4 one = splat4(1.0f);
   const Float4 pull = select4(u > one, 1.0f / render_detail::sqrt4(select4(u > one, u, one)), one);
   const float cx = s[kCx], cy = s[kCy], cz = s[kCz];
   const Float4 px = select4(valid, cx + (t * a - cx) * pull, splat4(cx));
   const Float4 py = select4(valid, cy + (t * b - cy) * pull, splat4(cy));
   const Float4 pz = select4(valid, cz + (t - cz) * pull, splat4(cz));
-  const float* p = planes + 4 * static_cast<std::size_t>(float_to_bits(s[kClipFirst]));
-  Int4 any{}, all = Int4{} - 1;
-  Float4 nearest = splat4(kInf), nearest_side = zero;
-  for (std::uint32_t k = 0; k < count; ++k, p += 4) {
-    const Float4 side = p[0] * px + p[1] * py + p[2] * pz - p[3];
-    const Int4 out = side < zero;
-    any |= out;
-    all &= out;
-    const Float4 dist = select4(out, -side, side);
-    const Int4 closer = dist < nearest;
-    nearest = select4(closer, dist, nearest);
-    nearest_side = select4(closer, side, nearest_side);
-  }
-  switch (mode) {
-    case ClipMode::Union: return any;
-    case ClipMode::Intersection: return all;
-    case ClipMode::Nearest: return nearest_side < zero;
-    case ClipMode::None: break;
-  }
-  return Int4{};
+  return render_detail::clip_discard4(
+      planes + 4 * static_cast<std::size_t>(float_to_bits(s[kClipFirst])), clip_count(code),
+      clip_mode(code), px, py, pz);
 }
 
 // One splat over its pixels in the band. Visibility pass (kAccumulate false): B = min(B, bound)

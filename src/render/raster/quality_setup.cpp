@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "raster/clip_lanes.hpp"
 #include "raster/quality_kernel.hpp"
 
 namespace pointillist::quality_detail {
@@ -123,16 +124,10 @@ void prepare_chunk(const SplatChunk& chunk, const SetupConstants& k, bool featur
       for (int b = b0; b <= b1; ++b) ++bins[static_cast<std::size_t>(b) + 1];
     }
   }
-  // Clip planes n·x − h >= 0 (world) in eye coordinates: x = eye + P.x·right + P.y·up +
-  // P.z·forward.
-  planes.clear();
   if (features) {
-    for (const ClipPlane& p : chunk.clip_planes) {
-      planes.push_back(dot(p.n, cam.right));
-      planes.push_back(dot(p.n, cam.up));
-      planes.push_back(dot(p.n, cam.forward));
-      planes.push_back(p.h - dot(p.n, cam.eye));
-    }
+    render_detail::eye_space_planes(chunk, cam, planes);
+  } else {
+    planes.clear();
   }
   // Counting sort by band, stream order within each band: bins[b] serves as band b's write
   // cursor (ending at band b + 1's start), then the starts are shifted back into place.

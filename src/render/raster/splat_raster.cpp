@@ -18,6 +18,9 @@
 #include <cstring>
 #include <limits>
 
+#include <type_traits>
+
+#include "raster/clip_lanes.hpp"
 #include "simd.hpp"
 
 namespace pointillist {
@@ -78,6 +81,31 @@ inline void plot(const Target& t, int i, int j, float z, std::uint32_t c) {
   }
 }
 
+// No clip test: every covered pixel is drawn.
+struct NoClip {
+  Int4 operator()(Float4, float) const { return Int4{}; }
+};
+
+// The clip test of a splat with sharp-feature planes (clip_lanes.hpp), per pixel: the pixel's
+// ray meets the splat's plane at P (the centre where it misses); one plane test per plane.
+struct PixelClip {
+  float cx, cy, cz, nx, ny, nz, nc;  // centre and normal, eye coordinates; n·c
+  float half_w, half_h, inv_f;
+  const float* planes;
+  std::uint32_t count;
+  ClipMode mode;
+  // Lanes of pixel centres (px, py) whose fragment is discarded.
+  Int4 operator()(Float4 px, float py) const {
+    const Float4 a = (px - half_w) * inv_f;
+    const float b = (half_h - py) * inv_f;
+    const Float4 t = nc / (nx * a + (ny * b + nz));
+    const Int4 valid = (t > splat4(0.0f)) & (t < splat4(std::numeric_limits<float>::infinity()));
+    return render_detail::clip_discard4(planes, count, mode, select4(valid, t * a, splat4(cx)),
+                                        select4(valid, t * b, splat4(cy)),
+                                        select4(valid, t, splat4(cz)));
+  }
+};
+
 // Pixels whose centre lies in [x − hx, x + hx] × [y − hy, y + hy], clipped to the band.
 struct PixelBox {
   int i0, i1, j0, j1;
@@ -115,9 +143,9 @@ inline NearestCentre nearest_centre(const Target& t, float x, float y) {
 // written back unchanged; they are in the band's own rows, so no other thread touches them. The
 // last group of a row is shifted left to stay in the image (pixels seen twice are unchanged the
 // second time: the depth test is strict). Needs width ≥ 4.
-template <class Inside>
+template <class Inside, class Clip>
 inline void fill_box(const Target& t, const PixelBox& b, float x, float y, float z,
-                     std::uint32_t c, Inside inside) {
+                     std::uint32_t c, Inside inside, const Clip& clip) {
   const Float4 lane_centre{0.5f, 1.5f, 2.5f, 3.5f};
   const Float4 zv = splat4(z);
   const Int4 cv = Int4{} + static_cast<std::int32_t>(c);
@@ -129,13 +157,15 @@ inline void fill_box(const Target& t, const PixelBox& b, float x, float y, float
   for (int i = first; i <= b.i1; i += kLanes) {
     const int s = std::min(i, t.width - kLanes);
     // (s + k + 0.5) is exact, so each lane rounds once, as nearest_centre does.
-    const auto row_test = inside((static_cast<float>(s) + lane_centre) - x);
+    const Float4 px = static_cast<float>(s) + lane_centre;
+    const auto row_test = inside(px - x);
     float* depth = t.depth + static_cast<std::size_t>(b.j0) * w + s;
     std::uint32_t* color = t.color + static_cast<std::size_t>(b.j0 - t.row_begin) * w + s;
     float cy = static_cast<float>(b.j0) + 0.5f;
     for (int j = b.j0; j <= b.j1; ++j, cy += 1.0f, depth += w, color += w) {
       const Float4 old_depth = load4(depth);
-      const Int4 m = row_test(cy - y) & (zv < old_depth);
+      Int4 m = row_test(cy - y) & (zv < old_depth);
+      if constexpr (!std::is_same_v<Clip, NoClip>) m &= ~clip(px, cy);
       store4(depth, select4(m, zv, old_depth));
       store4(color, select4(m, cv, load4(color)));
     }
@@ -143,32 +173,45 @@ inline void fill_box(const Target& t, const PixelBox& b, float x, float y, float
 }
 
 // The same one pixel at a time, for images narrower than four pixels.
-template <class Inside>
+template <class Inside, class Clip>
 inline void fill_box_narrow(const Target& t, const PixelBox& b, float x, float y, float z,
-                            std::uint32_t c, Inside inside) {
+                            std::uint32_t c, Inside inside, const Clip& clip) {
   for (int j = b.j0; j <= b.j1; ++j) {
     const float dy = static_cast<float>(j) + 0.5f - y;
     for (int i = b.i0; i <= b.i1; ++i) {
-      if (inside(splat4(static_cast<float>(i) + 0.5f - x))(dy)[0]) plot(t, i, j, z, c);
+      const float px = static_cast<float>(i) + 0.5f;
+      if (inside(splat4(px - x))(dy)[0] && !clip(splat4(px), dy + y)[0]) plot(t, i, j, z, c);
     }
   }
 }
 
-template <class Inside>
+template <class Inside, class Clip>
 inline void fill(const Target& t, const PixelBox& b, float x, float y, float z, std::uint32_t c,
-                 Inside inside) {
+                 Inside inside, const Clip& clip) {
   if (t.width >= kLanes) {
-    fill_box(t, b, x, y, z, c, inside);
+    fill_box(t, b, x, y, z, c, inside, clip);
   } else {
-    fill_box_narrow(t, b, x, y, z, c, inside);
+    fill_box_narrow(t, b, x, y, z, c, inside, clip);
   }
 }
 
-inline void draw_square(const Target& t, float x, float y, float z, float r, std::uint32_t c) {
+// The pixel holding a splat that covers no pixel centre, unless the clip test discards it.
+template <class Clip>
+inline void plot_nearest(const Target& t, const NearestCentre& n, float z, std::uint32_t c,
+                         const Clip& clip) {
+  if constexpr (!std::is_same_v<Clip, NoClip>) {
+    if (clip(splat4(static_cast<float>(n.i) + 0.5f), static_cast<float>(n.j) + 0.5f)[0]) return;
+  }
+  plot(t, n.i, n.j, z, c);
+}
+
+template <class Clip>
+inline void draw_square(const Target& t, float x, float y, float z, float r, std::uint32_t c,
+                        const Clip& clip) {
   if (r < kSquareAlwaysCovers) {
     const NearestCentre n = nearest_centre(t, x, y);
     if (!(std::abs(n.dx) <= r && std::abs(n.dy) <= r)) {
-      plot(t, n.i, n.j, z, c);
+      plot_nearest(t, n, z, c, clip);
       return;
     }
   }
@@ -177,15 +220,17 @@ inline void draw_square(const Target& t, float x, float y, float z, float r, std
   fill(t, pixel_box(t, x, y, r, r), x, y, z, c, [&](Float4 dx) {
     const Int4 in_x = (dx <= rv) & (-dx <= rv);
     return [in_x](float) { return in_x; };
-  });
+  }, clip);
 }
 
-inline void draw_circle(const Target& t, float x, float y, float z, float r, std::uint32_t c) {
+template <class Clip>
+inline void draw_circle(const Target& t, float x, float y, float z, float r, std::uint32_t c,
+                        const Clip& clip) {
   const float r2 = r * r;
   if (r < kDiscAlwaysCovers) {
     const NearestCentre n = nearest_centre(t, x, y);
     if (!(n.dx * n.dx + n.dy * n.dy <= r2)) {
-      plot(t, n.i, n.j, z, c);
+      plot_nearest(t, n, z, c, clip);
       return;
     }
   }
@@ -193,12 +238,13 @@ inline void draw_circle(const Target& t, float x, float y, float z, float r, std
   fill(t, pixel_box(t, x, y, r, r), x, y, z, c, [&](Float4 dx) {
     const Float4 dx2 = dx * dx;
     return [dx2, r2v](float dy) { return dx2 + dy * dy <= r2v; };
-  });
+  }, clip);
 }
 
 // Ellipse {d : A·dx² + 2B·dx·dy + C·dy² ≤ r²} (see ellipse_parameters).
+template <class Clip>
 inline void draw_ellipse(const Target& t, float x, float y, float z, float r, const float* e,
-                         std::uint32_t c) {
+                         std::uint32_t c, const Clip& clip) {
   const float a = e[0], b2 = e[1], cc = e[2];
   const float hx = r * e[3], hy = r * e[4];
   const float r2 = r * r;
@@ -217,7 +263,7 @@ inline void draw_ellipse(const Target& t, float x, float y, float z, float r, co
       }
     }
     if (!covers) {
-      plot(t, n.i, n.j, z, c);
+      plot_nearest(t, n, z, c, clip);
       return;
     }
   }
@@ -225,7 +271,7 @@ inline void draw_ellipse(const Target& t, float x, float y, float z, float r, co
   fill(t, pixel_box(t, x, y, hx, hy), x, y, z, c, [&](Float4 dx) {
     const Float4 adx2 = av * dx * dx, b2dx = b2 * dx;
     return [=](float dy) { return adx2 + b2dx * dy + cc * dy * dy <= r2v; };
-  });
+  }, clip);
 }
 
 // Ellipse of a disc with eye-space normal ne seen along ve: minor axis (ax, ay) along the screen
@@ -307,24 +353,46 @@ void row_extent(const SplatChunk& chunk, RasterScratch::Chunk& out) {
   out.y_max_px = hi;
 }
 
-template <SplatShape kShape>
-inline void draw_one(const Target& t, const SplatChunk& s, const RasterScratch::Chunk& sc,
-                     std::size_t i) {
+template <SplatShape kShape, class Clip>
+inline void draw_shape(const Target& t, const SplatChunk& s, const RasterScratch::Chunk& sc,
+                       std::size_t i, const Clip& clip) {
   const float r = 0.5f * s.size_px[i];
   const std::uint32_t c = s.shaded[i];
   if constexpr (kShape == SplatShape::Square) {
-    draw_square(t, s.x_px[i], s.y_px[i], s.depth[i], r, c);
+    draw_square(t, s.x_px[i], s.y_px[i], s.depth[i], r, c, clip);
   } else if constexpr (kShape == SplatShape::Circle) {
-    draw_circle(t, s.x_px[i], s.y_px[i], s.depth[i], r, c);
+    draw_circle(t, s.x_px[i], s.y_px[i], s.depth[i], r, c, clip);
   } else {
-    draw_ellipse(t, s.x_px[i], s.y_px[i], s.depth[i], r, &sc.ellipse[kEllipseStride * i], c);
+    draw_ellipse(t, s.x_px[i], s.y_px[i], s.depth[i], r, &sc.ellipse[kEllipseStride * i], c, clip);
   }
+}
+
+// kFeatures: splats with clip planes test each covered pixel against them.
+template <SplatShape kShape, bool kFeatures>
+inline void draw_one(const Target& t, const SplatChunk& s, const RasterScratch::Chunk& sc,
+                     std::size_t i) {
+  if constexpr (kFeatures) {
+    const std::uint8_t code = s.clip_code[i];
+    if (clip_count(code) != 0) {
+      const CameraFrame& cam = *sc.camera;
+      const Vec3f d = s.center[i] - cam.eye, n = s.normal[i];
+      const Vec3f ce{dot(d, cam.right), dot(d, cam.up), dot(d, cam.forward)};
+      const Vec3f ne{dot(n, cam.right), dot(n, cam.up), dot(n, cam.forward)};
+      const PixelClip clip{ce.x, ce.y, ce.z, ne.x, ne.y, ne.z, dot(ne, ce),
+                           0.5f * t.width_f, 0.5f * t.height_f, 1.0f / cam.focal_px,
+                           sc.planes.data() + 4 * static_cast<std::size_t>(s.clip_first[i]),
+                           clip_count(code), clip_mode(code)};
+      draw_shape<kShape>(t, s, sc, i, clip);
+      return;
+    }
+  }
+  draw_shape<kShape>(t, s, sc, i, NoClip{});
 }
 
 // Draws every splat that may touch the band, chunk by chunk in stream order. A splat touches
 // rows whose centre is within its radius of y, and the row holding y, so y + r ≥ first row and
 // y − r < end row is a safe test.
-template <SplatShape kShape>
+template <SplatShape kShape, bool kFeatures>
 void draw_band(const SplatStream& stream, const RasterScratch& scratch, bool banded,
                const Target& t) {
   const float band_lo = static_cast<float>(t.row_begin), band_hi = static_cast<float>(t.row_end);
@@ -332,13 +400,13 @@ void draw_band(const SplatStream& stream, const RasterScratch& scratch, bool ban
     const SplatChunk& s = stream.chunks[c];
     const RasterScratch::Chunk& sc = scratch.chunks[c];
     if (!banded || (sc.y_min_px >= band_lo && sc.y_max_px < band_hi)) {
-      for (std::size_t i = 0; i < s.count; ++i) draw_one<kShape>(t, s, sc, i);
+      for (std::size_t i = 0; i < s.count; ++i) draw_one<kShape, kFeatures>(t, s, sc, i);
       continue;
     }
     if (!(sc.y_max_px >= band_lo && sc.y_min_px < band_hi)) continue;
     for (std::size_t i = 0; i < s.count; ++i) {
       const float y = s.y_px[i], r = 0.5f * s.size_px[i];
-      if (y + r >= band_lo && y - r < band_hi) draw_one<kShape>(t, s, sc, i);
+      if (y + r >= band_lo && y - r < band_hi) draw_one<kShape, kFeatures>(t, s, sc, i);
     }
   }
 }
@@ -408,9 +476,14 @@ void rasterize_splats(const SplatStream& stream, const CameraFrame& camera,
   const bool banded = bands.count > 1;
 
   if (scratch.chunks.size() < stream.chunk_count) scratch.chunks.resize(stream.chunk_count);
-  if (ellipses || banded) pool.run(stream.chunk_count, [&](std::size_t c) {
+  const bool features = stream.has_features;
+  if (ellipses || banded || features) pool.run(stream.chunk_count, [&](std::size_t c) {
     if (ellipses) prepare_ellipses(stream.chunks[c], camera, scratch.chunks[c]);
     if (banded) row_extent(stream.chunks[c], scratch.chunks[c]);
+    if (features) {
+      render_detail::eye_space_planes(stream.chunks[c], camera, scratch.chunks[c].planes);
+      scratch.chunks[c].camera = &camera;
+    }
   });
 
   // One worker per thread takes bands off a shared counter and packs colors in its own
@@ -433,11 +506,19 @@ void rasterize_splats(const SplatStream& stream, const CameraFrame& camera,
                      static_cast<float>(camera.width),
                      static_cast<float>(camera.height)};
       clear_band(t, settings.background);
+      const bool f = stream.has_features;
       switch (settings.shape) {
-        case SplatShape::Square: draw_band<SplatShape::Square>(stream, scratch, banded, t); break;
-        case SplatShape::Circle: draw_band<SplatShape::Circle>(stream, scratch, banded, t); break;
+        case SplatShape::Square:
+          (f ? draw_band<SplatShape::Square, true> : draw_band<SplatShape::Square, false>)(
+              stream, scratch, banded, t);
+          break;
+        case SplatShape::Circle:
+          (f ? draw_band<SplatShape::Circle, true> : draw_band<SplatShape::Circle, false>)(
+              stream, scratch, banded, t);
+          break;
         case SplatShape::Ellipse:
-          draw_band<SplatShape::Ellipse>(stream, scratch, banded, t);
+          (f ? draw_band<SplatShape::Ellipse, true> : draw_band<SplatShape::Ellipse, false>)(
+              stream, scratch, banded, t);
           break;
       }
       unpack_band(t, color);
