@@ -13,7 +13,7 @@ trap 'rm -rf "$work"' EXIT
 
 results="$work/results.json"
 : > "$results"
-for b in io prep lod format render; do
+for b in io prep features lod format render; do
   if [ -x "$bin/bench/${b}_bench" ]; then
     echo "== ${b}_bench"
     # Human-readable output on the terminal, JSON (one document per program) for the summary.

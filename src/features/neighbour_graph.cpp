@@ -125,6 +125,13 @@ NeighbourGraph build_neighbour_graph(std::span<const Vec3f> centers, std::span<c
   if (n == 0) return NeighbourGraph{{0}, {}};
   ProgressPhase phase(progress, "neighbour graph", n);
   const Grid grid = make_grid(centers, radii);
+  // Centres and radii in cell order, so that a cell's candidates are read contiguously.
+  std::vector<Vec3f> cell_centers(n);
+  std::vector<float> cell_radii(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    cell_centers[k] = centers[grid.order[k]];
+    cell_radii[k] = radii[grid.order[k]];
+  }
   // Splats in cell order, so that neighbouring queries read neighbouring memory.
   constexpr std::size_t kBlock = 2048;
   std::vector<std::vector<std::uint32_t>> blocks((n + kBlock - 1) / kBlock);
@@ -149,11 +156,13 @@ NeighbourGraph build_neighbour_graph(std::span<const Vec3f> centers, std::span<c
           const std::uint32_t first = grid.cell_start[row + lo[0]];
           const std::uint32_t last = grid.cell_start[row + hi[0] + 1];
           for (std::uint32_t k = first; k < last; ++k) {
-            const std::uint32_t j = grid.order[k];
-            const float rj = radii[j];
-            if (owns(ri, i, rj, j) && spheres_overlap(ci, ri, centers[j], rj)) {
-              edges.push_back(i);
-              edges.push_back(j);
+            const float rj = cell_radii[k];
+            if (rj <= ri && spheres_overlap(ci, ri, cell_centers[k], rj)) {
+              const std::uint32_t j = grid.order[k];
+              if (owns(ri, i, rj, j)) {
+                edges.push_back(i);
+                edges.push_back(j);
+              }
             }
           }
         }

@@ -195,10 +195,26 @@ std::vector<std::uint8_t> reflex_partners(const Disc& s, std::span<const Vec3f> 
   const auto beyond = [&](const Disc& p, int sign, Vec3f x) {
     return dot(x - p.c, p.n) * static_cast<float>(sign);
   };
+  // Which points of s's surface (its centre, then `continuous`) lie beyond each plane, as bit
+  // sets, so that a pair's test is a few word ANDs.
+  const std::size_t points = continuous.size() + 1, words = (points + 63) / 64;
+  std::vector<std::uint64_t> far(through.size() * words, 0);
+  std::vector<int> sign(through.size());
+  std::vector<Vec3f> line(through.size());
   for (std::size_t a = 0; a < through.size(); ++a) {
-    const int sa = -concavity(s, through[a]);
+    sign[a] = -concavity(s, through[a]);
+    line[a] = normalized(cross(through[a].n, s.n));
+    if (sign[a] == 0) continue;
+    std::uint64_t* bits = &far[a * words];
+    for (std::size_t k = 0; k < points; ++k) {
+      const Vec3f x = k == 0 ? s.c : continuous[k - 1];
+      if (beyond(through[a], sign[a], x) > tol) bits[k / 64] |= std::uint64_t{1} << (k % 64);
+    }
+  }
+  for (std::size_t a = 0; a < through.size(); ++a) {
+    const int sa = sign[a];
     if (sa == 0) continue;
-    const Vec3f la = normalized(cross(through[a].n, s.n));
+    const Vec3f la = line[a];
     // One plane: the surface continues past it, but only beside the disc's chord on the line
     // where the planes meet (a splat near such a corner whose disc does not reach the other
     // plane). Straight across the chord lies none of the surface beyond the plane.
@@ -209,23 +225,18 @@ std::vector<std::uint8_t> reflex_partners(const Disc& s, std::span<const Vec3f> 
       if (to_line < s.r) {
         const float half = std::sqrt(s.r * s.r - to_line * to_line);
         bool empty = true;
-        for (std::size_t k = 0; k < continuous.size() && empty; ++k) {
-          empty = !(beyond(through[a], sa, continuous[k]) > tol &&
-                    std::fabs(dot(continuous[k] - s.c, la)) < half);
+        for (std::size_t k = 1; k < points && empty; ++k) {
+          const bool is_far = (far[a * words + k / 64] >> (k % 64)) & 1;
+          empty = !(is_far && std::fabs(dot(continuous[k - 1] - s.c, la)) < half);
         }
         if (empty) flags[a] = 1;
       }
     }
     for (std::size_t b = a + 1; b < through.size(); ++b) {
-      const int sb = -concavity(s, through[b]);
-      if (sb == 0) continue;
-      const Vec3f lb = normalized(cross(through[b].n, s.n));
-      if (length(cross(la, lb)) < 0.5f) continue;  // lines within 30°: not a corner
-      bool empty = !(beyond(through[a], sa, s.c) > tol && beyond(through[b], sb, s.c) > tol);
-      for (std::size_t k = 0; k < continuous.size() && empty; ++k) {
-        empty = !(beyond(through[a], sa, continuous[k]) > tol &&
-                  beyond(through[b], sb, continuous[k]) > tol);
-      }
+      if (sign[b] == 0) continue;
+      if (length(cross(la, line[b])) < 0.5f) continue;  // lines within 30°: not a corner
+      bool empty = true;
+      for (std::size_t w = 0; w < words && empty; ++w) empty = (far[a * words + w] & far[b * words + w]) == 0;
       if (empty) flags[a] = flags[b] = 1;
     }
   }
