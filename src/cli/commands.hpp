@@ -90,6 +90,8 @@ struct InfoOptions {
   std::string columns;     // --columns for text inputs
   unsigned threads = 0;
   bool spt = false;        // --spt: build the Sequential Point Tree and report its list
+  bool features = false;   // --features: compute the sharp features and report them
+  FeatureOptions feature;
   ViewOptions view;        // for the SPT report: the view whose scanned fraction is given
   float epsilon_px = 1.0f;
 };

@@ -29,6 +29,37 @@ std::string input_format_name(const std::string& path) {
   return "text";
 }
 
+double share(std::uint64_t part, std::uint64_t whole) {
+  return whole ? 100.0 * double(part) / double(whole) : 0.0;
+}
+
+// The dissertation's Tables 6.1-6.3 for this model, and what Pointillist adds.
+void print_feature_stats(const FeatureStats& s, const FeatureOptions& o) {
+  const auto u = [](std::uint64_t v) { return static_cast<unsigned long long>(v); };
+  std::printf("sharp features (w_s %.2f, edge test %s, drawn radius %.2f x splat radius):\n",
+              o.sharp_threshold, o.edge_test == EdgeTest::Side ? "side" : "linsen",
+              o.radius_scale);
+  std::printf("  graph:       %llu edges, m = %.2f edges a splat (bounding spheres, eq. 3.1)\n",
+              u(s.edges), s.mean_degree());
+  std::printf("  sharp edges: %llu (%.2f%% of edges); discs really crossing: %llu (%.2f%% of "
+              "sharp edges); antiparallel: %llu\n",
+              u(s.sharp_edges), share(s.sharp_edges, s.edges), u(s.crossing_edges),
+              share(s.crossing_edges, s.sharp_edges), u(s.antiparallel_edges));
+  std::printf("  splats:      %llu; candidates %llu (%.2f%%); clipped %llu (%.2f%% of "
+              "candidates); crossings passed through (intersections) %llu\n",
+              u(s.splats), u(s.candidates), share(s.candidates, s.splats), u(s.clipped),
+              share(s.clipped, s.candidates), u(s.pass_through));
+  std::printf("  planes per clipped splat:");
+  for (std::size_t k = 1; k < s.plane_histogram.size(); ++k) {
+    if (s.plane_histogram[k]) std::printf(" %zu: %llu", k, u(s.plane_histogram[k]));
+  }
+  std::printf("%s\n", s.capped ? (" (" + std::to_string(s.capped) + " capped at 16)").c_str() : "");
+  std::printf("  rules:       eqs. 4.13-4.15 undefined for %llu splats; nearest-plane rule for "
+              "%llu\n", u(s.undefined_4_15), u(s.nearest_rule));
+  std::printf("  surfaces:    %llu segments, %llu with at least 0.5%% of the splats\n",
+              u(s.segments), u(s.large_segments));
+}
+
 }  // namespace
 
 int run_info(const InfoOptions& o) {
@@ -36,6 +67,10 @@ int run_info(const InfoOptions& o) {
   OpenModelOptions open;
   open.columns = o.columns;
   open.paging = o.spt ? Paging::Never : Paging::Auto;
+  if (o.features) {
+    open.features = o.feature;
+    open.paging = Paging::Never;
+  }
   const Model model = open_model(o.input, open, pool, Progress::none());
   const SphereTreeView& t = model.tree();
   const Model::ScanInput& in = model.scan_input();
@@ -115,6 +150,7 @@ int run_info(const InfoOptions& o) {
   std::printf("file size:   %s (%.2f bytes/point)\n",
               human_bytes(double(model.file_size())).c_str(),
               leaves > 0 ? double(model.file_size()) / leaves : 0.0);
+  if (const TreeFeatures* f = model.features()) print_feature_stats(f->stats, f->options);
   if (o.spt) {
     const SequentialPointTree spt = build_sequential_point_tree(sphere_tree_leaves(t), pool);
     std::printf("sequential point tree (built in memory, chunk level %u):\n", spt.chunk_level);
@@ -160,6 +196,13 @@ Command add_info_command(CLI::App& app) {
   cmd->add_option("input", o->input, "Model or scan file")->required()->check(CLI::ExistingFile);
   add_threads(cmd, o->threads);
   add_columns(cmd, o->columns);
+  cmd->add_flag("--features", o->features,
+                "Find the sharp features in memory and print their statistics (the "
+                "dissertation's tables: graph, sharp edges, crossings, clipped splats, surfaces)");
+  cmd->add_option("--sharp-threshold", o->feature.sharp_threshold,
+                  "With --features: cosine between normals below which an edge is sharp")
+      ->default_val(0.9f)
+      ->check(CLI::Range(-1.0f, 1.0f));
   cmd->add_flag("--spt", o->spt,
                 "Also build the Sequential Point Tree and report its list and the share of it "
                 "one view scans");

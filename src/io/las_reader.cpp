@@ -199,13 +199,35 @@ void for_chunks(ThreadPool* pool, std::size_t count,
   for (std::size_t k = 0; k < chunks; ++k) chunk(k);
 }
 
+// For GzipInflater::set_limit: the most bytes the public header allows (point data offset +
+// count x record length, plus 1 MiB for what writers leave after the points), once the header
+// is in; no bound for a LAS 1.3/1.4 file with extended records after the points (their sizes
+// are in them) or a header the parser will reject anyway.
+std::uint64_t las_limit(std::string_view prefix) {
+  constexpr std::uint64_t kNone = std::numeric_limits<std::uint64_t>::max();
+  constexpr std::size_t kMinHeader = 227, kEvlrStartAt = 235, kEvlrCountAt = 243;
+  if (prefix.size() < 375) return kNone;
+  const char* d = prefix.data();
+  if (std::memcmp(d, "LASF", 4) != 0 || u8(d + kVersionAt) != 1) return kNone;
+  const int minor = u8(d + kVersionAt + 1);
+  if (u16(d + kHeaderSizeAt) < kMinHeader) return kNone;
+  if (minor >= 3 && u64(d + kEvlrStartAt) != 0 && (minor < 4 || u32(d + kEvlrCountAt) != 0)) {
+    return kNone;
+  }
+  const std::uint64_t offset = u32(d + kPointOffsetAt), record = u16(d + kRecordLengthAt);
+  const std::uint64_t count64 = minor >= 4 ? u64(d + kCount64At) : 0;
+  const std::uint64_t count = count64 != 0 ? count64 : u32(d + kLegacyCountAt);
+  if (record == 0 || count > (kNone - offset - (1u << 20)) / record) return kNone;
+  return offset + count * record + (1u << 20);
+}
+
 }  // namespace
 
 PointSet read_las(const std::string& path, Progress& progress, const LasReadOptions& options) {
   FileBytes raw = FileBytes::map(path);
   const std::uint64_t file_size = raw.file_size();
   ReadProgress read_progress(progress, file_size);
-  FileBytes bytes = inflate_if_gzipped(std::move(raw), path, read_progress);
+  FileBytes bytes = inflate_if_gzipped(std::move(raw), path, read_progress, las_limit);
   const bool gzip = bytes.was_compressed();
   const std::string_view data = bytes.view();
   const LasHeader h = LasFile(path, data, gzip).parse_header();

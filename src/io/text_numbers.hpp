@@ -14,6 +14,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <cstdio>
 #include <cstring>
 #include <limits>
@@ -246,13 +247,16 @@ class ReadProgress {
 };
 
 // `raw` (a file mapped from `path`) as is, or inflated when it starts with the gzip magic; the
-// inflation earns the first half of `progress` (whose total is the file's size).
+// inflation earns the first half of `progress` (whose total is the file's size). `limit`: the
+// most bytes the file's header allows (GzipInflater::set_limit), or empty.
 inline FileBytes inflate_if_gzipped(FileBytes raw, const std::string& path,
-                                    ReadProgress& progress) {
+                                    ReadProgress& progress,
+                                    std::function<std::uint64_t(std::string_view)> limit = {}) {
   if (!has_gzip_magic(raw.view())) return raw;
   const std::uint64_t size = raw.file_size();
   progress.begin_part(size / 2, size);
-  return FileBytes::inflate(raw, path, [&](std::uint64_t n) { progress.advance(n); });
+  return FileBytes::inflate(raw, path, [&](std::uint64_t n) { progress.advance(n); },
+                            std::move(limit));
 }
 
 }  // namespace pointillist::io_detail

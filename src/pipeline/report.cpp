@@ -66,8 +66,22 @@ std::string render_report_json(const RenderReport& r) {
   if (r.scene) {
     Json models = Json::array();
     for (const auto& m : r.scene->models()) {
-      models.push_back({{"path", m->path()}, {"kind", kind_name(m->kind())},
-                        {"paging", m->paging_reason()}});
+      Json model = {{"path", m->path()}, {"kind", kind_name(m->kind())},
+                    {"paging", m->paging_reason()}};
+      if (const TreeFeatures* f = m->features()) {
+        const FeatureStats& fs = f->stats;
+        model["features"] = {{"splats", fs.splats},
+                             {"edges", fs.edges},
+                             {"mean_degree", fs.mean_degree()},
+                             {"sharp_edges", fs.sharp_edges},
+                             {"crossing_edges", fs.crossing_edges},
+                             {"candidates", fs.candidates},
+                             {"clipped", fs.clipped},
+                             {"undefined_4_15", fs.undefined_4_15},
+                             {"segments", fs.segments},
+                             {"large_segments", fs.large_segments}};
+      }
+      models.push_back(std::move(model));
     }
     j["models"] = std::move(models);
   }

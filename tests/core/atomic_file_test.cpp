@@ -3,6 +3,7 @@
 // bytes, made by the test itself.
 #include <gtest/gtest.h>
 #include <sys/file.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <fcntl.h>
 #include <unistd.h>
@@ -55,6 +56,45 @@ TEST(AtomicFile, ASignalDuringTheWriteLeavesNoTemporaryFile) {
     EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == signal);
     EXPECT_TRUE(listing(dir.path()).empty()) << "signal " << signal;
   }
+}
+
+TEST(AtomicFile, AFullDiskNamesTheOutputAndLeavesNothing) {
+  // The disk fills during the write: a file-size limit makes write() fail the same way (EFBIG
+  // instead of ENOSPC), in a child so the limit stays there.
+  pointillist::testing::TempDir dir;
+  const std::string out = dir.file("model.ptl");
+  int pipe_fds[2];
+  ASSERT_EQ(pipe(pipe_fds), 0);
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    close(pipe_fds[0]);
+    std::signal(SIGXFSZ, SIG_IGN);
+    const rlimit limit{4096, 4096};
+    setrlimit(RLIMIT_FSIZE, &limit);
+    std::string message = "no error";
+    try {
+      AtomicFile f(out);
+      const std::string block(1 << 16, 'x');
+      for (int i = 0; i < 16; ++i) f.write(block);
+      f.commit();
+    } catch (const IoError& e) {
+      message = e.what();
+    }
+    [[maybe_unused]] const auto n = ::write(pipe_fds[1], message.data(), message.size());
+    _exit(0);
+  }
+  close(pipe_fds[1]);
+  std::string message;
+  char buf[512];
+  for (ssize_t n; (n = read(pipe_fds[0], buf, sizeof buf)) > 0;) message.append(buf, std::size_t(n));
+  close(pipe_fds[0]);
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  EXPECT_NE(message.find("cannot write " + out), std::string::npos) << message;
+  EXPECT_NE(message.find(".tmp-"), std::string::npos) << message;  // and its temporary file
+  EXPECT_NE(message.find("too large"), std::string::npos) << message;  // the system's reason
+  EXPECT_TRUE(listing(dir.path()).empty()) << "a partial output or temporary file was left";
 }
 
 TEST(AtomicFile, TheNextWriteRemovesStaleTemporariesButNotLiveOnes) {

@@ -1,4 +1,4 @@
-// A gzip file whose data goes on far past what its PLY header describes (a "gzip bomb": a small
+// Gzip files whose data goes on far past what their PLY or LAS header describes (a "gzip bomb": a small
 // file inflating to gigabytes) is refused as soon as the inflated data passes the most bytes the
 // header allows (plus 1 MiB), whether it is inflated whole or while parsing. The oracle: the
 // header size plus the body size the test's own header gives (10 binary vertices of 12 bytes).
@@ -9,6 +9,8 @@
 #include "io_test_support.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/core/thread_pool.hpp"
+#include "las_builder.hpp"
+#include "pointillist/io/las.hpp"
 #include "pointillist/io/ply.hpp"
 #include "testing/testing.hpp"
 
@@ -64,4 +66,27 @@ TEST(PlyGzip, AFileThatEndsWhereItsHeaderSaysStillReads) {
     ASSERT_EQ(p.size(), 10u);
     EXPECT_EQ(p.positions[9], (Vec3f{9, 18, -1}));
   }
+}
+
+// The same for LAS: the public header's point data offset + count × record length bound it.
+TEST(LasGzip, DataFarPastWhatTheHeaderDescribesIsRefusedAtTheBound) {
+  pointillist::testing::TempDir dir;
+  const std::string path = dir.file("bomb.las.gz");
+  const std::vector<pointillist::testing::LasPoint> points(10, {1, 2, 3});
+  const std::string las = pointillist::testing::build_las({.minor = 2}, points);
+  pointillist::testing::write_file(path,
+                                   pointillist::testing::gzip(las + std::string(64 << 20, '\0'), 9));
+  const std::size_t bound = las.size() + (1 << 20);  // header + records, 1 MiB of slack
+  try {
+    read_las(path, Progress::none());
+    FAIL() << "a LAS gzip bomb was read";
+  } catch (const FormatError& e) {
+    EXPECT_NE(std::string(e.what()).find(path + ": decompressed byte " + std::to_string(bound) +
+                                         ": the data goes on past"),
+              std::string::npos)
+        << e.what();
+  }
+  // Without the zeros it reads.
+  pointillist::testing::write_file(path, pointillist::testing::gzip(las, 9));
+  EXPECT_EQ(read_las(path, Progress::none()).size(), 10u);
 }
