@@ -17,6 +17,9 @@
 #include "pointillist/core/thread_pool.hpp"
 #include "pointillist/format/ptl.hpp"
 #include "pointillist/format/ptl_v2.hpp"
+#include "pointillist/lod/tree_features.hpp"
+#include "pointillist/prep/radii.hpp"
+#include "pointillist/scene/csg.hpp"
 #include "pointillist/format/qs.hpp"
 #include "pointillist/io/ply.hpp"
 #include "pointillist/lod/sphere_tree.hpp"
@@ -266,6 +269,18 @@ void make_models(const fs::path& root, ThreadPool& pool) {
                {.leaf_trim = quant::LeafTrim::Eighths});
   // About 900 nodes in 1 KiB pages: page 0 and a few child pages.
   write_ptl_v2((v2 / "pages.ptl").string(), paged_tree, "seed: pages", {.page_bytes = 1024});
+  {
+    // A small cube with its sharp features stored (surface ids, clipped leaves and planes).
+    CsgScene cube = csg_scene("T1");
+    cube.spacing = 0.3f;
+    CsgSamples s = sample_csg(cube, SamplingMode::Jittered, 1);
+    CloudRadiusOptions radius;
+    radius.coverage = 1.0f;
+    s.points.radii = cloud_radii(s.points.positions, pool, Progress::none(), radius);
+    const SphereTree tree = build_sphere_tree(s.points, pool);
+    const TreeFeatures features = compute_tree_features(tree.view(), pool);
+    write_ptl_v2((v2 / "features.ptl").string(), tree, "seed: features", {.features = &features});
+  }
 
   write_qs((root / "qs" / "colors.qs").string(), small);
   write_qs((root / "qs" / "mesh.qs").string(), grid_mesh(), {.write_comments = true});

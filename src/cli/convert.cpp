@@ -62,12 +62,29 @@ Command add_convert_command(CLI::App& app) {
                             "before 2026-11-24 reads)");
   trim_option->group(kGroupOutput);
   cmd->add_flag("--ascii", o->convert.ascii, "Write .ply output as ascii")->group(kGroupOutput);
+  auto features = std::make_shared<FeatureOptions>();
+  auto with_features = std::make_shared<bool>(false);
+  cmd->add_flag("--features", *with_features,
+                    ".ptl v2: find the sharp edges, corners and intersecting surfaces and store "
+                    "them (render draws them)")
+          ->group(kGroupOutput);
+  cmd->add_option("--sharp-threshold", features->sharp_threshold,
+                  "With --features: cosine between neighbours' normals below which their edge is "
+                  "sharp (0.9: about 26 degrees)")
+      ->default_val(0.9f)
+      ->check(CLI::Range(-1.0f, 1.0f))
+      ->group(kGroupOutput);
+  add_enum<EdgeTest>(cmd, "--edge-test", features->edge_test,
+                     {{"side", EdgeTest::Side}, {"linsen", EdgeTest::Linsen}},
+                     "With --features: side (per pair) or linsen (angular gap)", "side")
+      ->group(kGroupOutput);
   add_columns(cmd, o->convert.columns);
   add_prepare_options(cmd, o->convert.prepare);
   add_threads(cmd, o->threads);
   cmd->add_flag("-q,--quiet", o->quiet, "No progress bars and no summary");
-  return {cmd, [o, trim, trim_option] {
+  return {cmd, [o, trim, trim_option, features, with_features] {
             if (trim_option->count() > 0) o->convert.leaf_trim = *trim;
+            if (*with_features) o->convert.features = *features;
             return run_convert(*o);
           }};
 }

@@ -134,6 +134,7 @@ int run_render(const RenderOptions& o) {
   open.frames = std::max<std::uint64_t>(1, std::uint64_t(o.orbit_frames) + o.refine_frames);
   open.frame_pixels = std::uint64_t(o.view.width) * std::uint64_t(o.view.height);
   open.features = o.features;
+  open.stored_features = o.frame.features;
   if (o.features) open.paging = Paging::Never;  // features need the hierarchy held whole
   const Scene scene = o.inputs.size() == 1 && is_scene_file(o.inputs[0])
                           ? read_scene(o.inputs[0], open, pool, progress)

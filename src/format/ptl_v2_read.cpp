@@ -11,6 +11,7 @@
 
 #include "ptl_header.hpp"
 #include "ptl_v2_codec.hpp"
+#include "ptl_v2_features.hpp"
 #include "ptl_v2_layout.hpp"
 #include "pointillist/core/file_bytes.hpp"
 #include "pointillist/core/error.hpp"
@@ -241,10 +242,28 @@ std::unique_ptr<PtlV2File> PtlV2File::open(const std::string& path) {
                 " bytes; it was probably truncated");
   }
   file->metadata_.assign(view.data() + metadata_offset, metadata_size);
+  if (load_u32(b + offset::kCompatFlags) & kCompatFeatures) {
+    const std::uint64_t at = load_u64(b + kFeaturesOffsetAt), bytes = load_u64(b + kFeaturesSizeAt);
+    if (at < header_size || bytes == 0 || at > size || bytes > size - at) {
+      fail_at(path, kFeaturesOffsetAt,
+              "the sharp-features section (bytes " + str(at) + " to " + str(at + bytes) +
+                  ") is not inside the file (" + str(size) +
+                  " bytes); it was probably truncated");
+    }
+    file->features_offset_ = at;
+    file->features_size_ = bytes;
+  }
   return file;
 }
 
 PtlV2File::~PtlV2File() = default;
+
+std::optional<FeatureData> PtlV2File::features() const {
+  if (features_size_ == 0) return std::nullopt;
+  const std::string_view view = map_->bytes.view();
+  return decode_features(view.substr(features_offset_, features_size_), features_offset_,
+                         leaf_count_, path_);
+}
 
 template <class OnRecord>
 std::uint32_t PtlV2File::scan_page(std::uint32_t page, std::vector<Sphere>& root_spheres,

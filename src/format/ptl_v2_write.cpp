@@ -10,6 +10,7 @@
 
 #include "ptl_header.hpp"
 #include "ptl_v2_codec.hpp"
+#include "ptl_v2_features.hpp"
 #include "ptl_v2_layout.hpp"
 #include "pointillist/core/atomic_file.hpp"
 #include "pointillist/core/error.hpp"
@@ -352,6 +353,8 @@ PtlV2WriteReport write_ptl_v2(const std::string& path, const SphereTree& tree,
     page_offset += pages[p].byte_size;
   }
   const std::uint64_t metadata_offset = page_offset;
+  const std::vector<std::uint8_t> feature_bytes =
+      options.features ? encode_features(nodes, *options.features) : std::vector<std::uint8_t>{};
 
   std::uint8_t* h = head.data();
   std::memcpy(h, ptl::kMagic, sizeof ptl::kMagic);
@@ -361,7 +364,12 @@ PtlV2WriteReport write_ptl_v2(const std::string& path, const SphereTree& tree,
   store_u32(h + offset::kFlags, colors ? kFlagHasColors : 0);
   // The frame only when it is not the default, so such files keep their old bytes.
   const bool frame = tree.origin != std::array<double, 3>{} || !(tree.up == Vec3f{0, 1, 0});
-  store_u32(h + offset::kCompatFlags, frame ? kCompatFrame : 0);
+  store_u32(h + offset::kCompatFlags,
+            (frame ? kCompatFrame : 0) | (feature_bytes.empty() ? 0 : kCompatFeatures));
+  if (!feature_bytes.empty()) {
+    store_u64(h + kFeaturesOffsetAt, metadata_offset + metadata.size());
+    store_u64(h + kFeaturesSizeAt, feature_bytes.size());
+  }
   if (frame) {
     for (int a = 0; a < 3; ++a) store_f64(h + offset::kOrigin + 8 * a, tree.origin[a]);
     store_vec(h + offset::kUp, tree.up);
@@ -424,9 +432,10 @@ PtlV2WriteReport write_ptl_v2(const std::string& path, const SphereTree& tree,
     file.write(bytes.data(), bytes.size());
   }
   file.write(metadata.data(), metadata.size());
+  file.write(feature_bytes.data(), feature_bytes.size());
   file.commit();
 
-  report.file_size = metadata_offset + metadata.size();
+  report.file_size = metadata_offset + metadata.size() + feature_bytes.size();
   report.record_bytes = std::uint64_t{n} * record_size;
   report.node_count = n;
   report.leaf_count = leaves;

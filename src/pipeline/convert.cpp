@@ -12,6 +12,7 @@
 #include "pointillist/format/qs.hpp"
 #include "pointillist/io/merge.hpp"
 #include "pointillist/io/ply.hpp"
+#include "pointillist/lod/tree_features.hpp"
 #include "pointillist/io/point_file.hpp"
 #include "pointillist/lod/sphere_tree.hpp"
 #include "pointillist/pipeline/model.hpp"
@@ -51,6 +52,10 @@ ConvertResult convert(std::span<const std::string> inputs, const std::string& ou
   if (o.ptl_version != 1 && o.ptl_version != 2) {
     throw OptionError("convert: --ptl-version " + std::to_string(o.ptl_version) +
                       " does not exist; use 2 (compact, the default) or 1 (float nodes)");
+  }
+  if (o.features && !(to_ptl && o.ptl_version == 2)) {
+    throw OptionError("convert: --features are stored only in .ptl version 2 output; write a .ptl "
+                      "(or render the scan with --features)");
   }
   if (o.leaf_trim && !(to_ptl && o.ptl_version == 2)) {
     throw OptionError("convert: --leaf-trim applies only to .ptl version 2 output; drop it");
@@ -106,6 +111,19 @@ ConvertResult convert(std::span<const std::string> inputs, const std::string& ou
       PtlV2WriteOptions v2;
       if (o.leaf_trim) v2.leaf_trim = *o.leaf_trim;
       write_ptl_v2(output, tree, meta.str(), v2, pool);
+      if (o.features) {
+        // Features of the splats as the file stores them (quantized centres and normals,
+        // enlarged radii), which is what the renderer draws: found on the written file's
+        // decoded leaves, then written with it.
+        const SphereTree decoded = PtlV2File::open(output)->decode_all();
+        const TreeFeatures features =
+            compute_tree_features(decoded.view(), pool, *o.features, progress);
+        meta << "features: sharp threshold " << o.features->sharp_threshold << ", "
+             << features.stats.clipped << " clipped splats, " << features.stats.segments
+             << " surfaces\n";
+        v2.features = &features;
+        write_ptl_v2(output, tree, meta.str(), v2, pool);
+      }
     }
   } else {
     ProgressPhase phase(progress, "write", 0);

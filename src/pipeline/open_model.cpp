@@ -71,6 +71,9 @@ Model Model::open_file(const std::string& path, const OpenModelOptions& options,
           model.paging_reason_ = "paged: the decoded hierarchy would take " +
                                  megabytes(decoded_bytes) + ", more than a quarter of the memory (" +
                                  megabytes(memory) + ")";
+        } else if (options.stored_features && model.v2_->has_features()) {
+          model.paging_reason_ =
+              "decoded whole: its sharp features are drawn from the whole hierarchy";
         } else if (options.frames > 1) {
           model.paging_reason_ =
               "decoded whole: the " + frames + " of a sequence draw from the whole hierarchy "
@@ -142,6 +145,14 @@ Model open_model(const std::string& path, const OpenModelOptions& options, Threa
     model.features_ = std::make_unique<TreeFeatures>(
         compute_tree_features(model.view_, pool, *options.features, progress));
     model.view_.features = model.features_.get();
+  } else if (model.v2_ && model.v2_->has_features() && options.stored_features) {
+    if (model.paged()) {
+      model.paging_reason_ += "; its sharp features are drawn only when it is decoded whole";
+    } else {
+      model.features_ =
+          std::make_unique<TreeFeatures>(tree_features(model.view_.nodes, *model.v2_->features()));
+      model.view_.features = model.features_.get();
+    }
   }
   model.renderable_ = std::make_unique<RenderModel>(
       RenderModel{.tree = model.view_,

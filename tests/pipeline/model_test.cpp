@@ -16,6 +16,7 @@
 #include "pointillist/pipeline/model.hpp"
 #include "pointillist/render/sequence.hpp"
 #include "pointillist/scene/analytic.hpp"
+#include "pointillist/scene/csg.hpp"
 #include "testing/testing.hpp"
 
 using namespace pointillist;
@@ -241,4 +242,75 @@ TEST(Convert, DroppedOutliersAreCounted) {
   const ConvertResult r = convert(in, dir.file("s.ptl"), o, pool, Progress::none());
   EXPECT_EQ(r.input_points, 3005u);
   EXPECT_EQ(r.output_points, 3000u);
+}
+
+namespace {
+
+// A T1 cube scan with exact normals and a colour per face, written as PLY.
+std::string write_cube_scan(const pointillist::testing::TempDir& dir) {
+  CsgScene cube = csg_scene("T1");
+  cube.spacing = 0.08f;
+  CsgSamples s = sample_csg(cube, SamplingMode::Jittered, 5);
+  for (std::uint32_t l : s.labels) {
+    s.points.colors.push_back({static_cast<std::uint8_t>(40 * l), 100, 200});
+  }
+  const std::string path = dir.file("cube.ply");
+  write_ply(path, s.points);
+  return path;
+}
+
+Frame render_model(const Model& m, ThreadPool& pool, bool features) {
+  Renderer renderer;
+  Frame frame;
+  FrameSettings fs;
+  fs.rasterizer = Rasterizer::Quality;
+  fs.features = features;
+  Camera cam;
+  cam.eye = {2.0f, 2.1f, 1.9f};
+  cam.target = {1, 1, 1};
+  cam.width = cam.height = 96;
+  const SceneInstance inst{&m.renderable(), {}};
+  renderer.render({&inst, 1}, cam, RenderSettings{}, fs, pool, frame);
+  return frame;
+}
+
+}  // namespace
+
+TEST(ConvertFeatures, StoredFeaturesDrawAsFeaturesComputedOnTheDecodedModel) {
+  pointillist::testing::TempDir dir;
+  ThreadPool pool(2);
+  const std::string in[] = {write_cube_scan(dir)};
+  ConvertOptions with;
+  with.features = FeatureOptions{};
+  convert(in, dir.file("f.ptl"), with, pool, Progress::none());
+  convert(in, dir.file("plain.ptl"), {}, pool, Progress::none());
+  const Model stored = open_model(dir.file("f.ptl"), {}, pool, Progress::none());
+  ASSERT_NE(stored.features(), nullptr);  // decoded whole to draw them, by default
+  EXPECT_FALSE(stored.paged());
+  EXPECT_GT(stored.features()->stats.clipped, 0u);
+  const Model computed =
+      open_model(dir.file("plain.ptl"), {.paging = Paging::Never, .features = FeatureOptions{}},
+                 pool, Progress::none());
+  ASSERT_NE(computed.features(), nullptr);
+  const Frame a = render_model(stored, pool, true), b = render_model(computed, pool, true);
+  EXPECT_TRUE(std::equal(a.color.begin(), a.color.end(), b.color.begin()));
+  // --no-features: the stored ones are not drawn.
+  const Frame off = render_model(stored, pool, false);
+  EXPECT_FALSE(std::equal(a.color.begin(), a.color.end(), off.color.begin()));
+}
+
+TEST(ConvertFeatures, OnlyPtlVersion2StoresThem) {
+  pointillist::testing::TempDir dir;
+  ThreadPool pool(1);
+  const std::string in[] = {write_cube_scan(dir)};
+  ConvertOptions with;
+  with.features = FeatureOptions{};
+  for (const char* out : {"x.qs", "x.ply"}) {
+    try {
+      convert(in, dir.file(out), with, pool, Progress::none());
+      FAIL() << out;
+    } catch (const OptionError& e) {
+      EXPECT_THAT(e.what(), HasSubstr("--features are stored only in .ptl version 2"));
+    }
+  }
 }

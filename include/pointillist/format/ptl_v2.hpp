@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,7 @@
 #include "pointillist/core/thread_pool.hpp"
 #include "pointillist/lod/quantization.hpp"
 #include "pointillist/lod/sphere_tree.hpp"
+#include "pointillist/lod/tree_features.hpp"
 
 namespace pointillist {
 
@@ -38,6 +40,9 @@ struct PtlV2WriteOptions {
   // 1.24x their true radius on the dragon), or in eighths (1.28x), the encoding of the first
   // version 2 files, which Pointillist before 2026-11-24 reads.
   quant::LeafTrim leaf_trim = quant::LeafTrim::Sixteenths;
+  // Sharp features of the tree's nodes to store (the leaves' surface ids and clip planes, in a
+  // section after the metadata), or null.
+  const TreeFeatures* features = nullptr;
 };
 
 // What write_ptl_v2 did.
@@ -152,6 +157,10 @@ class PtlV2File {
   const std::array<double, 3>& origin() const { return origin_; }
   Vec3f up() const { return up_; }
   const std::string& metadata() const { return metadata_; }
+  // Whether the file stores sharp features, and its leaves' features (indexed by leaf in node
+  // order, as decode_all's leaves). Throws FormatError for a damaged section.
+  bool has_features() const { return features_size_ != 0; }
+  std::optional<FeatureData> features() const;
   std::uint64_t file_size() const { return size_; }
   const std::string& path() const { return path_; }
 
@@ -185,6 +194,7 @@ class PtlV2File {
   std::array<double, 3> origin_{};
   Vec3f up_{0, 1, 0};
   std::string metadata_;
+  std::uint64_t features_offset_ = 0, features_size_ = 0;
   std::vector<PtlV2PageInfo> pages_;
 };
 

@@ -10,6 +10,7 @@
 
 #include "pointillist/core/progress.hpp"
 #include "pointillist/core/thread_pool.hpp"
+#include "pointillist/features/features.hpp"
 #include "pointillist/lod/quantization.hpp"
 #include "pointillist/prep/prepare.hpp"
 
@@ -23,6 +24,8 @@ struct ConvertOptions {
   // .ptl v2 output: how leaves keep their radius trim (sixteenths; eighths for readers older
   // than 2026-11-24). Unset: the default, allowed with any output.
   std::optional<quant::LeafTrim> leaf_trim;
+  // .ptl v2 output: compute the sharp features on the hierarchy's leaves and store them.
+  std::optional<FeatureOptions> features;
 };
 
 struct ConvertResult {

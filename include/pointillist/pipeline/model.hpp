@@ -56,6 +56,9 @@ struct OpenModelOptions {
   // Compute sharp features (surface ids, clip planes) on the leaves of a model held whole, with
   // these options (render --features). A paged model gets none.
   std::optional<FeatureOptions> features;
+  // Load the sharp features a .ptl file stores (Paging::Auto then decodes it whole, unless it
+  // would take more than a quarter of the memory).
+  bool stored_features = true;
 };
 
 class Model {
