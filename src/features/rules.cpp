@@ -35,11 +35,17 @@ ClipPlane oriented_plane(const Disc& partner, bool keep_positive) {
 
 // Pointillist's orientation: the kept side of the partner's plane is the side where the splat's
 // own surface lies: its centre, or the centroid of it and its continuous neighbours when the
-// centre is on the plane; the convex default (keep the back side) when both are.
+// centre is near the plane; the convex default (keep the back side) when both are on it.
+// A centre closer to the plane than kOrientByCentre·r does not decide: a quantized model moves
+// centres by several percent of the radius, which put some on the wrong side of the crease (the
+// kept half turned over: a disc shown beyond the edge and cut on its own face).
+constexpr float kOrientByCentre = 0.25f;
 bool keep_positive_side(const Disc& s, const Disc& partner, std::span<const Vec3f> continuous) {
   const float tol = kClassifyTolerance * s.r;
   const float side = dot(s.c - partner.c, partner.n);
-  if (std::fabs(side) > tol) return side > 0;
+  if (std::fabs(side) > kOrientByCentre * s.r || continuous.empty()) {
+    if (std::fabs(side) > tol) return side > 0;
+  }
   Vec3f sum{0, 0, 0};
   for (Vec3f c : continuous) sum += c - s.c;
   const Vec3f centroid = s.c + sum / static_cast<float>(continuous.size() + 1);
@@ -82,15 +88,21 @@ void deduplicate(std::vector<ClipPlane>& planes, std::vector<Vec3f>& centres, fl
 
 // Union or intersection from the pairs of planes (spec §4.8 item 4): b's centre projected into
 // the splat's plane lies on a's kept side (convex pair) or on its clipped side (reflex pair).
+constexpr float kSameCreaseSin = 0.0872f;  // sin 5°
 ClipMode combine_pairs(const Disc& s, const std::vector<ClipPlane>& planes,
                        const std::vector<Vec3f>& centres) {
   if (planes.size() == 1) return ClipMode::Union;
   const float tol = kClassifyTolerance * s.r;
   bool convex = false, reflex = false;
+  std::vector<Vec3f> line(planes.size());
+  for (std::size_t a = 0; a < planes.size(); ++a) line[a] = normalized(cross(planes[a].n, s.n));
   for (std::size_t b = 0; b < planes.size(); ++b) {
     const Vec3f x = centres[b] - s.n * dot(centres[b] - s.c, s.n);
     for (std::size_t a = 0; a < planes.size(); ++a) {
-      if (a == b) continue;
+      // Lines within 5° in the splat's plane are one crease (a quantized model's normals differ
+      // by a degree or two): union and intersection of the two keep the same region but for a
+      // sliver, and their pair says nothing about the corner.
+      if (a == b || length(cross(line[a], line[b])) < kSameCreaseSin) continue;
       // Relative to the splat's centre for precision: n·(x − c) − (h − n·c).
       const float side = dot(planes[a].n, x - s.c) - (planes[a].h - dot(planes[a].n, s.c));
       convex |= side > tol;
