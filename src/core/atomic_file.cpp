@@ -137,6 +137,7 @@ AtomicFile::~AtomicFile() {
 }
 
 void AtomicFile::write(const void* data, std::size_t size) {
+  if (size == 0) return;  // data may be null (an empty vector's)
   const char* bytes = static_cast<const char*>(data);
   if (used_ + size > buffer_.size()) {
     flush();

@@ -77,6 +77,10 @@ void validate_feature_options(const FeatureOptions& o) {
     throw OptionError("the Linsen gap angle must be in (0, 360) degrees, not " +
                       std::to_string(o.linsen_alpha_deg));
   }
+  if (!(o.clip_margin >= 0.0f && o.clip_margin <= 0.5f)) {
+    throw OptionError("the clip margin must be in [0, 0.5] splat radii, not " +
+                      std::to_string(o.clip_margin));
+  }
   if (!(o.radius_scale >= 1.0f && o.radius_scale <= 2.0f)) {
     throw OptionError("the features' radius scale must be in [1, 2] (the renderer's "
                       "--radius-scale), not " + std::to_string(o.radius_scale));
@@ -161,7 +165,8 @@ FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec
         std::stable_sort(partners.begin(), partners.end(), nearer);
         std::stable_sort(through.begin(), through.end(), nearer);
         const ClipResult clip =
-            classify_partners(s, partners, continuous, options.clip_rule, through);
+            classify_partners(s, partners, continuous, options.clip_rule, through,
+                              options.clip_margin);
         block.stats.undefined_4_15 += clip.undefined_4_15;
         block.stats.capped += clip.capped;
         block.modes[i - first] = clip.mode;

@@ -262,7 +262,7 @@ std::vector<std::uint8_t> reflex_partners(const Disc& s, std::span<const Vec3f> 
 
 ClipResult classify_partners(const Disc& s, std::span<const Disc> partners,
                              std::span<const Vec3f> continuous, ClipRule rule,
-                             std::span<const Disc> reflex) {
+                             std::span<const Disc> reflex, float margin) {
   ClipResult result;
   if (partners.empty() && (rule != ClipRule::Classified || reflex.empty())) return result;
   const Classification c = partners.empty() ? Classification{} : classify_4_15(s, partners);
@@ -318,11 +318,12 @@ ClipResult classify_partners(const Disc& s, std::span<const Disc> partners,
   }
   // Scale each plane so that, within the splat's plane, n·P − h is the distance to the line
   // where the planes meet (ClipMode::Nearest compares these distances).
+  // Then move each line `margin` radii out, onto the clipped side.
   for (ClipPlane& p : planes) {
     const float cos_angle = dot(p.n, s.n);
     const float scale = 1.0f / std::sqrt(std::max(1e-6f, 1.0f - cos_angle * cos_angle));
     p.n *= scale;
-    p.h *= scale;
+    p.h = p.h * scale - margin * s.r;
   }
   result.planes = std::move(planes);
   return result;

@@ -9,17 +9,20 @@
 #include <map>
 #include <tuple>
 
+#include "pointillist/format/ptl_v2.hpp"
 #include "pointillist/lod/tree_features.hpp"
 #include "pointillist/prep/radii.hpp"
 #include "pointillist/render/renderer.hpp"
 #include "pointillist/scene/csg.hpp"
+#include "testing/testing.hpp"
 
 using namespace pointillist;
 
 namespace {
 
-constexpr Rgb8 kColors[8] = {{255, 0, 0},   {0, 160, 0},   {0, 0, 255},  {200, 200, 0},
-                             {0, 200, 200}, {200, 0, 200}, {255, 128, 0}, {128, 0, 255}};
+// Eight colours that RGB 565 keeps exactly (a .ptl v2 file stores colours so).
+constexpr Rgb8 kColors[8] = {{255, 0, 0},     {0, 255, 0},   {0, 0, 255},     {255, 255, 0},
+                             {0, 255, 255},   {255, 0, 255}, {255, 255, 255}, {132, 130, 132}};
 
 // A scene's samples with a colour per surface: faces on one plane share it (the step's front
 // faces are one surface), and the reference uses the same map.
@@ -37,7 +40,9 @@ int plane_key_colour(std::map<std::tuple<int, int, int, int>, int>& keys, Vec3f 
   return keys.emplace(key, int(keys.size()) % 8).first->second;
 }
 
-std::unique_ptr<Model> make_model(const std::string& id, ThreadPool& pool) {
+std::unique_ptr<Model> make_model(const std::string& id, ThreadPool& pool, bool quantized = false);
+
+std::unique_ptr<Model> make_model(const std::string& id, ThreadPool& pool, bool quantized) {
   auto m = std::make_unique<Model>();
   m->scene = csg_scene(id);
   CsgSamples s = sample_csg(m->scene, SamplingMode::Jittered, 9);
@@ -57,7 +62,15 @@ std::unique_ptr<Model> make_model(const std::string& id, ThreadPool& pool) {
   }
   for (std::uint32_t l : s.labels) s.points.colors.push_back(kColors[m->colour_of_label[l]]);
   m->tree = build_sphere_tree(s.points, pool);
-  m->features = compute_tree_features(m->tree.view(), pool);
+  if (quantized) {
+    // As a .ptl v2 file stores it (quantized centres, normals, radii, colours).
+    pointillist::testing::TempDir dir;
+    write_ptl_v2(dir.file("m.ptl"), m->tree, "");
+    m->tree = PtlV2File::open(dir.file("m.ptl"))->decode_all();
+  }
+  FeatureOptions options;
+  if (quantized) options.clip_margin = kQuantizedClipMargin;
+  m->features = compute_tree_features(m->tree.view(), pool, options);
   m->render.tree = m->tree.view();
   m->render.tree.features = &m->features;
   return m;
@@ -187,6 +200,24 @@ TEST(FeaturesRender, FastModeClipsAtCreasesToo) {
     EXPECT_EQ(with.mixed, 0u) << id;  // opaque splats never blend
     EXPECT_GT(without.wrong, 200u) << id;  // discs of one face over the other
     EXPECT_LE(with.wrong, with.covered / 500) << id;
+  }
+}
+
+TEST(FeaturesRender, QuantizedModelsKeepMostOfIt) {
+  // The same scenes as a .ptl v2 file decodes them: centres, normals and radii quantized, colours
+  // in RGB 565 (so the pure-colour test compares with the quantized palette).
+  ThreadPool pool(2);
+  for (const char* id : {"T1", "T8"}) {
+    const auto m = make_model(id, pool, true);
+    const Camera cam = std::string(id) == "T1" ? look({2.0f, 2.1f, 1.9f}, {1, 1, 1})
+                                               : look({1.0f, 0.9f, 2.1f}, {0, 0, 1});
+    const LabelMetrics with = measure(*m, cam, render(*m, cam, pool, true));
+    const LabelMetrics without = measure(*m, cam, render(*m, cam, pool, false));
+    std::cout << id << " quantized: covered " << with.covered << " wrong " << with.wrong
+              << " mixed " << with.mixed << " holes " << with.holes << " / without: mixed "
+              << without.mixed << "\n";
+    EXPECT_EQ(with.holes, 0u) << id;
+    EXPECT_LT(with.mixed + with.wrong, (without.mixed + without.wrong) / 4) << id;
   }
 }
 

@@ -60,7 +60,13 @@ struct FeatureOptions {
   // The radius the renderer draws over the splat radius (QualitySettings::radius_scale): the
   // graph and the crossing tests use the drawn discs. In [1, 2].
   float radius_scale = 1.1f;
+  // How far past the crease a disc is kept, in its radii, in [0, 0.5]: 0 for exact data. A
+  // quantized model (.ptl v2: centres a few percent of a radius off their face, normals a
+  // degree or two off) needs some, or the discs of two faces stop short of each other and open
+  // thin holes along the crease; convert uses kQuantizedClipMargin.
+  float clip_margin = 0.0f;
 };
+inline constexpr float kQuantizedClipMargin = 0.1f;
 
 // Throws OptionError naming the field when a value is out of range.
 void validate_feature_options(const FeatureOptions& options);

@@ -62,8 +62,10 @@ struct ClipResult {
 // orienting a plane that passes through s's centre). `reflex` (ClipRule::Classified only) are
 // partners found by reflex_partners; they are oriented by their own eq. 4.14 sign instead of
 // by the side s lies on (s's surface is on both sides of each).
+// `margin` (FeatureOptions::clip_margin) moves every plane's line that many radii of s onto
+// its clipped side.
 ClipResult classify_partners(const Disc& s, std::span<const Disc> partners,
                              std::span<const Vec3f> continuous, ClipRule rule,
-                             std::span<const Disc> reflex = {});
+                             std::span<const Disc> reflex = {}, float margin = 0.0f);
 
 }  // namespace pointillist
