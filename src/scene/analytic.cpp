@@ -250,9 +250,7 @@ RayCastImage ray_cast_image(const AnalyticScene& scene, const Camera& camera) {
   img.normal.assign(n, Vec3f{});
   for (int y = 0; y < f.height; ++y) {
     for (int x = 0; x < f.width; ++x) {
-      const float sx = (x + 0.5f - f.width * 0.5f) / f.focal_px;
-      const float sy = (f.height * 0.5f - (y + 0.5f)) / f.focal_px;
-      const Vec3f dir = normalized(f.forward + f.right * sx + f.up * sy);
+      const Vec3f dir = pixel_ray(f, x, y);
       if (auto hit = ray_cast(scene, f.eye, dir)) {
         const std::size_t i = std::size_t(y) * f.width + x;
         img.covered[i] = 1;

@@ -447,9 +447,7 @@ CsgImage ray_cast_csg_image(const CsgScene& scene, const Camera& camera) {
   img.normal.assign(n, Vec3f{});
   for (int y = 0; y < f.height; ++y) {
     for (int x = 0; x < f.width; ++x) {
-      const float sx = (x + 0.5f - f.width * 0.5f) / f.focal_px;
-      const float sy = (f.height * 0.5f - (y + 0.5f)) / f.focal_px;
-      const Vec3f dir = normalized(f.forward + f.right * sx + f.up * sy);
+      const Vec3f dir = pixel_ray(f, x, y);
       if (auto hit = ray_cast_csg(scene, f.eye, dir)) {
         const std::size_t i = static_cast<std::size_t>(y) * f.width + x;
         img.label[i] = hit->label;

@@ -61,6 +61,13 @@ struct CameraFrame {
   float depth(Vec3f p) const { return dot(p - eye, forward); }
 };
 
+// Unit direction (world) of the ray from the eye through the centre of pixel (x, y).
+inline Vec3f pixel_ray(const CameraFrame& f, int x, int y) {
+  const float sx = (static_cast<float>(x) + 0.5f - static_cast<float>(f.width) * 0.5f) / f.focal_px;
+  const float sy = (static_cast<float>(f.height) * 0.5f - (static_cast<float>(y) + 0.5f)) / f.focal_px;
+  return normalized(f.forward + f.right * sx + f.up * sy);
+}
+
 // Throws OptionError when eye == target, up is parallel to the view direction, fov is not in
 // (0, 180) or the size is not positive.
 CameraFrame make_camera_frame(const Camera& camera);
