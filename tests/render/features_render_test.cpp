@@ -186,6 +186,35 @@ TEST(FeaturesRender, InterpenetratingSpheresShowNoMagenta) {
   }
 }
 
+TEST(FeaturesRender, CurvedCreasesAndThinPartsReport) {
+  // A3 (curved rims: cylinder cap, plate with a hole), A5 (crossed cylinders: rims clipped,
+  // crossing not), A6 (thin slab: front and back never blend): holes and blends against the
+  // exact reference, with and without features.
+  ThreadPool pool(2);
+  struct View {
+    const char* id;
+    Camera cam;
+  };
+  const View views[] = {
+      {"T3", look({1.3f, 1.7f, 1.0f}, {0.8f * 0.7071f, 0.8f, 0.8f * 0.7071f})},  // cap rim
+      {"T4", look({0.9f, 1.4f, 0.9f}, {0.5f * 0.7071f, 0.2f, 0.5f * 0.7071f})},  // hole rim
+      {"T10", look({1.2f, 1.4f, 1.6f}, {0, 0.3f, 0.3f})},                         // crossing
+      {"T11", look({1.6f, 1.2f, 1.9f}, {1, 1, 0})},                               // slab corner
+  };
+  for (const View& v : views) {
+    const auto m = make_model(v.id, pool);
+    const LabelMetrics with = measure(*m, v.cam, render(*m, v.cam, pool, true));
+    const LabelMetrics without = measure(*m, v.cam, render(*m, v.cam, pool, false));
+    std::cout << v.id << ": covered " << with.covered << " wrong " << with.wrong << " mixed "
+              << with.mixed << " holes " << with.holes << " / without: wrong " << without.wrong
+              << " mixed " << without.mixed << " holes " << without.holes << "\n";
+    EXPECT_EQ(with.holes, 0u) << v.id;
+    EXPECT_EQ(with.mixed, 0u) << v.id;
+    EXPECT_LE(with.wrong, with.covered / 50) << v.id;  // A3: LER <= 2 % on curved creases
+    EXPECT_GT(with.covered, 10000u) << v.id;
+  }
+}
+
 TEST(FeaturesRender, FastModeClipsAtCreasesToo) {
   ThreadPool pool(2);
   for (const char* id : {"T1", "T8"}) {
