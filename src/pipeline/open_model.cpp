@@ -1,6 +1,7 @@
 // open_model: every kind of model file, and scans built in memory (see model.hpp).
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <string>
 
@@ -142,8 +143,13 @@ Model open_model(const std::string& path, const OpenModelOptions& options, Threa
                  Progress& progress) {
   Model model = Model::open_file(path, options, pool, progress);
   if (options.features && !model.paged()) {
-    model.features_ = std::make_unique<TreeFeatures>(
-        compute_tree_features(model.view_, pool, *options.features, progress));
+    FeatureOptions fo = *options.features;
+    // Quantized models (.ptl v2, .qs) need the margin that keeps their creases free of holes.
+    if (model.kind_ == ModelKind::PtlV2 || model.kind_ == ModelKind::Qsplat) {
+      fo.clip_margin = std::max(fo.clip_margin, kQuantizedClipMargin);
+    }
+    model.features_ =
+        std::make_unique<TreeFeatures>(compute_tree_features(model.view_, pool, fo, progress));
     model.view_.features = model.features_.get();
   } else if (model.v2_ && model.v2_->has_features() && options.stored_features) {
     if (model.paged()) {

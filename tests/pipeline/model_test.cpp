@@ -288,11 +288,11 @@ TEST(ConvertFeatures, StoredFeaturesDrawAsFeaturesComputedOnTheDecodedModel) {
   ASSERT_NE(stored.features(), nullptr);  // decoded whole to draw them, by default
   EXPECT_FALSE(stored.paged());
   EXPECT_GT(stored.features()->stats.clipped, 0u);
-  FeatureOptions quantized;
-  quantized.clip_margin = kQuantizedClipMargin;  // what convert uses for a .ptl's leaves
+  // Default options: open_model gives a quantized model the margin convert uses.
   const Model computed =
-      open_model(dir.file("plain.ptl"), {.paging = Paging::Never, .features = quantized}, pool,
-                 Progress::none());
+      open_model(dir.file("plain.ptl"), {.paging = Paging::Never, .features = FeatureOptions{}},
+                 pool, Progress::none());
+  EXPECT_EQ(computed.features()->options.clip_margin, kQuantizedClipMargin);
   ASSERT_NE(computed.features(), nullptr);
   const Frame a = render_model(stored, pool, true), b = render_model(computed, pool, true);
   EXPECT_TRUE(std::equal(a.color.begin(), a.color.end(), b.color.begin()));
