@@ -6,6 +6,7 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <span>
 
 #include "bench_data.hpp"
 #include "pointillist/features/features.hpp"
@@ -71,20 +72,29 @@ void BM_FeatureGraphBruteForce(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(c.positions.size()));
 }
 
+// Times compute_features on the splats and reports the mean degree, the shares of sharp
+// edges and clipped splats and the throughput.
+void time_features(benchmark::State& state, std::span<const Vec3f> positions,
+                   std::span<const Vec3f> normals, std::span<const float> radii,
+                   ThreadPool& pool) {
+  FeatureStats stats;
+  for (auto _ : state) {
+    const FeatureData f = compute_features(positions, normals, radii, pool);
+    stats = f.stats;
+    benchmark::DoNotOptimize(f.surface_id.data());
+  }
+  state.counters["m"] = stats.mean_degree();
+  state.counters["sharp_share"] = double(stats.sharp_edges) / double(stats.edges);
+  state.counters["clipped_share"] = double(stats.clipped) / double(stats.splats);
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(positions.size()));
+}
+
 // Whole preprocessing (graph, sharp edges, edge test, disc tests, classification,
 // de-duplication, segmentation); range(1): 0 = J mode, 1 = R mode; range(2): threads.
 void BM_Features(benchmark::State& state) {
   const Cube& c = cube(static_cast<std::size_t>(state.range(0)), state.range(1) != 0);
   ThreadPool pool(static_cast<unsigned>(state.range(2)));
-  FeatureStats stats;
-  for (auto _ : state) {
-    const FeatureData f = compute_features(c.positions, c.normals, c.radii, pool);
-    stats = f.stats;
-    benchmark::DoNotOptimize(f.surface_id.data());
-  }
-  state.counters["m"] = stats.mean_degree();
-  state.counters["clipped_share"] = double(stats.clipped) / double(stats.splats);
-  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(c.positions.size()));
+  time_features(state, c.positions, c.normals, c.radii, pool);
 }
 
 // The dragon (T16), prepared as the CLI does (normals from its faces, QSplat radii).
@@ -95,16 +105,7 @@ void BM_FeaturesDragon(benchmark::State& state) {
     return;
   }
   ThreadPool pool(static_cast<unsigned>(state.range(0)));
-  FeatureStats stats;
-  for (auto _ : state) {
-    const FeatureData f = compute_features(d.positions, d.normals, d.radii, pool);
-    stats = f.stats;
-    benchmark::DoNotOptimize(f.surface_id.data());
-  }
-  state.counters["m"] = stats.mean_degree();
-  state.counters["sharp_share"] = double(stats.sharp_edges) / double(stats.edges);
-  state.counters["clipped_share"] = double(stats.clipped) / double(stats.splats);
-  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(d.positions.size()));
+  time_features(state, d.positions, d.normals, d.radii, pool);
 }
 
 // A random cloud of the demo scene with default preparation (PCA normals, cloud radii).
@@ -118,15 +119,7 @@ void BM_FeaturesCloud(benchmark::State& state) {
     prepare_splats(prepared, pool, Progress::none(), {});
     cloud = sphere_tree_leaves(build_sphere_tree(prepared, pool).view());
   }
-  FeatureStats stats;
-  for (auto _ : state) {
-    const FeatureData f = compute_features(cloud.positions, cloud.normals, cloud.radii, pool);
-    stats = f.stats;
-    benchmark::DoNotOptimize(f.surface_id.data());
-  }
-  state.counters["m"] = stats.mean_degree();
-  state.counters["clipped_share"] = double(stats.clipped) / double(stats.splats);
-  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(n));
+  time_features(state, cloud.positions, cloud.normals, cloud.radii, pool);
 }
 
 // P3/P4: a quality frame of T1 at the corner close-up (V2, 1024×1024), range(0): 1 = features.

@@ -100,6 +100,8 @@ FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec
   out.stats.splats = n;
   out.stats.edges = graph.edge_count();
 
+  const bool reflex_rule =
+      options.edge_test == EdgeTest::Side && options.clip_rule == ClipRule::Classified;
   constexpr std::size_t kBlock = 4096;
   std::vector<Block> blocks((n + kBlock - 1) / kBlock);
   {
@@ -143,19 +145,17 @@ FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec
                                                                    : surface_ends_at(s, continuous, p);
           (ends ? partners : through).push_back(p);
         }
-        // A reflex vertex of the splat's face: its surface passes through two partner planes,
-        // but not through both at once.
+        // Of the crossings the surface passes through, only those at a reflex vertex of the
+        // splat's face clip it (Pointillist's rule only): keep them in `through`.
         const std::size_t passing = through.size();
-        if (options.edge_test == EdgeTest::Side && options.clip_rule == ClipRule::Classified &&
-            !through.empty()) {
+        if (reflex_rule && !through.empty()) {
           const std::vector<std::uint8_t> reflex = reflex_partners(s, continuous, through);
           std::size_t kept = 0;
           for (std::size_t k = 0; k < through.size(); ++k) {
             if (reflex[k]) through[kept++] = through[k];
           }
           through.resize(kept);
-        }
-        if (options.edge_test != EdgeTest::Side || options.clip_rule != ClipRule::Classified) {
+        } else {
           through.clear();
         }
         block.stats.pass_through += passing - through.size();

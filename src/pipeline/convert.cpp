@@ -116,9 +116,8 @@ ConvertResult convert(std::span<const std::string> inputs, const std::string& ou
         // enlarged radii), which is what the renderer draws: found on the written file's
         // decoded leaves, then written with it.
         const SphereTree decoded = PtlV2File::open(output)->decode_all();
-        FeatureOptions fo = *o.features;
-        fo.clip_margin = std::max(fo.clip_margin, kQuantizedClipMargin);
-        const TreeFeatures features = compute_tree_features(decoded.view(), pool, fo, progress);
+        const TreeFeatures features = compute_tree_features(
+            decoded.view(), pool, for_quantized_model(*o.features), progress);
         meta << "features: sharp threshold " << o.features->sharp_threshold << ", "
              << features.stats.clipped << " clipped splats, " << features.stats.segments
              << " surfaces\n";

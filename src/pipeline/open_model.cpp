@@ -1,7 +1,6 @@
 // open_model: every kind of model file, and scans built in memory (see model.hpp).
 #include <unistd.h>
 
-#include <algorithm>
 #include <filesystem>
 #include <string>
 
@@ -143,11 +142,9 @@ Model open_model(const std::string& path, const OpenModelOptions& options, Threa
                  Progress& progress) {
   Model model = Model::open_file(path, options, pool, progress);
   if (options.features && !model.paged()) {
-    FeatureOptions fo = *options.features;
-    // Quantized models (.ptl v2, .qs) need the margin that keeps their creases free of holes.
-    if (model.kind_ == ModelKind::PtlV2 || model.kind_ == ModelKind::Qsplat) {
-      fo.clip_margin = std::max(fo.clip_margin, kQuantizedClipMargin);
-    }
+    const bool quantized = model.kind_ == ModelKind::PtlV2 || model.kind_ == ModelKind::Qsplat;
+    const FeatureOptions fo =
+        quantized ? for_quantized_model(*options.features) : *options.features;
     model.features_ =
         std::make_unique<TreeFeatures>(compute_tree_features(model.view_, pool, fo, progress));
     model.view_.features = model.features_.get();

@@ -68,8 +68,8 @@ std::string render_report_json(const RenderReport& r) {
     for (const auto& m : r.scene->models()) {
       Json model = {{"path", m->path()}, {"kind", kind_name(m->kind())},
                     {"paging", m->paging_reason()}};
-      if (const TreeFeatures* f = m->features()) {
-        const FeatureStats& fs = f->stats;
+      if (const TreeFeatures* features = m->features()) {
+        const FeatureStats& fs = features->stats;
         model["features"] = {{"splats", fs.splats},
                              {"edges", fs.edges},
                              {"mean_degree", fs.mean_degree()},

@@ -63,10 +63,16 @@ struct FeatureOptions {
   // How far past the crease a disc is kept, in its radii, in [0, 0.5]: 0 for exact data. A
   // quantized model (.ptl v2: centres a few percent of a radius off their face, normals a
   // degree or two off) needs some, or the discs of two faces stop short of each other and open
-  // thin holes along the crease; convert uses kQuantizedClipMargin.
+  // thin holes along the crease; for_quantized_model gives them kQuantizedClipMargin.
   float clip_margin = 0.0f;
 };
 inline constexpr float kQuantizedClipMargin = 0.1f;
+
+// `options` for the leaves of a quantized model (.ptl v2, .qs): at least kQuantizedClipMargin.
+inline FeatureOptions for_quantized_model(FeatureOptions options) {
+  if (options.clip_margin < kQuantizedClipMargin) options.clip_margin = kQuantizedClipMargin;
+  return options;
+}
 
 // Throws OptionError naming the field when a value is out of range.
 void validate_feature_options(const FeatureOptions& options);
