@@ -10,8 +10,9 @@ namespace pointillist::ptl2 {
 namespace {
 
 constexpr char kSectionMagic[4] = {'P', 'T', 'L', 'F'};
-constexpr std::uint32_t kSectionVersion = 1;
+constexpr std::uint32_t kSectionVersion = 2;  // 1: the leaves in node order (still read)
 constexpr std::size_t kStatsCount = 13;
+constexpr std::size_t kBlockEntry = 16;  // u64 offset, u32 clipped nodes, u32 planes
 constexpr std::size_t kFixedBytes = 32 + 8 * kStatsCount + 8 * kMaxClipPlanes;
 
 std::uint64_t* stat_fields(FeatureStats& s, std::size_t k) {
@@ -66,6 +67,10 @@ class Reader {
     return v;
   }
   float f32() { return std::bit_cast<float>(u32()); }
+  void seek(std::uint64_t pos) {
+    if (pos > size_) fail("a position past the section's end");
+    pos_ = pos;
+  }
   std::uint64_t left() const { return size_ - pos_; }
   const std::uint8_t* here() const { return b_ + pos_; }
 
@@ -77,9 +82,9 @@ class Reader {
 
 }  // namespace
 
-std::vector<std::uint8_t> encode_features(std::span<const SphereNode> nodes,
-                                          const TreeFeatures& f) {
-  Writer w;
+namespace {
+
+void write_fixed(Writer& w, const TreeFeatures& f, std::uint64_t leaves) {
   for (char c : kSectionMagic) w.u8(static_cast<std::uint8_t>(c));
   w.u32(kSectionVersion);
   w.f32(f.options.sharp_threshold);
@@ -89,52 +94,93 @@ std::vector<std::uint8_t> encode_features(std::span<const SphereNode> nodes,
   w.u8(0);
   w.u8(0);
   w.u32(f.surface_count);
-  std::uint64_t leaves = 0;
-  for (const SphereNode& n : nodes) leaves += n.child_count == 0;
   w.u64(leaves);
   FeatureStats stats = f.stats;
   for (std::size_t k = 0; k < kStatsCount; ++k) w.u64(*stat_fields(stats, k));
   for (int k = 1; k <= kMaxClipPlanes; ++k) w.u64(stats.plane_histogram[k]);
-  // Surface ids of the leaves in node order, as runs (a surface's leaves are mostly together).
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> runs;
-  for (std::size_t k = 0; k < nodes.size(); ++k) {
-    if (nodes[k].child_count != 0) continue;
-    if (!runs.empty() && runs.back().first == f.surface[k]) {
-      ++runs.back().second;
-    } else {
-      runs.push_back({f.surface[k], 1});
+}
+
+// A clip code and its planes, after a record or leaf index.
+void write_planes(Writer& w, const TreeFeatures& f, std::size_t node) {
+  const auto planes = f.planes(node);
+  w.u8(static_cast<std::uint8_t>(planes.size() | static_cast<unsigned>(f.clip_mode[node]) << 5));
+  for (const ClipPlane& p : planes) w.f32(p.n.x), w.f32(p.n.y), w.f32(p.n.z), w.f32(p.h);
+}
+
+// A clip code at section byte `field` and its planes; appends the planes to `planes`.
+ClipMode read_planes(Reader& r, std::uint64_t field, std::vector<ClipPlane>& planes) {
+  const std::uint8_t code = r.u8();
+  const std::uint32_t count = code & 31u, mode = code >> 5;
+  if (count == 0 || count > kMaxClipPlanes || mode == 0 || mode > 3) {
+    r.fail_at(field, "clip code " + std::to_string(code) + " (1 to 16 planes, mode 1 to 3)");
+  }
+  r.need(16ull * count, "clip planes");
+  for (std::uint32_t p = 0; p < count; ++p) {
+    ClipPlane plane;
+    plane.n = {r.f32(), r.f32(), r.f32()};
+    plane.h = r.f32();
+    if (!is_finite(plane.n) || !std::isfinite(plane.h)) r.fail("a clip plane is not finite");
+    planes.push_back(plane);
+  }
+  return static_cast<ClipMode>(mode);
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> encode_features(std::span<const SphereNode> nodes,
+                                          const TreeFeatures& f,
+                                          std::span<const std::span<const std::uint32_t>> pages) {
+  Writer w;
+  std::uint64_t leaves = 0;
+  for (const SphereNode& n : nodes) leaves += n.child_count == 0;
+  write_fixed(w, f, leaves);
+  w.u64(pages.size());
+  // The block table: (offset, clipped nodes, planes) per page, then (end, 0, 0).
+  const std::size_t table = w.out.size();
+  for (std::size_t p = 0; p <= pages.size(); ++p) w.u64(0), w.u32(0), w.u32(0);
+  for (std::size_t p = 0; p < pages.size(); ++p) {
+    const std::span<const std::uint32_t> page = pages[p];
+    // Surface ids of every node, as runs (a surface's nodes are mostly together).
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> runs;
+    std::uint32_t clipped = 0, planes = 0;
+    for (const std::uint32_t k : page) {
+      if (!runs.empty() && runs.back().first == f.surface[k]) {
+        ++runs.back().second;
+      } else {
+        runs.push_back({f.surface[k], 1});
+      }
+      clipped += !f.planes(k).empty();
+      planes += static_cast<std::uint32_t>(f.planes(k).size());
+    }
+    store_u64(&w.out[table + kBlockEntry * p], w.out.size());
+    store_u32(&w.out[table + kBlockEntry * p + 8], clipped);
+    store_u32(&w.out[table + kBlockEntry * p + 12], planes);
+    w.u32(static_cast<std::uint32_t>(runs.size()));
+    for (const auto& [id, length] : runs) w.u32(id), w.u32(length);
+    w.u32(clipped);
+    for (std::size_t j = 0; j < page.size(); ++j) {
+      if (f.planes(page[j]).empty()) continue;
+      w.u32(static_cast<std::uint32_t>(j));
+      write_planes(w, f, page[j]);
     }
   }
-  w.u64(runs.size());
-  for (const auto& [id, length] : runs) w.u32(id), w.u32(length);
-  // Clipped leaves: leaf index, clip code, planes.
-  std::uint64_t clipped = 0;
-  for (std::size_t k = 0; k < nodes.size(); ++k) clipped += nodes[k].child_count == 0 && !f.planes(k).empty();
-  w.u64(clipped);
-  std::uint32_t leaf = 0;
-  for (std::size_t k = 0; k < nodes.size(); ++k) {
-    if (nodes[k].child_count != 0) continue;
-    const auto planes = f.planes(k);
-    if (!planes.empty()) {
-      w.u32(leaf);
-      w.u8(static_cast<std::uint8_t>(planes.size() | static_cast<unsigned>(f.clip_mode[k]) << 5));
-      for (const ClipPlane& p : planes) w.f32(p.n.x), w.f32(p.n.y), w.f32(p.n.z), w.f32(p.h);
-    }
-    ++leaf;
-  }
+  store_u64(&w.out[table + kBlockEntry * pages.size()], w.out.size());
   return std::move(w.out);
 }
 
-FeatureData decode_features(std::string_view bytes, std::uint64_t at, std::uint64_t leaf_count,
-                            const std::string& path) {
+FeatureSection decode_feature_header(std::string_view bytes, std::uint64_t at,
+                                     std::uint64_t leaf_count, std::uint32_t page_count,
+                                     const std::string& path) {
   Reader r(bytes, at, path);
   r.need(kFixedBytes, "its fixed fields");
   if (std::memcmp(r.here(), kSectionMagic, 4) != 0) r.fail("no 'PTLF' signature");
   for (int k = 0; k < 4; ++k) r.u8();
-  if (const std::uint32_t v = r.u32(); v != kSectionVersion) {
-    r.fail("section version " + std::to_string(v) + " (this Pointillist reads 1; upgrade it)");
+  FeatureSection out;
+  out.version = r.u32();
+  if (out.version != 1 && out.version != kSectionVersion) {
+    r.fail("section version " + std::to_string(out.version) +
+           " (this Pointillist reads 1 and 2; upgrade it)");
   }
-  FeatureData out;
   out.options.sharp_threshold = r.f32();
   out.options.radius_scale = r.f32();
   const std::uint8_t edge = r.u8(), rule = r.u8();
@@ -147,14 +193,57 @@ FeatureData decode_features(std::string_view bytes, std::uint64_t at, std::uint6
       !(out.options.radius_scale >= 1 && out.options.radius_scale <= 2)) {
     r.fail("threshold or radius scale out of range");
   }
-  const std::uint32_t surfaces = r.u32();
+  out.surfaces = r.u32();
   if (const std::uint64_t leaves = r.u64(); leaves != leaf_count) {
     r.fail("it describes " + std::to_string(leaves) + " leaves, the model has " +
            std::to_string(leaf_count));
   }
   for (std::size_t k = 0; k < kStatsCount; ++k) *stat_fields(out.stats, k) = r.u64();
   for (int k = 1; k <= kMaxClipPlanes; ++k) out.stats.plane_histogram[k] = r.u64();
-  if (out.stats.segments != surfaces) r.fail("surface count and statistics disagree");
+  if (out.stats.segments != out.surfaces) r.fail("surface count and statistics disagree");
+  if (out.version == 1) {
+    out.body = r.pos();
+    return out;
+  }
+  const std::uint64_t field = r.pos();
+  if (const std::uint64_t pages = r.u64(); pages != page_count) {
+    r.fail_at(field, "it describes " + std::to_string(pages) + " pages, the model has " +
+                         std::to_string(page_count));
+  }
+  if (std::uint64_t{page_count} + 1 > r.left() / kBlockEntry) r.fail("the block table does not fit");
+  out.blocks.resize(std::size_t{page_count} + 1);
+  out.clipped.resize(page_count);
+  out.planes.resize(page_count);
+  const std::uint64_t table_end = r.pos() + kBlockEntry * out.blocks.size();
+  for (std::size_t p = 0; p < out.blocks.size(); ++p) {
+    const std::uint64_t entry = r.pos();
+    out.blocks[p] = r.u64();
+    const std::uint32_t clipped = r.u32(), planes = r.u32();
+    if (p < page_count) {
+      out.clipped[p] = clipped;
+      out.planes[p] = planes;
+    }
+    const std::uint64_t low = p == 0 ? table_end : out.blocks[p - 1];
+    if (out.blocks[p] < low || out.blocks[p] > bytes.size() ||
+        (p == 0 && out.blocks[p] != table_end) ||
+        (p + 1 == out.blocks.size() && out.blocks[p] != bytes.size())) {
+      r.fail_at(entry, "the block of page " + std::to_string(p) + " starts at section byte " +
+                           std::to_string(out.blocks[p]) +
+                           ", not after the previous one and inside the section");
+    }
+  }
+  return out;
+}
+
+FeatureData decode_leaf_features(std::string_view bytes, std::uint64_t at,
+                                 const FeatureSection& section, std::uint64_t leaf_count,
+                                 const std::string& path) {
+  Reader r(bytes, at, path);
+  r.seek(section.body);
+  FeatureData out;
+  out.options = section.options;
+  out.stats = section.stats;
+  const std::uint32_t surfaces = section.surfaces;
   const std::uint64_t runs = r.u64();
   if (runs > r.left() / 8 || runs > leaf_count) r.fail(std::to_string(runs) + " runs of surface ids do not fit");
   out.surface_id.reserve(leaf_count);
@@ -184,24 +273,84 @@ FeatureData decode_features(std::string_view bytes, std::uint64_t at, std::uint6
       r.fail_at(field, "clipped leaf " + std::to_string(leaf) + " out of order or range");
     }
     next = std::uint64_t{leaf} + 1;
-    const std::uint8_t code = r.u8();
-    const std::uint32_t count = code & 31u, mode = code >> 5;
-    if (count == 0 || count > kMaxClipPlanes || mode == 0 || mode > 3) {
-      r.fail_at(field + 4, "clip code " + std::to_string(code) + " (1 to 16 planes, mode 1 to 3)");
-    }
-    r.need(16ull * count, "clip planes");
-    out.clip_mode[leaf] = static_cast<ClipMode>(mode);
-    counts[leaf] = count;
-    for (std::uint32_t p = 0; p < count; ++p) {
-      ClipPlane plane;
-      plane.n = {r.f32(), r.f32(), r.f32()};
-      plane.h = r.f32();
-      if (!is_finite(plane.n) || !std::isfinite(plane.h)) r.fail("a clip plane is not finite");
-      out.clip_planes.push_back(plane);
-    }
+    const std::size_t before = out.clip_planes.size();
+    out.clip_mode[leaf] = read_planes(r, field + 4, out.clip_planes);
+    counts[leaf] = static_cast<std::uint32_t>(out.clip_planes.size() - before);
   }
   for (std::uint64_t i = 0; i < leaf_count; ++i) out.clip_offset[i + 1] = out.clip_offset[i] + counts[i];
   return out;
+}
+
+void decode_page_features(std::string_view bytes, std::uint64_t at,
+                          const FeatureSection& section, std::uint32_t page,
+                          std::uint32_t node_count,
+                          const std::function<bool(std::uint32_t)>& is_leaf,
+                          const std::string& path, PageFeatures& out) {
+  out.clear();
+  const std::uint64_t begin = section.blocks.at(page), end = section.blocks.at(page + 1);
+  Reader r(bytes.substr(0, end), at, path);
+  r.seek(begin);
+  const std::string where = "page " + std::to_string(page) + ": ";
+  const std::uint32_t runs = r.u32();
+  if (runs > r.left() / 8 || runs > node_count) {
+    r.fail(where + std::to_string(runs) + " runs of surface ids do not fit");
+  }
+  out.surface.reserve(node_count);
+  for (std::uint32_t k = 0; k < runs; ++k) {
+    const std::uint64_t field = r.pos();
+    const std::uint32_t id = r.u32(), length = r.u32();
+    if (length == 0 || length > node_count - out.surface.size()) {
+      r.fail_at(field + 4, where + "a run of surface ids overruns the page's " +
+                               std::to_string(node_count) + " nodes");
+    }
+    const auto first = static_cast<std::uint32_t>(out.surface.size());
+    if (id >= section.surfaces) {
+      for (std::uint32_t j = first; j < first + length && id == kMixedSurface; ++j) {
+        if (is_leaf(j)) {
+          r.fail_at(field, where + "leaf " + std::to_string(j) + " has no surface id");
+        }
+      }
+      if (id != kMixedSurface) {
+        r.fail_at(field, where + "surface id " + std::to_string(id) + " (the model has " +
+                             std::to_string(section.surfaces) + " surfaces)");
+      }
+    }
+    out.surface.insert(out.surface.end(), length, id);
+  }
+  if (out.surface.size() != node_count) {
+    r.fail(where + "the surface ids cover " + std::to_string(out.surface.size()) + " of its " +
+           std::to_string(node_count) + " nodes");
+  }
+  const std::uint64_t clipped_field = r.pos();
+  const std::uint32_t clipped = r.u32();
+  if (clipped > node_count || clipped > r.left() / 21) {
+    r.fail(where + std::to_string(clipped) + " clipped nodes do not fit");
+  }
+  if (clipped != section.clipped[page]) {
+    r.fail_at(clipped_field, where + std::to_string(clipped) + " clipped nodes, the block table "
+                             "says " + std::to_string(section.clipped[page]));
+  }
+  out.clipped.reserve(clipped);
+  out.clipped_mode.reserve(clipped);
+  out.clipped_first.reserve(std::size_t{clipped} + 1);
+  out.clipped_first.push_back(0);
+  for (std::uint32_t k = 0; k < clipped; ++k) {
+    const std::uint64_t field = r.pos();
+    const std::uint32_t node = r.u32();
+    if ((!out.clipped.empty() && node <= out.clipped.back()) || node >= node_count ||
+        !is_leaf(node)) {
+      r.fail_at(field, where + "clipped node " + std::to_string(node) +
+                           " is out of order, out of range or not a leaf");
+    }
+    out.clipped.push_back(node);
+    out.clipped_mode.push_back(read_planes(r, field + 4, out.planes));
+    out.clipped_first.push_back(static_cast<std::uint32_t>(out.planes.size()));
+  }
+  if (out.planes.size() != section.planes[page]) {
+    r.fail(where + std::to_string(out.planes.size()) + " clip planes, the block table says " +
+           std::to_string(section.planes[page]));
+  }
+  if (r.left() != 0) r.fail(where + std::to_string(r.left()) + " bytes after the block's end");
 }
 
 }  // namespace pointillist::ptl2

@@ -14,8 +14,10 @@ std::string str(std::uint64_t v) { return std::to_string(v); }
 
 class PtlV2Pages final : public PageSource {
  public:
-  explicit PtlV2Pages(const PtlV2File& file)
-      : file_(file), children_(file.page_count()), link_count_(file.page_count(), 0) {
+  PtlV2Pages(const PtlV2File& file, bool with_features)
+      : file_(file), children_(file.page_count()), link_count_(file.page_count(), 0),
+        features_(with_features && file.page_features_stored() ? file.feature_summary()
+                                                               : nullptr) {
     for (std::uint32_t q = 1; q < file.page_count(); ++q) {
       const PtlV2PageInfo& info = file.page_info(q);
       children_[info.parent_page].push_back(q);
@@ -44,9 +46,11 @@ class PtlV2Pages final : public PageSource {
     return file_.page_info(page).node_count;
   }
   std::uint64_t page_memory_bytes(std::uint32_t page) const override {
-    return PackedPage::memory_bytes(file_.page_info(page).node_count, link_count_[page],
-                                    file_.has_colors());
+    const std::uint32_t nodes = file_.page_info(page).node_count;
+    return PackedPage::memory_bytes(nodes, link_count_[page], file_.has_colors()) +
+           (features_ ? file_.page_feature_memory(page) : 0);
   }
+  const TreeFeatures* features() const override { return features_; }
   std::uint64_t open_bytes() const override { return open_bytes_; }
   SphereTreeView summary() const override { return summary_; }
 
@@ -90,6 +94,14 @@ class PtlV2Pages final : public PageSource {
         corrupt(i, "has children but no page holds them");
       }
     }
+    if (features_) {
+      file_.page_features(
+          page,
+          [&](std::uint32_t k) { return quant::record_child_count(packed.records[k]) == 0; },
+          out.features);
+    } else {
+      out.features.clear();
+    }
   }
 
  private:
@@ -98,12 +110,13 @@ class PtlV2Pages final : public PageSource {
   std::vector<std::uint64_t> link_count_;             // roots of each page's child pages
   std::uint64_t open_bytes_ = 0;
   SphereTreeView summary_;
+  const TreeFeatures* features_;  // the file's, when its pages carry them and they are wanted
 };
 
 }  // namespace
 
-std::unique_ptr<PageSource> ptl_v2_page_source(const PtlV2File& file) {
-  return std::make_unique<PtlV2Pages>(file);
+std::unique_ptr<PageSource> ptl_v2_page_source(const PtlV2File& file, bool with_features) {
+  return std::make_unique<PtlV2Pages>(file, with_features);
 }
 
 }  // namespace pointillist

@@ -5,6 +5,7 @@
 #include <cassert>
 #include <cmath>
 #include <cstring>
+#include <mutex>
 #include <string>
 #include <utility>
 #include <vector>
@@ -23,6 +24,10 @@ namespace pointillist {
 
 struct PtlV2File::Mapping {
   FileBytes bytes;
+  // The features section's fixed fields, read on first use.
+  std::once_flag features_once;
+  ptl2::FeatureSection features;
+  TreeFeatures summary;  // surface count, options, statistics
 };
 
 namespace {
@@ -44,7 +49,8 @@ bool finite_sphere(const Sphere& s) {
 std::unique_ptr<PtlV2File> PtlV2File::open(const std::string& path) {
   std::unique_ptr<PtlV2File> file(new PtlV2File);
   file->path_ = path;
-  file->map_ = std::make_unique<Mapping>(Mapping{FileBytes::map(path)});
+  file->map_ = std::make_unique<Mapping>();
+  file->map_->bytes = FileBytes::map(path);
   const std::string_view view = file->map_->bytes.view();
   const auto* b = reinterpret_cast<const std::uint8_t*>(view.data());
   const std::uint64_t size = view.size();
@@ -258,11 +264,71 @@ std::unique_ptr<PtlV2File> PtlV2File::open(const std::string& path) {
 
 PtlV2File::~PtlV2File() = default;
 
+const ptl2::FeatureSection& PtlV2File::feature_section() const {
+  std::call_once(map_->features_once, [&] {
+    const std::string_view view = map_->bytes.view();
+    map_->features = decode_feature_header(view.substr(features_offset_, features_size_),
+                                           features_offset_, leaf_count_, page_count(), path_);
+    map_->summary.surface_count = map_->features.surfaces;
+    map_->summary.options = map_->features.options;
+    map_->summary.stats = map_->features.stats;
+  });
+  return map_->features;
+}
+
+const TreeFeatures* PtlV2File::feature_summary() const {
+  if (features_size_ == 0) return nullptr;
+  feature_section();
+  return &map_->summary;
+}
+
+bool PtlV2File::page_features_stored() const {
+  return features_size_ != 0 && feature_section().version >= 2;
+}
+
+void PtlV2File::page_features(std::uint32_t page, const std::function<bool(std::uint32_t)>& is_leaf,
+                              PageFeatures& out) const {
+  const ptl2::FeatureSection& section = feature_section();
+  if (section.version < 2) {
+    throw FormatError(path_ + ": its sharp features are stored for the whole model (a file of an "
+                      "earlier Pointillist), not per page; convert it again to draw them page by "
+                      "page");
+  }
+  const std::string_view view = map_->bytes.view();
+  decode_page_features(view.substr(features_offset_, features_size_), features_offset_, section,
+                       page, pages_.at(page).node_count, is_leaf, path_, out);
+}
+
+std::uint64_t PtlV2File::page_feature_memory(std::uint32_t page) const {
+  if (!page_features_stored()) return 0;
+  const ptl2::FeatureSection& f = feature_section();
+  return PageFeatures::memory_bytes(pages_.at(page).node_count, f.clipped.at(page),
+                                    f.planes.at(page));
+}
+
 std::optional<FeatureData> PtlV2File::features() const {
   if (features_size_ == 0) return std::nullopt;
-  const std::string_view view = map_->bytes.view();
-  return decode_features(view.substr(features_offset_, features_size_), features_offset_,
-                         leaf_count_, path_);
+  const ptl2::FeatureSection& section = feature_section();
+  if (section.version == 1) {
+    const std::string_view view = map_->bytes.view();
+    return decode_leaf_features(view.substr(features_offset_, features_size_), features_offset_,
+                                section, leaf_count_, path_);
+  }
+  TreeFeatures tree;
+  const SphereTree whole = decode_all(&tree);
+  FeatureData out;
+  out.options = tree.options;
+  out.stats = tree.stats;
+  out.clip_offset.push_back(0);
+  for (std::size_t k = 0; k < whole.nodes.size(); ++k) {
+    if (whole.nodes[k].child_count != 0) continue;
+    out.surface_id.push_back(tree.surface[k]);
+    out.clip_mode.push_back(tree.clip_mode[k]);
+    const auto planes = tree.planes(k);
+    out.clip_planes.insert(out.clip_planes.end(), planes.begin(), planes.end());
+    out.clip_offset.push_back(static_cast<std::uint32_t>(out.clip_planes.size()));
+  }
+  return out;
 }
 
 template <class OnRecord>
@@ -431,7 +497,7 @@ void PtlV2File::pack_page(std::uint32_t page, PackedPage& out) const {
   }
 }
 
-SphereTree PtlV2File::decode_all() const {
+SphereTree PtlV2File::decode_all(TreeFeatures* features) const {
   const std::uint32_t page_count = this->page_count();
   std::vector<PtlV2Page> pages(page_count);
   for (std::uint32_t p = 0; p < page_count; ++p) decode_page(p, pages[p]);
@@ -545,6 +611,35 @@ SphereTree PtlV2File::decode_all() const {
   tree.view_sphere = view_sphere_;
   tree.origin = origin_;
   tree.up = up_;
+  if (features && features_size_ != 0) {
+    const ptl2::FeatureSection& section = feature_section();
+    if (section.version == 1) {
+      *features = tree_features(tree.nodes, *this->features());
+    } else {
+      // Each page's block, then every node's features from its page and record.
+      std::vector<PageFeatures> blocks(page_count);
+      for (std::uint32_t p = 0; p < page_count; ++p) {
+        const PtlV2Page& pg = pages[p];
+        page_features(
+            p, [&](std::uint32_t k) { return pg.nodes[k].child_count == 0; }, blocks[p]);
+      }
+      TreeFeatures& f = *features;
+      f = {};
+      f.surface_count = section.surfaces;
+      f.options = section.options;
+      f.stats = section.stats;
+      f.surface.resize(tree.nodes.size());
+      f.clip_mode.resize(tree.nodes.size());
+      f.clip_offset.assign(tree.nodes.size() + 1, 0);
+      for (std::size_t i = 0; i < tree.nodes.size(); ++i) {
+        const Ref ref = refs[i];
+        f.surface[i] = blocks[ref.page].surface[ref.record];
+        const auto planes = blocks[ref.page].planes_of(ref.record, f.clip_mode[i]);
+        f.clip_planes.insert(f.clip_planes.end(), planes.begin(), planes.end());
+        f.clip_offset[i + 1] = static_cast<std::uint32_t>(f.clip_planes.size());
+      }
+    }
+  }
   return tree;
 }
 

@@ -353,8 +353,12 @@ PtlV2WriteReport write_ptl_v2(const std::string& path, const SphereTree& tree,
     page_offset += pages[p].byte_size;
   }
   const std::uint64_t metadata_offset = page_offset;
-  const std::vector<std::uint8_t> feature_bytes =
-      options.features ? encode_features(nodes, *options.features) : std::vector<std::uint8_t>{};
+  std::vector<std::uint8_t> feature_bytes;
+  if (options.features) {
+    std::vector<std::span<const std::uint32_t>> page_nodes;
+    for (const PagePlan& pg : pages) page_nodes.emplace_back(pg.nodes);
+    feature_bytes = encode_features(nodes, *options.features, page_nodes);
+  }
 
   std::uint8_t* h = head.data();
   std::memcpy(h, ptl::kMagic, sizeof ptl::kMagic);

@@ -1,5 +1,6 @@
 // An in-memory hierarchy cut into pages (paginate): the page layout of paged model files, for
 // tests and for models held in memory.
+#include <algorithm>
 #include <cassert>
 #include <memory>
 #include <string>
@@ -7,6 +8,7 @@
 
 #include "pointillist/core/error.hpp"
 #include "pointillist/lod/pages.hpp"
+#include "pointillist/lod/tree_features.hpp"
 
 namespace pointillist {
 namespace {
@@ -18,6 +20,13 @@ class InMemoryPages final : public PageSource {
   InMemoryPages(const SphereTreeView& tree, std::uint64_t page_bytes, std::uint32_t max_levels) {
     summary_ = tree;
     summary_.nodes = {};
+    summary_.features = nullptr;
+    has_features_ = tree.features != nullptr;
+    if (tree.features) {
+      features_.surface_count = tree.features->surface_count;
+      features_.options = tree.features->options;
+      features_.stats = tree.features->stats;
+    }
     if (tree.nodes.empty()) return;
     // Global indices of each page's nodes, in page order, and of the anchors of new pages.
     struct Pending {
@@ -57,6 +66,7 @@ class InMemoryPages final : public PageSource {
         page.nodes.push_back(n);
         page.child_page.push_back(child_page);
       }
+      if (tree.features) add_features(*tree.features, global, page.features);
       pages_.push_back(std::move(page));
     }
   }
@@ -69,7 +79,12 @@ class InMemoryPages final : public PageSource {
     return static_cast<std::uint32_t>(pages_.at(page).nodes.size());
   }
   std::uint64_t page_memory_bytes(std::uint32_t page) const override {
-    return HierarchyPage::memory_bytes(pages_.at(page).nodes.size());
+    const HierarchyPage& p = pages_.at(page);
+    return HierarchyPage::memory_bytes(p.nodes.size()) +
+           (p.features.empty() ? 0 : p.features.memory_bytes());
+  }
+  const TreeFeatures* features() const override {
+    return has_features_ ? &features_ : nullptr;
   }
   std::uint64_t open_bytes() const override { return 0; }
   SphereTreeView summary() const override { return summary_; }
@@ -78,11 +93,48 @@ class InMemoryPages final : public PageSource {
   }
 
  private:
+  // The features of the nodes `global` (tree indices, in page order).
+  static void add_features(const TreeFeatures& f, const std::vector<std::uint32_t>& global,
+                           PageFeatures& out) {
+    for (std::size_t k = 0; k < global.size(); ++k) {
+      const std::uint32_t g = global[k];
+      out.surface.push_back(f.surface[g]);
+      const auto planes = f.planes(g);
+      if (planes.empty()) continue;
+      if (out.clipped.empty()) out.clipped_first.push_back(0);
+      out.clipped.push_back(static_cast<std::uint32_t>(k));
+      out.clipped_mode.push_back(f.clip_mode[g]);
+      out.planes.insert(out.planes.end(), planes.begin(), planes.end());
+      out.clipped_first.push_back(static_cast<std::uint32_t>(out.planes.size()));
+    }
+  }
+
   SphereTreeView summary_;
   std::vector<HierarchyPage> pages_;
+  TreeFeatures features_;  // counts, options and statistics only
+  bool has_features_ = false;
 };
 
 }  // namespace
+
+void PageFeatures::clear() {
+  surface.clear();
+  clipped.clear();
+  clipped_mode.clear();
+  clipped_first.clear();
+  planes.clear();
+}
+
+std::span<const ClipPlane> PageFeatures::planes_of(std::uint32_t node, ClipMode& mode) const {
+  const auto it = std::lower_bound(clipped.begin(), clipped.end(), node);
+  if (it == clipped.end() || *it != node) {
+    mode = ClipMode::None;
+    return {};
+  }
+  const std::size_t k = static_cast<std::size_t>(it - clipped.begin());
+  mode = clipped_mode[k];
+  return {planes.data() + clipped_first[k], planes.data() + clipped_first[k + 1]};
+}
 
 void PackedPage::index_links(std::uint32_t first_level_count) {
   const auto count = static_cast<std::uint32_t>(records.size());

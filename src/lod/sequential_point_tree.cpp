@@ -350,8 +350,9 @@ constexpr std::uint32_t range_of(const ListKey& k) {
   return static_cast<std::uint32_t>(k.major >> 32);
 }
 
-void fill_list(const std::vector<BuildNode>& nodes, std::uint32_t chunk_level, bool has_colors,
-               ThreadPool& pool, SequentialPointTree& tree) {
+void fill_list(const std::vector<BuildNode>& nodes, std::span<const MortonKey> order,
+               std::uint32_t chunk_level, bool has_colors, ThreadPool& pool,
+               SequentialPointTree& tree) {
   const std::size_t count = nodes.size();
   const auto is_top = [&](const BuildNode& nd) { return !nd.leaf && nd.level < chunk_level; };
   // Chunk roots: not top, parent top (or none); disjoint ranges, so sorting by begin gives the
@@ -394,6 +395,7 @@ void fill_list(const std::vector<BuildNode>& nodes, std::uint32_t chunk_level, b
   }
   tree.is_leaf.resize(count);
   tree.parent.resize(count);
+  tree.source.resize(count);
   if (has_colors) tree.colors.resize(count);
   parallel_for(pool, count, kPointGrain, [&](std::size_t first, std::size_t last) {
     for (std::size_t i = first; i < last; ++i) {
@@ -408,6 +410,7 @@ void fill_list(const std::vector<BuildNode>& nodes, std::uint32_t chunk_level, b
       tree.error[i] = nd.error;
       tree.parent_error[i] = nd.parent == kSptNoParent ? kInf : nodes[nd.parent].error;
       tree.is_leaf[i] = nd.leaf ? 1 : 0;
+      tree.source[i] = nd.leaf ? order[nd.begin].index : kSptNoParent;
       tree.parent[i] = nd.parent == kSptNoParent ? kSptNoParent : position[nd.parent];
       if (has_colors) {
         const auto byte = [](float c) {
@@ -541,15 +544,16 @@ SequentialPointTree build_sequential_point_tree(const PointSet& points, ThreadPo
                       lod_detail::max_distance(points.positions, tree.bounds.center(), pool)};
 
   std::vector<BuildNode> nodes;
+  std::vector<MortonKey> keys;
   {
     ProgressPhase phase(progress, "hierarchy", points.size());
-    const std::vector<MortonKey> keys = morton_keys(points.positions, tree.bounds, pool);
+    keys = morton_keys(points.positions, tree.bounds, pool);
     const std::vector<SortedSplat> splats = gather_splats(points, keys, pool);
     const NodeMaker maker{keys, splats, tree.has_colors, options.color_tolerance};
     nodes = build_nodes(maker, options.parallel_grain_points, pool, phase);
   }
   ProgressPhase phase(progress, "sequential list", nodes.size());
-  fill_list(nodes, options.chunk_level, tree.has_colors, pool, tree);
+  fill_list(nodes, keys, options.chunk_level, tree.has_colors, pool, tree);
   phase.advance(nodes.size());
   return tree;
 }

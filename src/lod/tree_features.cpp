@@ -45,6 +45,61 @@ TreeFeatures tree_features(std::span<const SphereNode> nodes, const FeatureData&
   return out;
 }
 
+TreeFeatures spt_features(const SequentialPointTree& spt, std::span<const SphereNode> nodes,
+                          const TreeFeatures& features) {
+  std::vector<std::uint32_t> leaf_node;  // sphere-tree node of each leaf, in node order
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    if (nodes[k].child_count == 0) leaf_node.push_back(static_cast<std::uint32_t>(k));
+  }
+  const std::size_t count = spt.node_count();
+  if (spt.source.size() != count || spt.parent.size() != count ||
+      spt.leaf_count != leaf_node.size()) {
+    throw Error("sharp features: the sequential point tree of " + std::to_string(spt.leaf_count) +
+                " splats was not built from this tree's " + std::to_string(leaf_node.size()) +
+                " leaves");
+  }
+  TreeFeatures out;
+  out.options = features.options;
+  out.stats = features.stats;
+  out.surface_count = features.surface_count;
+  out.surface.assign(count, kMixedSurface);
+  out.clip_mode.assign(count, ClipMode::None);
+  out.clip_offset.assign(count + 1, 0);
+  // Ids: leaves first; then children come after their parent in the list, so a backward sweep
+  // has folded every child into its parent before the parent passes its id on. `kUnset` marks
+  // an interior entry no child has reached yet.
+  constexpr std::uint32_t kUnset = kMixedSurface - 1;
+  for (std::size_t i = 0; i < count; ++i) {
+    if (spt.is_leaf[i]) {
+      const std::uint32_t s = spt.source[i];
+      if (s >= leaf_node.size()) {
+        throw Error("sharp features: SPT entry " + std::to_string(i) + " names splat " +
+                    std::to_string(s) + " of " + std::to_string(leaf_node.size()));
+      }
+      const std::uint32_t node = leaf_node[s];
+      out.surface[i] = features.surface[node];
+      out.clip_mode[i] = features.clip_mode[node];
+    } else {
+      out.surface[i] = kUnset;
+    }
+  }
+  for (std::size_t i = count; i-- > 0;) {
+    const std::uint32_t p = spt.parent[i];
+    if (p == kSptNoParent) continue;
+    std::uint32_t& id = out.surface[p];
+    id = id == kUnset ? out.surface[i] : (id == out.surface[i] ? id : kMixedSurface);
+  }
+  for (std::size_t i = 0; i < count; ++i) {
+    if (out.surface[i] == kUnset) out.surface[i] = kMixedSurface;
+    if (spt.is_leaf[i]) {
+      const auto planes = features.planes(leaf_node[spt.source[i]]);
+      out.clip_planes.insert(out.clip_planes.end(), planes.begin(), planes.end());
+    }
+    out.clip_offset[i + 1] = static_cast<std::uint32_t>(out.clip_planes.size());
+  }
+  return out;
+}
+
 TreeFeatures compute_tree_features(const SphereTreeView& tree, ThreadPool& pool,
                                    const FeatureOptions& options, Progress& progress) {
   const PointSet leaves = sphere_tree_leaves(tree);

@@ -71,9 +71,11 @@ Model Model::open_file(const std::string& path, const OpenModelOptions& options,
           model.paging_reason_ = "paged: the decoded hierarchy would take " +
                                  megabytes(decoded_bytes) + ", more than a quarter of the memory (" +
                                  megabytes(memory) + ")";
-        } else if (options.stored_features && model.v2_->has_features()) {
+        } else if (options.stored_features && model.v2_->has_features() &&
+                   !model.v2_->page_features_stored()) {
           model.paging_reason_ =
-              "decoded whole: its sharp features are drawn from the whole hierarchy";
+              "decoded whole: its sharp features (stored by an earlier Pointillist for the whole "
+              "model) are drawn from the whole hierarchy";
         } else if (options.frames > 1) {
           model.paging_reason_ =
               "decoded whole: the " + frames + " of a sequence draw from the whole hierarchy "
@@ -88,12 +90,20 @@ Model Model::open_file(const std::string& path, const OpenModelOptions& options,
         break;
       }
     }
+    // The stored features, unless they are not wanted or computed anew (options.features).
+    const bool stored = options.stored_features && !options.features && model.v2_->has_features();
     if (paged) {
-      model.pages_ = ptl_v2_page_source(*model.v2_);
+      model.pages_ = ptl_v2_page_source(*model.v2_, stored);
       model.view_ = model.pages_->summary();
+      if (stored && !model.v2_->page_features_stored()) {
+        model.paging_reason_ += "; its sharp features (stored by an earlier Pointillist for the "
+                                "whole model) are drawn only when it is decoded whole: convert it "
+                                "again to draw them page by page";
+      }
     } else {
       ProgressPhase phase(progress, "decode", 0);
-      model.built_ = model.v2_->decode_all();
+      if (stored) model.features_ = std::make_unique<TreeFeatures>();
+      model.built_ = model.v2_->decode_all(model.features_.get());
       model.view_ = model.built_.view();
     }
     return model;
@@ -148,14 +158,8 @@ Model open_model(const std::string& path, const OpenModelOptions& options, Threa
     model.features_ =
         std::make_unique<TreeFeatures>(compute_tree_features(model.view_, pool, fo, progress));
     model.view_.features = model.features_.get();
-  } else if (model.v2_ && model.v2_->has_features() && options.stored_features) {
-    if (model.paged()) {
-      model.paging_reason_ += "; its sharp features are drawn only when it is decoded whole";
-    } else {
-      model.features_ =
-          std::make_unique<TreeFeatures>(tree_features(model.view_.nodes, *model.v2_->features()));
-      model.view_.features = model.features_.get();
-    }
+  } else if (model.features_) {
+    model.view_.features = model.features_.get();  // stored ones, decoded with the hierarchy
   }
   model.renderable_ = std::make_unique<RenderModel>(
       RenderModel{.tree = model.view_,

@@ -49,6 +49,12 @@ std::uint8_t to_byte(float v) {
   return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
 }
 
+// The sharp features of a model: its hierarchy's, or (paged) what its pages carry.
+const TreeFeatures* model_features(const RenderModel& m) {
+  if (m.tree.features) return m.tree.features;
+  return m.pages ? m.pages->features() : nullptr;
+}
+
 void add(SelectionStats& a, const SelectionStats& b) {
   a.splats += b.splats;
   a.nodes_visited += b.nodes_visited;
@@ -69,6 +75,7 @@ struct Renderer::ModelState {
   const PageSource* pages = nullptr;
   std::optional<PagedRenderer> paged;
   std::optional<SequentialPointTree> spt;
+  std::optional<TreeFeatures> spt_features;  // the model's features on the SPT's entries
   std::uint64_t frame = 0;  // the last frame that drew the model
   std::uint64_t model_bytes = 0;  // storage bytes of a paged model (open + every page)
 };
@@ -102,6 +109,9 @@ Renderer::ModelState& Renderer::state_for(const RenderModel& model, ThreadPool& 
   ModelState* state = slot.get();
   if (fs.lod == LodScheme::Spt && !state->spt) {
     state->spt = build_sequential_point_tree(sphere_tree_leaves(model.tree), pool);
+    if (model.tree.features) {
+      state->spt_features = spt_features(*state->spt, model.tree.nodes, *model.tree.features);
+    }
   }
   return *state;
 }
@@ -168,11 +178,11 @@ SelectionStats Renderer::select(std::span<const SceneInstance> scene, const Came
   bool any_colors = false, any_features = false;
   for (const SceneInstance& inst : scene) {
     any_colors = any_colors || inst.model->tree.has_colors;
-    any_features = any_features || inst.model->tree.features;
+    any_features = any_features || model_features(*inst.model);
   }
-  // Sharp features on the QSplat hierarchy held whole (node ids index the features); the
-  // clip test needs the discs in both rasterizers.
-  const bool features = fs.features && any_features && fs.lod == LodScheme::QSplat;
+  // Sharp features (node ids index the features: the hierarchy's nodes, or the SPT's entries);
+  // the clip test needs the discs in both rasterizers.
+  const bool features = fs.features && any_features;
   if (features) stream.with_discs = true;
   const bool with_discs = stream.with_discs;
   std::uint32_t id_base = 0;
@@ -197,20 +207,33 @@ SelectionStats Renderer::select(std::span<const SceneInstance> scene, const Came
       selected = spt.as_selection();
       spt_stats_ += spt;
     } else if (state.paged) {
-      selected = state.paged->select(cam, settings, pool, into, !first_use);
+      selected = state.paged->select(cam, settings, pool, into, !first_use,
+                                     features && state.pages->features());
     } else {
       select_splats(inst.model->tree, cam, settings, pool, into, selected);
     }
     add(total, selected);
-    if (const TreeFeatures* f = inst.model->tree.features) id_base += f->surface_count;
+    const TreeFeatures* model_f = model_features(*inst.model);
     const bool colors = into.has_colors;
     for (std::size_t c = 0; c < into.chunk_count; ++c) {
       SplatChunk& chunk = into.chunks[c];
       chunk.instance = static_cast<std::uint32_t>(i);
       if (!identity) to_world(inst.transform, chunk, with_discs);
       if (features) {
-        const TreeFeatures* f = state.paged ? nullptr : inst.model->tree.features;
-        render_detail::attach_features(f, identity ? nullptr : &inst.transform, id_base, chunk);
+        const InstanceTransform* t = identity ? nullptr : &inst.transform;
+        if (fs.lod == LodScheme::QSplat && state.paged) {
+          // Filled from the pages during selection (or none: mixed, unclipped).
+          if (state.pages->features()) {
+            render_detail::place_features(t, id_base, chunk);
+          } else {
+            render_detail::attach_features(nullptr, t, id_base, chunk);
+          }
+        } else {
+          const TreeFeatures* f = fs.lod == LodScheme::Spt
+                                      ? (state.spt_features ? &*state.spt_features : nullptr)
+                                      : inst.model->tree.features;
+          render_detail::attach_features(f, t, id_base, chunk);
+        }
       }
       if (any_colors && !colors) {
         // A model without colours beside coloured ones: its base colour, as the others carry.
@@ -220,6 +243,7 @@ SelectionStats Renderer::select(std::span<const SceneInstance> scene, const Came
         std::fill(chunk.color.begin(), chunk.color.begin() + chunk.count, base);
       }
     }
+    if (model_f) id_base += model_f->surface_count;
     if (i > 0) {
       const std::size_t base = stream.chunk_count;
       if (stream.chunks.size() < base + into.chunk_count) {

@@ -3,11 +3,16 @@
 // section fails with the file, the byte and what is wrong.
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <tuple>
 
 #include "pointillist/core/error.hpp"
 #include "pointillist/format/ptl_v2.hpp"
+#include "pointillist/format/ptl_v2_pages.hpp"
+#include "pointillist/lod/pages.hpp"
 #include "pointillist/lod/tree_features.hpp"
 #include "pointillist/prep/radii.hpp"
 #include "pointillist/scene/csg.hpp"
@@ -64,10 +69,87 @@ TEST(PtlV2Features, WhatIsReadIsWhatWasWritten) {
   EXPECT_EQ(read->stats.clipped, f.stats.clipped);
   EXPECT_EQ(read->stats.segments, f.stats.segments);
   EXPECT_EQ(read->options.sharp_threshold, f.options.sharp_threshold);
-  // The per-node form built from it equals the one written.
+  // The per-node form built from it equals the one written, and so does the one decode_all
+  // gathers from the pages' blocks (inner nodes' ids included).
   const TreeFeatures back = tree_features(file->decode_all().nodes, *read);
   EXPECT_EQ(back.surface, f.surface);
   EXPECT_EQ(back.clip_offset, f.clip_offset);
+  TreeFeatures paged;
+  (void)file->decode_all(&paged);
+  EXPECT_EQ(paged.surface, f.surface);
+  EXPECT_EQ(paged.clip_offset, f.clip_offset);
+  EXPECT_EQ(paged.clip_mode, f.clip_mode);
+  EXPECT_EQ(paged.surface_count, f.surface_count);
+  ASSERT_EQ(paged.clip_planes.size(), f.clip_planes.size());
+  for (std::size_t p = 0; p < f.clip_planes.size(); ++p) {
+    EXPECT_EQ(paged.clip_planes[p].n, f.clip_planes[p].n);
+    EXPECT_EQ(paged.clip_planes[p].h, f.clip_planes[p].h);
+  }
+}
+
+TEST(PtlV2Features, EveryPageCarriesItsNodesFeatures) {
+  // Small pages, so the cube spreads over many: each page's block, loaded with the page, holds
+  // the features of exactly the nodes the page holds (matched by decoding the page's nodes
+  // against the tree's: page records in page order are tree nodes, found by their spheres).
+  ThreadPool pool(2);
+  const SphereTree tree = cube_tree(pool);
+  pointillist::testing::TempDir dir;
+  const std::string path = dir.file("cube.ptl");
+  write_ptl_v2(path, tree, "", {.page_bytes = 1024});
+  const SphereTree decoded = PtlV2File::open(path)->decode_all();
+  const TreeFeatures f = compute_tree_features(decoded.view(), pool);
+  write_ptl_v2(path, decoded, "", {.page_bytes = 1024, .features = &f});
+  const auto file = PtlV2File::open(path);
+  ASSERT_TRUE(file->page_features_stored());
+  ASSERT_GT(file->page_count(), 8u);
+  // Tree node by its decoded sphere and normal; the few that two nodes share (an only child
+  // decodes as its parent) are left out.
+  using Key = std::tuple<float, float, float, float, float, float, float>;
+  const auto key = [](const SphereNode& n) {
+    return Key{n.center.x, n.center.y, n.center.z, n.radius, n.normal.x, n.normal.y, n.normal.z};
+  };
+  // (Node k of the file is node k of `decoded`, quantized once more.)
+  const SphereTree stored = file->decode_all();
+  ASSERT_EQ(stored.nodes.size(), decoded.nodes.size());
+  std::map<Key, std::size_t> by_sphere;
+  std::map<Key, int> uses;
+  for (std::size_t k = 0; k < stored.nodes.size(); ++k) {
+    by_sphere[key(stored.nodes[k])] = k;
+    ++uses[key(stored.nodes[k])];
+  }
+  ASSERT_GT(by_sphere.size(), decoded.nodes.size() * 99 / 100);
+  std::size_t matched = 0;
+  const auto source = ptl_v2_page_source(*file);
+  ASSERT_NE(source->features(), nullptr);
+  EXPECT_EQ(source->features()->surface_count, f.surface_count);
+  std::size_t clipped = 0;
+  for (std::uint32_t p = 0; p < file->page_count(); ++p) {
+    PtlV2Page page;
+    file->decode_page(p, page);
+    HierarchyPage loaded;
+    source->load(p, loaded);
+    ASSERT_EQ(loaded.features.surface.size(), page.nodes.size()) << "page " << p;
+    for (std::uint32_t r = 0; r < page.nodes.size(); ++r) {
+      const SphereNode& n = page.nodes[r];
+      if (uses.at(key(n)) != 1) continue;
+      const std::size_t k = by_sphere.at(key(n));
+      ++matched;
+      EXPECT_EQ(loaded.features.surface[r], f.surface[k]) << "page " << p << " record " << r;
+      ClipMode mode;
+      const auto got = loaded.features.planes_of(r, mode);
+      ASSERT_EQ(got.size(), f.planes(k).size()) << "page " << p << " record " << r;
+      EXPECT_EQ(mode, f.clip_mode[k]);
+      clipped += !got.empty();
+    }
+    EXPECT_GE(loaded.memory_bytes(), source->page_memory_bytes(p) / 4);
+    EXPECT_LE(loaded.memory_bytes(), source->page_memory_bytes(p));
+  }
+  EXPECT_GT(matched, decoded.nodes.size() * 98 / 100);
+  EXPECT_GT(clipped, f.stats.clipped * 9 / 10);
+  // Without features wanted, pages carry none.
+  HierarchyPage plain;
+  ptl_v2_page_source(*file, false)->load(0, plain);
+  EXPECT_TRUE(plain.features.empty());
 }
 
 TEST(PtlV2Features, FilesWithoutThemStillLoadAndKeepTheirBytes) {
@@ -86,6 +168,100 @@ TEST(PtlV2Features, FilesWithoutThemStillLoadAndKeepTheirBytes) {
   EXPECT_EQ(b.substr(256, a.size() - 256), a.substr(256));
 }
 
+// The section as Pointillist wrote it before page blocks (version 1, docs/ptl-format.md): the
+// fixed fields, then the leaves' surface ids as runs and the clipped leaves, in node order.
+std::string version1_section(const SphereTree& tree, const TreeFeatures& f) {
+  std::string out;
+  const auto u8 = [&](unsigned v) { out.push_back(static_cast<char>(v)); };
+  const auto u32 = [&](std::uint32_t v) {
+    for (int i = 0; i < 4; ++i) u8((v >> (8 * i)) & 0xff);
+  };
+  const auto u64 = [&](std::uint64_t v) {
+    for (int i = 0; i < 8; ++i) u8((v >> (8 * i)) & 0xff);
+  };
+  const auto f32 = [&](float v) { u32(std::bit_cast<std::uint32_t>(v)); };
+  out = "PTLF";
+  u32(1);
+  f32(f.options.sharp_threshold);
+  f32(f.options.radius_scale);
+  u8(static_cast<unsigned>(f.options.edge_test));
+  u8(static_cast<unsigned>(f.options.clip_rule));
+  u8(0), u8(0);
+  u32(f.surface_count);
+  u64(tree.leaf_count);
+  const FeatureStats& st = f.stats;
+  for (std::uint64_t v : {st.splats, st.edges, st.sharp_edges, st.crossing_edges,
+                          st.antiparallel_edges, st.candidates, st.clipped, st.pass_through,
+                          st.undefined_4_15, st.nearest_rule, st.capped, st.segments,
+                          st.large_segments}) {
+    u64(v);
+  }
+  for (int k = 1; k <= kMaxClipPlanes; ++k) u64(st.plane_histogram[k]);
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> runs;
+  std::vector<std::size_t> clipped;
+  std::uint32_t leaf = 0;
+  for (std::size_t k = 0; k < tree.nodes.size(); ++k) {
+    if (tree.nodes[k].child_count != 0) continue;
+    if (!runs.empty() && runs.back().first == f.surface[k]) {
+      ++runs.back().second;
+    } else {
+      runs.push_back({f.surface[k], 1});
+    }
+    if (!f.planes(k).empty()) clipped.push_back(k);
+    ++leaf;
+  }
+  u64(runs.size());
+  for (const auto& [id, n] : runs) u32(id), u32(n);
+  u64(clipped.size());
+  leaf = 0;
+  for (std::size_t k = 0; k < tree.nodes.size(); ++k) {
+    if (tree.nodes[k].child_count != 0) continue;
+    if (!f.planes(k).empty()) {
+      u32(leaf);
+      u8(static_cast<unsigned>(f.planes(k).size()) | static_cast<unsigned>(f.clip_mode[k]) << 5);
+      for (const ClipPlane& p : f.planes(k)) f32(p.n.x), f32(p.n.y), f32(p.n.z), f32(p.h);
+    }
+    ++leaf;
+  }
+  return out;
+}
+
+TEST(PtlV2Features, FilesOfTheFirstSectionVersionStillLoad) {
+  ThreadPool pool(2);
+  const SphereTree tree = cube_tree(pool);
+  pointillist::testing::TempDir dir;
+  const std::string path = dir.file("cube.ptl");
+  write_ptl_v2(path, tree, "", {.page_bytes = 1024});
+  const SphereTree decoded = PtlV2File::open(path)->decode_all();
+  const TreeFeatures f = compute_tree_features(decoded.view(), pool);
+  write_ptl_v2(path, decoded, "", {.page_bytes = 1024, .features = &f});
+  // Swap the section (the file's last bytes) for a version 1 one, and its size in the header.
+  std::string bytes = read_all(path);
+  std::uint64_t size = 0;
+  for (int i = 0; i < 8; ++i) size |= std::uint64_t(std::uint8_t(bytes[240 + i])) << (8 * i);
+  const SphereTree stored = PtlV2File::open(path)->decode_all();
+  const std::string old = version1_section(stored, f);
+  bytes = bytes.substr(0, bytes.size() - size) + old;
+  for (int i = 0; i < 8; ++i) bytes[240 + i] = static_cast<char>((old.size() >> (8 * i)) & 0xff);
+  write_all(path, bytes);
+
+  const auto file = PtlV2File::open(path);
+  ASSERT_TRUE(file->has_features());
+  EXPECT_FALSE(file->page_features_stored());
+  TreeFeatures back;
+  (void)file->decode_all(&back);
+  EXPECT_EQ(back.surface, f.surface);
+  EXPECT_EQ(back.clip_offset, f.clip_offset);
+  EXPECT_EQ(back.clip_mode, f.clip_mode);
+  EXPECT_EQ(file->features()->surface_id.size(), stored.leaf_count);
+  // Their pages carry none (the renderer then draws the paged model without them).
+  const auto source = ptl_v2_page_source(*file);
+  EXPECT_EQ(source->features(), nullptr);
+  HierarchyPage page;
+  source->load(0, page);
+  EXPECT_TRUE(page.features.empty());
+}
+
 TEST(PtlV2Features, ADamagedSectionNamesTheByte) {
   ThreadPool pool(1);
   const SphereTree tree = cube_tree(pool);
@@ -94,22 +270,51 @@ TEST(PtlV2Features, ADamagedSectionNamesTheByte) {
   const std::string path = dir.file("cube.ptl");
   write_ptl_v2(path, tree, "", {.features = &f});
   const std::string good = read_all(path);
-  // The first run's surface id (section byte 272) set past the surface count.
+  const std::uint32_t pages = PtlV2File::open(path)->page_count();
+  // Page 0's block follows the fixed fields (264 bytes), the page count and the block table
+  // (16 bytes a page, and one more);
+  // its first run's surface id (after the run count) set past the surface count.
   const std::size_t section = good.size() - [&] {
     std::uint64_t size = 0;
     for (int i = 0; i < 8; ++i) size |= std::uint64_t(std::uint8_t(good[240 + i])) << (8 * i);
     return size;
   }();
+  const std::size_t first_id = section + 264 + 8 + 16 * (pages + 1) + 4;
   std::string bad = good;
-  bad[section + 272 + 3] = '\x7f';
+  bad[first_id + 3] = '\x7f';
   write_all(path, bad);
   try {
     (void)PtlV2File::open(path)->features();
     FAIL() << "a damaged features section was read";
   } catch (const FormatError& e) {
     const std::string m = e.what();
-    EXPECT_NE(m.find(path + ": byte " + std::to_string(section + 272)), std::string::npos) << m;
+    EXPECT_NE(m.find(path + ": byte " + std::to_string(first_id)), std::string::npos) << m;
     EXPECT_NE(m.find("surface id"), std::string::npos) << m;
+  }
+  // The same damage found when the page is loaded for paged rendering.
+  {
+    const auto file = PtlV2File::open(path);
+    const auto source = ptl_v2_page_source(*file);
+    HierarchyPage page;
+    try {
+      source->load(0, page);
+      FAIL() << "a damaged page block was loaded";
+    } catch (const FormatError& e) {
+      EXPECT_NE(std::string(e.what()).find("byte " + std::to_string(first_id)), std::string::npos)
+          << e.what();
+    }
+  }
+  // A block table entry out of order is refused with the byte of the entry.
+  bad = good;
+  const std::size_t entry1 = section + 264 + 8 + 16;
+  bad[entry1 + 7] = '\x01';
+  write_all(path, bad);
+  try {
+    (void)PtlV2File::open(path)->features();
+    FAIL() << "a damaged block table was read";
+  } catch (const FormatError& e) {
+    EXPECT_NE(std::string(e.what()).find("byte " + std::to_string(entry1)), std::string::npos)
+        << e.what();
   }
   // A section that runs past the end of the file is refused on opening.
   write_all(path, good.substr(0, good.size() - 10));

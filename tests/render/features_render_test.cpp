@@ -10,9 +10,11 @@
 #include <tuple>
 
 #include "pointillist/format/ptl_v2.hpp"
+#include "pointillist/format/ptl_v2_pages.hpp"
 #include "pointillist/lod/tree_features.hpp"
 #include "pointillist/prep/radii.hpp"
 #include "pointillist/render/renderer.hpp"
+#include "pointillist/render/sequence.hpp"
 #include "pointillist/scene/csg.hpp"
 #include "testing/testing.hpp"
 
@@ -82,7 +84,7 @@ struct Image {
 };
 
 Image render(const Model& m, const Camera& camera, ThreadPool& pool, bool features,
-             Rasterizer rasterizer = Rasterizer::Quality) {
+             Rasterizer rasterizer = Rasterizer::Quality, LodScheme lod = LodScheme::QSplat) {
   RenderSettings settings;
   settings.ambient = 1.0f;
   settings.diffuse = 0.0f;
@@ -90,6 +92,7 @@ Image render(const Model& m, const Camera& camera, ThreadPool& pool, bool featur
   FrameSettings fs;
   fs.rasterizer = rasterizer;
   fs.features = features;
+  fs.lod = lod;
   Renderer renderer;
   Frame frame;
   const SceneInstance instance{&m.render, {}};
@@ -234,6 +237,87 @@ TEST(FeaturesRender, FastModeClipsAtCreasesToo) {
     EXPECT_EQ(with.mixed, 0u) << id;  // opaque splats never blend
     EXPECT_GT(without.wrong, 200u) << id;  // discs of one face over the other
     EXPECT_LE(with.wrong, with.covered / 500) << id;
+  }
+}
+
+TEST(FeaturesRender, SequentialPointTreesDrawThemToo) {
+  // The SPT's leaves carry their splats' planes and ids, its interior entries the common id of
+  // their subtree: close up (leaves) and from afar (interior entries near the corner), both
+  // rasterizers.
+  ThreadPool pool(2);
+  for (const char* id : {"T1", "T8"}) {
+    const auto m = make_model(id, pool);
+    const bool cube = std::string(id) == "T1";
+    const Camera near = cube ? look({2.0f, 2.1f, 1.9f}, {1, 1, 1})
+                             : look({1.0f, 0.9f, 2.1f}, {0, 0, 1});
+    const Camera far = look({3.2f, 2.4f, 4.1f}, {0, 0, 0});
+    for (const Camera& cam : {near, far}) {
+      for (Rasterizer r : {Rasterizer::Quality, Rasterizer::Fast}) {
+        const LabelMetrics with = measure(*m, cam, render(*m, cam, pool, true, r, LodScheme::Spt));
+        const LabelMetrics without =
+            measure(*m, cam, render(*m, cam, pool, false, r, LodScheme::Spt));
+        std::cout << id << " spt " << name(r) << ": covered " << with.covered << " wrong "
+                  << with.wrong << " mixed " << with.mixed << " holes " << with.holes
+                  << " / without: wrong " << without.wrong << " mixed " << without.mixed << "\n";
+        EXPECT_EQ(with.holes, 0u) << id << " " << name(r);
+        EXPECT_EQ(with.mixed, 0u) << id << " " << name(r);
+        EXPECT_LE(with.wrong, with.covered / 500) << id << " " << name(r);
+        EXPECT_GT(without.mixed + without.wrong, 50u) << id << " " << name(r);
+      }
+    }
+  }
+}
+
+// Renders until every page the view needs is loaded (a paged model), as `render` does.
+Image render_paged(const RenderModel& model, const Camera& camera, ThreadPool& pool,
+                   bool features, Rasterizer rasterizer, const RendererOptions& options = {}) {
+  RenderSettings settings;
+  settings.ambient = 1.0f;
+  settings.diffuse = 0.0f;
+  settings.specular = 0.0f;
+  FrameSettings fs;
+  fs.rasterizer = rasterizer;
+  fs.features = features;
+  Renderer renderer(options);
+  Frame frame;
+  const SceneInstance instance{&model, {}};
+  render_settled(renderer, {&instance, 1}, camera, settings, fs, pool, frame);
+  return {std::vector<Rgb8>(frame.color.begin(), frame.color.end()), frame.width, frame.height};
+}
+
+TEST(FeaturesRender, PagedModelsDrawThemAsModelsHeldWhole) {
+  // A .ptl v2 file with its features stored page by page, drawn from its pages (small ones, so
+  // the close-up needs many) and decoded whole: the same image bits; and a model held whole,
+  // cut into pages in memory, draws as it does whole.
+  ThreadPool pool(2);
+  for (const char* id : {"T1", "T8"}) {
+    const auto m = make_model(id, pool, true);
+    pointillist::testing::TempDir dir;
+    const std::string path = dir.file("m.ptl");
+    write_ptl_v2(path, m->tree, "", {.page_bytes = 2048, .features = &m->features});
+    const auto file = PtlV2File::open(path);
+    ASSERT_GT(file->page_count(), 10u);
+    TreeFeatures stored;
+    const SphereTree whole_tree = file->decode_all(&stored);
+    RenderModel whole{.tree = whole_tree.view()};
+    whole.tree.features = &stored;
+    const auto source = ptl_v2_page_source(*file);
+    const RenderModel paged{.tree = source->summary(), .pages = source.get()};
+    const Camera cam = std::string(id) == "T1" ? look({2.0f, 2.1f, 1.9f}, {1, 1, 1})
+                                               : look({1.0f, 0.9f, 2.1f}, {0, 0, 1});
+    for (Rasterizer r : {Rasterizer::Quality, Rasterizer::Fast}) {
+      const Image a = render_paged(paged, cam, pool, true, r);
+      const Image b = render_paged(whole, cam, pool, true, r);
+      EXPECT_TRUE(a.color == b.color) << id << " " << name(r);
+      const Image off = render_paged(paged, cam, pool, false, r);
+      EXPECT_FALSE(a.color == off.color) << id << " " << name(r) << ": features not drawn";
+      const LabelMetrics with = measure(*m, cam, a);
+      EXPECT_EQ(with.holes, 0u) << id << " " << name(r);
+      // In memory, cut into pages.
+      const Image cut = render_paged(m->render, cam, pool, true, r, {.page_all = true});
+      const Image flat = render_paged(m->render, cam, pool, true, r);
+      EXPECT_TRUE(cut.color == flat.color) << id << " " << name(r);
+    }
   }
 }
 

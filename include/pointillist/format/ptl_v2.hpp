@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -21,7 +22,11 @@
 
 namespace pointillist {
 
-struct PackedPage;  // lod/pages.hpp
+struct PackedPage;    // lod/pages.hpp
+struct PageFeatures;  // lod/pages.hpp
+namespace ptl2 {
+struct FeatureSection;  // format/ptl_v2_features.hpp (private)
+}
 
 constexpr std::uint32_t kPtlV2Version = 2;
 
@@ -141,8 +146,9 @@ class PtlV2File {
   // decoded spheres (each enclosing the written sphere and its decoded children), decoded
   // normals, cone_sin ((k + 1)/4)² for cone codes k < 3, 2 (no bound) for 3, 0 for leaves,
   // colors expanded from 565. Checks the pages against each other (roots and child pages
-  // match) and the header's counts. Throws FormatError.
-  SphereTree decode_all() const;
+  // match) and the header's counts. With `features` (and a file that stores them), also the
+  // sharp features of every node. Throws FormatError.
+  SphereTree decode_all(TreeFeatures* features = nullptr) const;
 
   bool has_colors() const { return has_colors_; }
   // How the leaves keep their radius trim (from the attribute schema).
@@ -161,11 +167,25 @@ class PtlV2File {
   // order, as decode_all's leaves). Throws FormatError for a damaged section.
   bool has_features() const { return features_size_ != 0; }
   std::optional<FeatureData> features() const;
+  // Their surface count, options and statistics (no per-node arrays), or null without them.
+  const TreeFeatures* feature_summary() const;
+  // Whether they are stored page by page (files of Pointillist 2026-11-26 and later; earlier ones
+  // store the leaves' features for the whole model, drawn only when it is decoded whole).
+  bool page_features_stored() const;
+  // The features of page `page`'s records (page order); is_leaf(k) tells whether record k is a
+  // leaf. Thread-safe. Throws FormatError for a damaged block or a file that stores none per
+  // page.
+  void page_features(std::uint32_t page, const std::function<bool(std::uint32_t)>& is_leaf,
+                     PageFeatures& out) const;
+  // Memory page `page`'s features take when loaded (PageFeatures::memory_bytes; 0 without page
+  // features).
+  std::uint64_t page_feature_memory(std::uint32_t page) const;
   std::uint64_t file_size() const { return size_; }
   const std::string& path() const { return path_; }
 
  private:
   struct Mapping;
+  const ptl2::FeatureSection& feature_section() const;
   // The parent of a record in its page: root `index` of the page's root table, or record `index`.
   struct PageParent {
     bool is_root = false;

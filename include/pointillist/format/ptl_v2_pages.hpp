@@ -14,7 +14,9 @@ namespace pointillist {
 // Pages of `file`, which must outlive the result. open_bytes() is everything before the first
 // page (header, schema, page table); page_storage_bytes() a page's size in the file. load()
 // throws FormatError for a corrupt page (including an interior node of a page's last level that
-// no child page continues).
-std::unique_ptr<PageSource> ptl_v2_page_source(const PtlV2File& file);
+// no child page continues). With `with_features` and a file that stores sharp features page by
+// page, each loaded page carries its nodes' features (PageFeatures); a damaged features section
+// throws FormatError here (its fixed fields) or from load() (a page's block).
+std::unique_ptr<PageSource> ptl_v2_page_source(const PtlV2File& file, bool with_features = true);
 
 }  // namespace pointillist

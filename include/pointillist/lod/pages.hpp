@@ -7,12 +7,16 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
+#include "pointillist/features/features.hpp"
 #include "pointillist/lod/quantization.hpp"
 #include "pointillist/lod/sphere_tree.hpp"
 
 namespace pointillist {
+
+struct TreeFeatures;  // tree_features.hpp
 
 inline constexpr std::uint32_t kNoPage = 0xffffffffu;
 
@@ -68,6 +72,31 @@ struct PackedPage {
   }
 };
 
+// Sharp features of a page's nodes (tree_features.hpp, per page): every node's surface id (a
+// leaf's splat's, an inner node's the common id of its subtree or kMixedSurface), and the clip
+// planes of the leaves that have some. Empty when the model has none.
+struct PageFeatures {
+  std::vector<std::uint32_t> surface;        // per node of the page, in page order
+  std::vector<std::uint32_t> clipped;        // nodes with clip planes, increasing
+  std::vector<ClipMode> clipped_mode;        // per clipped node
+  std::vector<std::uint32_t> clipped_first;  // per clipped node + 1: into planes
+  std::vector<ClipPlane> planes;
+
+  bool empty() const { return surface.empty(); }
+  void clear();
+  // Node `node`'s planes and how they combine (none: an empty span and ClipMode::None).
+  std::span<const ClipPlane> planes_of(std::uint32_t node, ClipMode& mode) const;
+  // Memory while resident (counted by size, not capacity, so a page source can say it before
+  // loading), and the same for counts of nodes, clipped nodes and planes.
+  std::uint64_t memory_bytes() const {
+    return memory_bytes(surface.size(), clipped.size(), planes.size());
+  }
+  static std::uint64_t memory_bytes(std::uint64_t nodes, std::uint64_t clipped,
+                                    std::uint64_t planes) {
+    return nodes * 4 + clipped * 9 + 4 + planes * sizeof(ClipPlane);
+  }
+};
+
 // One page: a connected part of the hierarchy. Page 0 holds the root and the levels below it;
 // any other page holds the children of one or more nodes of another page (its anchors), then
 // their descendants.
@@ -79,6 +108,7 @@ struct HierarchyPage {
   std::vector<SphereNode> nodes;
   std::vector<std::uint32_t> child_page;  // one per node; kNoPage: children (if any) are here
   PackedPage packed;
+  PageFeatures features;  // the nodes' sharp features, when the model has them
 
   bool is_packed() const { return nodes.empty(); }
   std::uint32_t node_count() const {
@@ -90,9 +120,10 @@ struct HierarchyPage {
   }
   // What this page costs in memory while it is resident.
   std::uint64_t memory_bytes() const {
-    return is_packed() ? PackedPage::memory_bytes(packed.records.size(), packed.links.size(),
-                                                  !packed.colors.empty())
-                       : memory_bytes(nodes.size());
+    return (is_packed() ? PackedPage::memory_bytes(packed.records.size(), packed.links.size(),
+                                                   !packed.colors.empty())
+                        : memory_bytes(nodes.size())) +
+           (features.empty() ? 0 : features.memory_bytes());
   }
 };
 
@@ -112,12 +143,17 @@ class PageSource {
   // Counts and boxes of the whole model (nodes stays empty): leaf_count, depth, bounds,
   // view_sphere (for the camera) and has_colors.
   virtual SphereTreeView summary() const = 0;
-  // Loads page `page` into `out`, decoded or packed (every page of a source in the same form).
+  // The sharp features the pages carry (HierarchyPage::features): only their surface count
+  // (ids of one model are 0 .. surface_count − 1), options and statistics are set (no per-node
+  // arrays); null when the pages carry none.
+  virtual const TreeFeatures* features() const { return nullptr; }
+  // Loads page `page` into `out`, decoded or packed (every page of a source in the same form),
+  // with its features when the source has them.
   // Safe to call concurrently for different pages. Throws FormatError or IoError.
   virtual void load(std::uint32_t page, HierarchyPage& out) const = 0;
 };
 
-// `tree` cut into pages: page 0 takes the root and then whole sibling groups breadth-first while
+// `tree` cut into pages (with its features, when tree.features is set): page 0 takes the root and then whole sibling groups breadth-first while
 // it stays within `page_bytes` (at 40 bytes a node, the .ptl v1 node size); each node whose
 // children do not fit starts a new page, filled the same way but with at most `max_levels`
 // levels. Shallow pages make a model stream in coarse to fine everywhere rather than region by

@@ -96,6 +96,8 @@ struct SequentialPointTree {
   std::vector<std::uint8_t> is_leaf;  // 1 for input splats, 0 for interior nodes
   std::vector<std::uint32_t> parent;  // list index of the parent (always smaller); root:
                                       // kSptNoParent
+  std::vector<std::uint32_t> source;  // leaves: index of the input splat; interior nodes:
+                                      // kSptNoParent
 
   std::uint32_t top_end = 0;  // the top list is [0, top_end)
   std::vector<SptChunk> chunks;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "pointillist/features/features.hpp"
+#include "pointillist/lod/sequential_point_tree.hpp"
 #include "pointillist/lod/sphere_tree.hpp"
 
 namespace pointillist {
@@ -30,6 +31,13 @@ struct TreeFeatures {
 // Spreads `leaves` (features of the tree's leaves in node order, as sphere_tree_leaves lists
 // them) over the nodes. Throws Error when the counts differ.
 TreeFeatures tree_features(std::span<const SphereNode> nodes, const FeatureData& leaves);
+
+// The same features on the entries of `spt`, a Sequential Point Tree built from the leaves of the
+// sphere tree `nodes` (sphere_tree_leaves order): a leaf entry takes its splat's surface id and
+// planes, an interior entry the common id of its subtree, or kMixedSurface, and no planes.
+// Throws Error when the SPT's leaves are not the tree's.
+TreeFeatures spt_features(const SequentialPointTree& spt, std::span<const SphereNode> nodes,
+                          const TreeFeatures& features);
 
 // compute_features on the tree's leaves (sphere_tree_leaves), then tree_features.
 TreeFeatures compute_tree_features(const SphereTreeView& tree, ThreadPool& pool,

@@ -56,8 +56,10 @@ struct OpenModelOptions {
   // Compute sharp features (surface ids, clip planes) on the leaves of a model held whole, with
   // these options (render --features). A paged model gets none.
   std::optional<FeatureOptions> features;
-  // Load the sharp features a .ptl file stores (Paging::Auto then decodes it whole, unless it
-  // would take more than a quarter of the memory).
+  // Load the sharp features a .ptl file stores: with the hierarchy when it is decoded, with
+  // each page when it is paged (files that store them for the whole model, written before
+  // 2026-11-26, are then decoded whole by Paging::Auto, unless that would take more than a
+  // quarter of the memory).
   bool stored_features = true;
 };
 
@@ -84,8 +86,11 @@ class Model {
   // The file's metadata text (.ptl, .qs), one "key: value" per line.
   const std::string& metadata() const { return metadata_; }
   std::uint64_t file_size() const { return file_size_; }
-  // Sharp features of the hierarchy's nodes, or null.
-  const TreeFeatures* features() const { return features_.get(); }
+  // Sharp features of the hierarchy's nodes, or for a paged model whose pages carry them their
+  // surface count, options and statistics only (no per-node arrays); null without features.
+  const TreeFeatures* features() const {
+    return features_ ? features_.get() : pages_ ? pages_->features() : nullptr;
+  }
   // .ptl files (null for other kinds).
   const PtlFile* ptl_v1() const { return v1_.get(); }
   const PtlV2File* ptl_v2() const { return v2_.get(); }

@@ -50,9 +50,12 @@ class PagedRenderer {
   // The selection of render() alone: writes the splats of the resident pages seen by `camera`
   // into `stream` (discs filled when stream.with_discs) and records the pages wanted. With
   // `same_frame`, the selection adds to the last one's requests (another instance of the model
-  // in the same frame) instead of starting a frame.
+  // in the same frame) instead of starting a frame. With `features` (a source whose pages carry
+  // them), each chunk also gets its splats' surface ids (the model's own) and clip planes
+  // (model space); the stream's has_features is the caller's to set.
   SelectionStats select(const CameraFrame& camera, const RenderSettings& settings,
-                        ThreadPool& pool, SplatStream& stream, bool same_frame = false);
+                        ThreadPool& pool, SplatStream& stream, bool same_frame = false,
+                        bool features = false);
 
   // Loading between frames: see PageCache (the requests are the last render's).
   std::size_t load_requested(ThreadPool& pool, std::size_t max_pages = SIZE_MAX,

@@ -12,6 +12,7 @@
 #include "frame_pass.hpp"
 #include "shading.hpp"
 #include "select/qsplat_traversal.hpp"
+#include "select/stream_features.hpp"
 
 namespace pointillist {
 namespace {
@@ -19,6 +20,27 @@ namespace {
 using namespace render_detail;
 
 using PageTable = PageCache::PageTable;
+
+struct PageRecord {
+  std::uint32_t page, index;
+};
+
+// The chunk's surface ids and clip planes (model space, the model's own ids) from the features
+// of the pages its splats' nodes lie in; `where` is indexed by the splats' node ids.
+void fill_page_features(const PageTable& pages, const std::vector<PageRecord>& where,
+                        SplatChunk& chunk) {
+  fill_features(chunk, [&](std::size_t i, std::uint32_t& surface, ClipMode& mode) {
+    const PageRecord w = where[chunk.node[i]];
+    const PageFeatures& f = pages[w.page]->features;
+    if (f.empty()) {
+      surface = kMixedSurface;
+      mode = ClipMode::None;
+      return std::span<const ClipPlane>{};
+    }
+    surface = f.surface[w.index];
+    return f.planes_of(w.index, mode);
+  });
+}
 
 // The traversal's view of decoded pages: nodes are used where they lie; a splat's node id is the
 // index of its node's address in the task's list (a stand-in lit from the front is a copy).
@@ -32,11 +54,13 @@ class DecodedAccess {
   struct Kept {
     std::vector<const SphereNode*> emitted;
     std::deque<SphereNode> flipped;
+    std::vector<PageRecord> where;  // with features: the page and index of each
   };
-  explicit DecodedAccess(const PageTable& pages) : pages_(pages) {}
+  DecodedAccess(const PageTable& pages, bool features) : pages_(pages), features_(features) {}
   Item root(std::uint8_t tests) const { return {0, 0, tests}; }
   const SphereNode& node(const Item& p) const { return pages_[p.page]->nodes[p.node]; }
   std::uint32_t page(const Item& p) const { return p.page; }
+  std::uint32_t index(const Item& p) const { return p.node; }
   ChildRef children(const Item& p, const SphereNode& n) const {
     const std::uint32_t cp = pages_[p.page]->child_page[p.node];
     if (cp == kNoPage) return {p.page, n.first_child, true};
@@ -49,7 +73,8 @@ class DecodedAccess {
   Item item(ChildRef c, std::uint32_t k, const SphereNode*, std::uint8_t tests) const {
     return {c.page, c.first + k, tests};
   }
-  std::uint32_t keep(Kept& kept, const SphereNode& n, bool flip) const {
+  std::uint32_t keep(Kept& kept, const SphereNode& n, bool flip, std::uint32_t page,
+                     std::uint32_t index) const {
     if (flip) {
       kept.flipped.push_back(n);
       kept.flipped.back().normal = -n.normal;
@@ -57,16 +82,22 @@ class DecodedAccess {
     } else {
       kept.emitted.push_back(&n);
     }
+    if (features_) kept.where.push_back({page, index});
     return static_cast<std::uint32_t>(kept.emitted.size() - 1);
   }
   const SphereNode& kept(const Kept& kept, std::uint32_t id) const { return *kept.emitted[id]; }
   static void clear(Kept& kept) {
     kept.emitted.clear();
     kept.flipped.clear();
+    kept.where.clear();
+  }
+  void finish(const Kept& kept, SplatChunk& chunk) const {
+    if (features_) fill_page_features(pages_, kept.where, chunk);
   }
 
  private:
   const PageTable& pages_;
+  bool features_;
 };
 
 // The traversal's view of packed pages: each node is decoded from its record against its
@@ -79,9 +110,12 @@ class PackedAccess {
     std::uint32_t page, index;
     std::uint8_t tests;
   };
-  using Kept = std::vector<SphereNode>;
-  PackedAccess(const PageTable& pages, bool has_colors)
-      : pages_(pages), has_colors_(has_colors) {}
+  struct Kept {
+    std::vector<SphereNode> nodes;
+    std::vector<PageRecord> where;  // with features: the page and index of each
+  };
+  PackedAccess(const PageTable& pages, bool has_colors, bool features)
+      : pages_(pages), has_colors_(has_colors), features_(features) {}
   Item root(std::uint8_t tests) const {
     const PackedPage& pk = pages_[0]->packed;
     Item root{{}, 0, 0, tests};
@@ -90,6 +124,7 @@ class PackedAccess {
   }
   const SphereNode& node(const Item& p) const { return p.node; }
   std::uint32_t page(const Item& p) const { return p.page; }
+  std::uint32_t index(const Item& p) const { return p.index; }
   ChildRef children(const Item& p, const SphereNode&) const {
     const PackedPage& pk = pages_[p.page]->packed;
     const std::uint32_t link = pk.link(p.index);
@@ -105,13 +140,21 @@ class PackedAccess {
   Item item(ChildRef c, std::uint32_t k, const SphereNode* kids, std::uint8_t tests) const {
     return {kids[k], c.page, c.first + k, tests};
   }
-  std::uint32_t keep(Kept& kept, const SphereNode& n, bool flip) const {
-    kept.push_back(n);
-    if (flip) kept.back().normal = -n.normal;
-    return static_cast<std::uint32_t>(kept.size() - 1);
+  std::uint32_t keep(Kept& kept, const SphereNode& n, bool flip, std::uint32_t page,
+                     std::uint32_t index) const {
+    kept.nodes.push_back(n);
+    if (flip) kept.nodes.back().normal = -n.normal;
+    if (features_) kept.where.push_back({page, index});
+    return static_cast<std::uint32_t>(kept.nodes.size() - 1);
   }
-  const SphereNode& kept(const Kept& kept, std::uint32_t id) const { return kept[id]; }
-  static void clear(Kept& kept) { kept.clear(); }
+  const SphereNode& kept(const Kept& kept, std::uint32_t id) const { return kept.nodes[id]; }
+  static void clear(Kept& kept) {
+    kept.nodes.clear();
+    kept.where.clear();
+  }
+  void finish(const Kept& kept, SplatChunk& chunk) const {
+    if (features_) fill_page_features(pages_, kept.where, chunk);
+  }
 
  private:
   template <class Parent>
@@ -122,6 +165,7 @@ class PackedAccess {
 
   const PageTable& pages_;
   bool has_colors_;
+  bool features_;
   quant::DecodeTables tables_;
 };
 
@@ -159,7 +203,8 @@ void PagedRenderer::render_quality(const Camera& camera, const RenderSettings& s
 }
 
 SelectionStats PagedRenderer::select(const CameraFrame& cam, const RenderSettings& settings,
-                                    ThreadPool& pool, SplatStream& stream, bool same_frame) {
+                                    ThreadPool& pool, SplatStream& stream, bool same_frame,
+                                    bool features) {
   if (!(settings.threshold_px > 0.0f) || !std::isfinite(settings.threshold_px)) {
     throw OptionError("splat size threshold " + std::to_string(settings.threshold_px) +
                       " px is invalid; give a positive number of pixels (1 draws every detail)");
@@ -178,9 +223,9 @@ SelectionStats PagedRenderer::select(const CameraFrame& cam, const RenderSetting
       with_colors, expected_splats(summary_.leaf_count, cam), stream, {}};
   if (!pages.empty() && pages[0]) {
     if (pages[0]->is_packed()) {
-      select_pages(PackedAccess(pages, with_colors), selection, pool, tasks_->packed);
+      select_pages(PackedAccess(pages, with_colors, features), selection, pool, tasks_->packed);
     } else {
-      select_pages(DecodedAccess(pages), selection, pool, tasks_->decoded);
+      select_pages(DecodedAccess(pages, features), selection, pool, tasks_->decoded);
     }
   }
   cache_.end_frame();

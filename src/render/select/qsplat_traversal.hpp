@@ -20,12 +20,16 @@
 //   Item root(std::uint8_t tests) const;
 //   const SphereNode& node(const Item&) const;
 //   std::uint32_t page(const Item&) const;
+//   std::uint32_t index(const Item&) const;  // the node's index in its page
 //   ChildRef children(const Item&, const SphereNode&) const;
 //   const SphereNode* load_children(ChildRef, const SphereNode& parent, SphereNode* scratch4) const;
 //   Item item(ChildRef, std::uint32_t k, const SphereNode* kids, std::uint8_t tests) const;
-//   std::uint32_t keep(Kept&, const SphereNode& n, bool flip) const;  // the splat's node id
+//   // The splat's node id, for node n at (page, index).
+//   std::uint32_t keep(Kept&, const SphereNode& n, bool flip, std::uint32_t page,
+//                      std::uint32_t index) const;
 //   const SphereNode& kept(const Kept&, std::uint32_t id) const;
 //   static void clear(Kept&);
+//   void finish(const Kept&, SplatChunk&) const;  // after finish_chunk (e.g. sharp features)
 #pragma once
 
 #include <cstdint>
@@ -63,9 +67,10 @@ void walk_subtree(const Access& access, const typename Access::Item& start,
   Counters counters;  // local: the hot loop keeps it in registers
   {
     Emitter emitter(chunk, with_colors, v.with_discs);
-    const auto emit = [&](const SphereNode& n, Vec3f d, float z, bool stand_in) {
+    const auto emit = [&](const SphereNode& n, std::uint32_t page, std::uint32_t index, Vec3f d,
+                          float z, bool stand_in) {
       const bool flip = stand_in && dot(d, n.normal) > 0;
-      emitter.emit(n, access.keep(out.kept, n, flip), d, z, v, counters, !stand_in);
+      emitter.emit(n, access.keep(out.kept, n, flip, page, index), d, z, v, counters, !stand_in);
     };
     SphereNode scratch[4];
     stack.clear();
@@ -80,12 +85,12 @@ void walk_subtree(const Access& access, const typename Access::Item& start,
         float z;
         std::uint8_t tests = p.tests;
         const Decision decision = visit(n, v, tests, counters, d, z);
-        if (decision == Decision::Draw) emit(n, d, z, false);
+        if (decision == Decision::Draw) emit(n, access.page(p), access.index(p), d, z, false);
         if (decision != Decision::Refine) break;
         const ChildRef c = access.children(p, n);
         if constexpr (Access::kPaged) {
           if (!c.resident) {
-            emit(n, d, z, true);
+            emit(n, access.page(p), access.index(p), d, z, true);
             out.requests.push_back({c.page, access.page(p), z > 0 ? n.radius / z : 0.0f});
             break;
           }
@@ -99,7 +104,7 @@ void walk_subtree(const Access& access, const typename Access::Item& start,
         for (; k < n.child_count && kids[k].child_count == 0; ++k) {
           std::uint8_t leaf_tests = tests;
           if (visit(kids[k], v, leaf_tests, counters, d, z) == Decision::Draw) {
-            emit(kids[k], d, z, false);
+            emit(kids[k], c.page, c.first + k, d, z, false);
           }
         }
         if (k == n.child_count) break;
@@ -183,6 +188,7 @@ void select_qsplat(const Access& access, const ViewConstants& v, std::uint8_t te
     walk_subtree(access, items[t], v, with_colors, stack, chunk, out);
     finish_chunk([&](std::uint32_t i) -> const SphereNode& { return access.kept(out.kept, i); },
                  v, with_colors, chunk);
+    access.finish(out.kept, chunk);
   });
 }
 

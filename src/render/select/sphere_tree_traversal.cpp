@@ -55,6 +55,7 @@ class FlatAccess {
   Item root(std::uint8_t tests) const { return {0, tests}; }
   const SphereNode& node(const Item& p) const { return nodes_[p.node]; }
   std::uint32_t page(const Item&) const { return 0; }
+  std::uint32_t index(const Item& p) const { return p.node; }
   ChildRef children(const Item&, const SphereNode& n) const { return {0, n.first_child, true}; }
   const SphereNode* load_children(ChildRef c, const SphereNode&, SphereNode*) const {
     return nodes_.data() + c.first;
@@ -62,11 +63,12 @@ class FlatAccess {
   Item item(ChildRef c, std::uint32_t k, const SphereNode*, std::uint8_t tests) const {
     return {c.first + k, tests};
   }
-  std::uint32_t keep(Kept&, const SphereNode& n, bool) const {
-    return static_cast<std::uint32_t>(&n - nodes_.data());
+  std::uint32_t keep(Kept&, const SphereNode&, bool, std::uint32_t, std::uint32_t index) const {
+    return index;
   }
   const SphereNode& kept(const Kept&, std::uint32_t id) const { return nodes_[id]; }
   static void clear(Kept&) {}
+  void finish(const Kept&, SplatChunk&) const {}  // features: attached by node id afterwards
 
  private:
   std::span<const SphereNode> nodes_;

@@ -2,39 +2,41 @@
 
 namespace pointillist::render_detail {
 
-void attach_features(const TreeFeatures* features, const InstanceTransform* transform,
-                     std::uint32_t id_base, SplatChunk& chunk) {
-  const std::size_t n = chunk.count;
-  if (chunk.surface.size() < n) {
+void reserve_features(SplatChunk& chunk) {
+  if (chunk.surface.size() < chunk.count) {
     const std::size_t cap = chunk.capacity();
     chunk.surface.resize(cap);
     chunk.clip_first.resize(cap);
     chunk.clip_code.resize(cap);
   }
-  chunk.clip_planes.clear();
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!features) {
-      chunk.surface[i] = kMixedSurface;
-      chunk.clip_first[i] = 0;
-      chunk.clip_code[i] = clip_code(0, ClipMode::None);
-      continue;
-    }
-    const std::uint32_t node = chunk.node[i];
-    const std::uint32_t id = features->surface[node];
-    chunk.surface[i] = id == kMixedSurface ? id : id + id_base;
-    chunk.clip_first[i] = static_cast<std::uint32_t>(chunk.clip_planes.size());
-    const auto planes = features->planes(node);
-    chunk.clip_code[i] = clip_code(planes.size(), features->clip_mode[node]);
-    for (ClipPlane p : planes) {
-      if (transform) {
-        // n·x − h >= 0 in the model is n′·y − h′ >= 0 for y = t + s·R·x: n′ = R·n, h′ =
-        // s·h + n′·t (a positive scale keeps the in-plane distances' ratios).
-        const Vec3f n2 = transform->rotate(p.n);
-        p = {n2, p.h * transform->scale + dot(n2, transform->translate)};
-      }
-      chunk.clip_planes.push_back(p);
+}
+
+void place_features(const InstanceTransform* transform, std::uint32_t id_base,
+                    SplatChunk& chunk) {
+  if (id_base != 0) {
+    for (std::size_t i = 0; i < chunk.count; ++i) {
+      if (chunk.surface[i] != kMixedSurface) chunk.surface[i] += id_base;
     }
   }
+  if (!transform) return;
+  for (ClipPlane& p : chunk.clip_planes) {
+    // n·x − h >= 0 in the model is n′·y − h′ >= 0 for y = t + s·R·x: n′ = R·n, h′ = s·h + n′·t
+    // (a positive scale keeps the in-plane distances' ratios).
+    const Vec3f n2 = transform->rotate(p.n);
+    p = {n2, p.h * transform->scale + dot(n2, transform->translate)};
+  }
+}
+
+void attach_features(const TreeFeatures* features, const InstanceTransform* transform,
+                     std::uint32_t id_base, SplatChunk& chunk) {
+  fill_features(chunk, [&](std::size_t i, std::uint32_t& surface, ClipMode& mode) {
+    if (!features) return std::span<const ClipPlane>{};
+    const std::uint32_t node = chunk.node[i];
+    surface = features->surface[node];
+    mode = features->clip_mode[node];
+    return features->planes(node);
+  });
+  place_features(transform, id_base, chunk);
 }
 
 }  // namespace pointillist::render_detail
