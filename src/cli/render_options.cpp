@@ -15,6 +15,7 @@ namespace {
 struct RenderText {
   CameraText camera;
   std::string background = "0,0,0", path, memory, read_per_frame;
+  bool unlit = false;
   bool no_chunk_culling = false;
   bool features = false, no_features = false;
   FeatureOptions feature;
@@ -43,6 +44,10 @@ void add_look(CLI::App* cmd, RenderOptions& o, RenderText& t) {
       ->check(CLI::Range(0.01f, 100.0f))
       ->group(kGroupLook);
   cmd->add_option("--background", t.background, "Background color R,G,B (0-255)")
+      ->group(kGroupLook);
+  cmd->add_flag("--unlit", t.unlit,
+                "Show each splat's own colour, unshaded (ambient 1, no diffuse or specular): "
+                "the face colours of generate --scene T*, for compare --labels")
       ->group(kGroupLook);
   add_enum<Reconstruction>(cmd, "--reconstruction", o.frame.quality.reconstruction,
                            {{"zrange", Reconstruction::ZRange},
@@ -226,6 +231,11 @@ Command add_render_command(CLI::App& app) {
             o->frame.features = !t->no_features;
             parse_camera_options(t->camera, o->view);
             o->settings.background = parse_rgb8(t->background, "--background");
+            if (t->unlit) {
+              o->settings.ambient = 1.0f;
+              o->settings.diffuse = 0.0f;
+              o->settings.specular = 0.0f;
+            }
             if (!t->path.empty()) o->orbit_frames = parse_orbit_path(t->path);
             if (!t->memory.empty()) o->memory_cap = parse_bytes(t->memory, "--memory");
             if (!t->read_per_frame.empty()) {
