@@ -112,6 +112,12 @@ struct GenerateOptions {
   std::uint64_t seed = 1;
   bool with_normals = false;  // write the exact normals too
   std::string sampling = "j";  // test scenes T*: j or r
+  // Test scenes T*: also write the exact label image here (empty = none), seen with `view` (as
+  // `render` would see the written .ply) on `background`.
+  std::string reference_output;
+  ViewOptions view;
+  Rgb8 background{0, 0, 0};
+  std::vector<std::string> warnings;  // options given that do not apply (printed by run_generate)
   unsigned threads = 0;
   bool quiet = false;
 };
@@ -122,6 +128,8 @@ struct CompareOptions {
   std::string test;
   std::optional<Rgb8> background;  // unset = the reference's top-left pixel
   std::string json_output;         // empty = none, "-" = stdout (instead of the text)
+  bool labels = false;             // --labels: the label metrics too (eval/label_metrics.hpp)
+  int label_tolerance = 2;         // levels per channel at which a pixel still shows a face
 };
 int run_compare(const CompareOptions& options);
 

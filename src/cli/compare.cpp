@@ -1,21 +1,69 @@
 // `pointillist compare REFERENCE.png TEST.png`: image-quality metrics of a render against a
-// reference render of the same view.
+// reference render of the same view; with --labels also the label metrics of the sharp-features
+// spec against an exact label reference (generate --reference).
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "commands.hpp"
 #include "options.hpp"
+#include "util.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/io/png.hpp"
 #include "pointillist/eval/image_compare.hpp"
+#include "pointillist/eval/label_metrics.hpp"
 
 namespace pointillist::cli {
 namespace {
 
-std::string comparison_to_json(const ImageComparison& c, int width, int height) {
+using ull = unsigned long long;
+
+std::string labels_to_json(const LabelComparison& l, int tolerance) {
+  char buf[2048];
+  std::snprintf(buf, sizeof buf,
+                ",\n"
+                "  \"labels\": {\n"
+                "    \"tolerance\": %d,\n"
+                "    \"covered_pixels\": %llu,\n"
+                "    \"interior_pixels\": %llu,\n"
+                "    \"boundary_pixels\": %llu,\n"
+                "    \"hole_pixels\": %llu,\n"
+                "    \"far_background_pixels\": %llu,\n"
+                "    \"overshoot_pixels\": %llu,\n"
+                "    \"band_pixels\": %llu,\n"
+                "    \"band_error_pixels\": %llu,\n"
+                "    \"ler_band\": %.6f,\n"
+                "    \"covered_error_pixels\": %llu,\n"
+                "    \"ler_covered\": %.6f,\n"
+                "    \"wrong_label_pixels\": %llu,\n"
+                "    \"mixed_pixels\": %llu,\n"
+                "    \"mix_band_pixels\": %llu,\n"
+                "    \"mixed_band_pixels\": %llu,\n"
+                "    \"mixed_per_boundary_pixel\": %.6f,\n"
+                "    \"mixed_outside_pixels\": %llu,\n"
+                "    \"profiles\": %llu,\n"
+                "    \"unmatched_profiles\": %llu,\n"
+                "    \"edge_displacement_mean_px\": %.6f,\n"
+                "    \"edge_displacement_max_px\": %.6f,\n"
+                "    \"transition_width_mean_px\": %.6f,\n"
+                "    \"transition_width_max_px\": %.6f\n"
+                "  }",
+                tolerance, ull(l.covered_count), ull(l.interior_count), ull(l.boundary_count),
+                ull(l.hole_count), ull(l.far_background_count), ull(l.overshoot_count),
+                ull(l.band_count), ull(l.band_error_count), l.ler_band,
+                ull(l.covered_error_count), l.ler_covered, ull(l.wrong_count),
+                ull(l.mixed_count), ull(l.mix_band_count), ull(l.mixed_band_count),
+                l.mixed_per_boundary_px, ull(l.mixed_outside_count), ull(l.profile_count),
+                ull(l.unmatched_profile_count), l.displacement_mean_px, l.displacement_max_px,
+                l.transition_mean_px, l.transition_max_px);
+  return buf;
+}
+
+std::string comparison_to_json(const ImageComparison& c, int width, int height,
+                               const std::string& labels) {
   char psnr[64];
   if (std::isinf(c.psnr_db)) {
     std::snprintf(psnr, sizeof psnr, "null");  // JSON has no infinity: identical images
@@ -35,14 +83,41 @@ std::string comparison_to_json(const ImageComparison& c, int width, int height) 
                 "  \"interior_pixels\": %llu,\n"
                 "  \"silhouette_iou\": %.6f,\n"
                 "  \"reference_foreground_pixels\": %llu,\n"
-                "  \"test_foreground_pixels\": %llu\n"
-                "}\n",
+                "  \"test_foreground_pixels\": %llu",
                 width, height, c.background.r, c.background.g, c.background.b, c.mse, psnr, c.ssim,
-                static_cast<unsigned long long>(c.hole_count),
-                static_cast<unsigned long long>(c.interior_count), c.silhouette_iou,
-                static_cast<unsigned long long>(c.reference_foreground_count),
-                static_cast<unsigned long long>(c.test_foreground_count));
-  return buf;
+                ull(c.hole_count), ull(c.interior_count), c.silhouette_iou,
+                ull(c.reference_foreground_count), ull(c.test_foreground_count));
+  return buf + labels + "\n}\n";
+}
+
+double percent(std::uint64_t a, std::uint64_t b) {
+  return b > 0 ? 100.0 * double(a) / double(b) : 0.0;
+}
+
+void print_labels(const LabelComparison& l, int tolerance) {
+  std::printf("labels:         palette of generate --scene T*, tolerance %d levels; reference "
+              "%llu covered px, %llu interior, %llu on label boundaries\n",
+              tolerance, ull(l.covered_count), ull(l.interior_count), ull(l.boundary_count));
+  std::printf("  HOLE:         %llu of %llu interior pixels\n", ull(l.hole_count),
+              ull(l.interior_count));
+  std::printf("  OVERSHOOT:    %llu of %llu background pixels more than 1 px from the reference\n",
+              ull(l.overshoot_count), ull(l.far_background_count));
+  std::printf("  LER:          %.3f%% in B_4 (%llu of %llu), %.3f%% of covered (%llu of %llu); "
+              "%llu show another label\n",
+              100.0 * l.ler_band, ull(l.band_error_count), ull(l.band_count),
+              100.0 * l.ler_covered, ull(l.covered_error_count), ull(l.covered_count),
+              ull(l.wrong_count));
+  std::printf("  MIX:          %llu interior pixels (%.3f%%); %llu in B_8 (of %llu, %.4f per "
+              "boundary pixel); %llu more on or beyond the silhouette\n",
+              ull(l.mixed_count), percent(l.mixed_count, l.interior_count),
+              ull(l.mixed_band_count), ull(l.mix_band_count), l.mixed_per_boundary_px,
+              ull(l.mixed_outside_count));
+  std::printf("  edge displacement: mean %.2f px, max %.2f px over %llu profiles (%llu without "
+              "both labels in the test)\n",
+              l.displacement_mean_px, l.displacement_max_px, ull(l.profile_count),
+              ull(l.unmatched_profile_count));
+  std::printf("  transition width:  mean %.2f px, max %.0f px\n", l.transition_mean_px,
+              l.transition_max_px);
 }
 
 void print_text(const CompareOptions& o, const ImageComparison& c, int width, int height) {
@@ -50,21 +125,19 @@ void print_text(const CompareOptions& o, const ImageComparison& c, int width, in
   std::printf("test:           %s\n", o.test.c_str());
   std::printf("size:           %dx%d\n", width, height);
   std::printf("background:     %d,%d,%d (%s)\n", c.background.r, c.background.g, c.background.b,
-              o.background ? "--background" : "top-left pixel of the reference");
+              o.background ? "--background"
+              : o.labels   ? "--labels: the default of generate --reference and render"
+                           : "top-left pixel of the reference");
   if (std::isinf(c.psnr_db)) {
     std::printf("PSNR:           inf dB (identical images)\n");
   } else {
     std::printf("PSNR:           %.2f dB (MSE %.3f)\n", c.psnr_db, c.mse);
   }
   std::printf("SSIM:           %.5f\n", c.ssim);
-  const double hole_percent =
-      c.interior_count > 0 ? 100.0 * double(c.hole_count) / double(c.interior_count) : 0.0;
   std::printf("hole pixels:    %llu of %llu interior reference pixels (%.3f%%)\n",
-              static_cast<unsigned long long>(c.hole_count),
-              static_cast<unsigned long long>(c.interior_count), hole_percent);
+              ull(c.hole_count), ull(c.interior_count), percent(c.hole_count, c.interior_count));
   std::printf("silhouette IoU: %.5f (foreground: reference %llu px, test %llu px)\n",
-              c.silhouette_iou, static_cast<unsigned long long>(c.reference_foreground_count),
-              static_cast<unsigned long long>(c.test_foreground_count));
+              c.silhouette_iou, ull(c.reference_foreground_count), ull(c.test_foreground_count));
 }
 
 }  // namespace
@@ -79,12 +152,26 @@ int run_compare(const CompareOptions& o) {
                 "; render the test image at the reference's size (--size " +
                 std::to_string(reference.width) + "x" + std::to_string(reference.height) + ")");
   }
-  const ImageComparison c =
-      compare_images({reference.width, reference.height, reference.pixels},
-                     {test.width, test.height, test.pixels}, {.background = o.background});
+  const ImageRgb8View ref_view{reference.width, reference.height, reference.pixels};
+  const ImageRgb8View test_view{test.width, test.height, test.pixels};
+  // A close-up label reference covers its corner, so --labels takes the background the label
+  // images are drawn on by default rather than the top-left pixel.
+  const std::optional<Rgb8> background =
+      o.background || !o.labels ? o.background : std::optional<Rgb8>(Rgb8{0, 0, 0});
+  const ImageComparison c = compare_images(ref_view, test_view, {.background = background});
+  std::optional<LabelComparison> labels;
+  if (o.labels) {
+    labels = compare_labels(ref_view, test_view,
+                            {.palette = kLabelPalette,
+                             .background = background,
+                             .tolerance = o.label_tolerance,
+                             .reference_name = o.reference});
+  }
 
   if (!o.json_output.empty()) {
-    const std::string json = comparison_to_json(c, reference.width, reference.height);
+    const std::string json =
+        comparison_to_json(c, reference.width, reference.height,
+                           labels ? labels_to_json(*labels, o.label_tolerance) : std::string());
     if (o.json_output == "-") {
       std::fputs(json.c_str(), stdout);
       return 0;
@@ -97,6 +184,7 @@ int run_compare(const CompareOptions& o) {
     }
   }
   print_text(o, c, reference.width, reference.height);
+  if (labels) print_labels(*labels, o.label_tolerance);
   return 0;
 }
 
@@ -105,7 +193,7 @@ Command add_compare_command(CLI::App& app) {
   auto background = std::make_shared<std::string>();
   auto* cmd = app.add_subcommand(
       "compare", "Compare a render with a reference image of the same size: PSNR, SSIM, hole "
-                 "pixels, silhouette IoU");
+                 "pixels, silhouette IoU; --labels: face-label metrics");
   cmd->add_option("reference", o->reference, "Reference PNG")
       ->required()
       ->check(CLI::ExistingFile);
@@ -114,11 +202,24 @@ Command add_compare_command(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--background", *background,
                   "Background color R,G,B (0-255) for the silhouette masks (default: the "
-                  "reference's top-left pixel)");
+                  "reference's top-left pixel; with --labels 0,0,0)");
   cmd->add_option("--json", o->json_output,
                   "Also write the metrics as JSON to FILE (- = stdout, instead of text)");
-  return {cmd, [o, background] {
+  cmd->add_flag("--labels", o->labels,
+                "Also the label metrics (hole, overshoot, label error rate, mixed pixels, edge "
+                "displacement, transition width) of an unlit render of a test scene against "
+                "its exact label image (generate --scene T* --reference)");
+  cmd->add_option("--label-tolerance", o->label_tolerance,
+                  "With --labels: a pixel within this many levels (each channel) of a face "
+                  "colour shows that face; farther, it blends faces")
+      ->default_val(2)
+      ->check(CLI::Range(0, 64));
+  return {cmd, [o, background, cmd] {
             if (!background->empty()) o->background = parse_rgb8(*background, "--background");
+            if (!o->labels && cmd->count("--label-tolerance") > 0) {
+              std::fprintf(stderr, "pointillist compare: warning: --label-tolerance is ignored: "
+                                   "it applies with --labels\n");
+            }
             return run_compare(*o);
           }};
 }

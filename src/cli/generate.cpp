@@ -1,10 +1,19 @@
+// `pointillist generate`: point clouds sampled from the analytic scenes, and the sharp-features
+// test scenes with their exact label reference image.
+#include <cctype>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "commands.hpp"
 #include "options.hpp"
+#include "util.hpp"
+#include "pointillist/core/atomic_file.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/io/ply.hpp"
+#include "pointillist/io/png.hpp"
 #include "pointillist/prep/radii.hpp"
 #include "pointillist/scene/analytic.hpp"
 #include "pointillist/scene/csg.hpp"
@@ -13,9 +22,21 @@ namespace pointillist::cli {
 
 namespace {
 
-// Eight well-separated face colours (spec §4.1), so that any blending of two faces shows.
-constexpr Rgb8 kPalette[8] = {{230, 25, 75},  {60, 180, 75},  {0, 130, 200}, {255, 225, 25},
-                              {245, 130, 48}, {145, 30, 180}, {70, 240, 240}, {240, 50, 230}};
+// The exact ray-cast image of the scene, unlit: each pixel its face label's palette colour, the
+// background where the ray misses. The camera is the one `render` builds for the generated
+// .ply with the same camera options: the orbit around the samples' view sphere (the centre of
+// their bounding box and the largest distance to a sample, as the hierarchy built from the file
+// computes it), +Y up (the samples record no other up axis).
+std::vector<Rgb8> reference_image(const GenerateOptions& o, const CsgScene& scene,
+                                  const PointSet& samples) {
+  const Camera camera = make_camera(o.view, view_sphere(samples.positions), samples.up);
+  const CsgImage image = ray_cast_csg_image(scene, camera);
+  std::vector<Rgb8> pixels(image.label.size(), o.background);
+  for (std::size_t i = 0; i < pixels.size(); ++i) {
+    if (image.label[i] != kNoLabel) pixels[i] = kLabelPalette[image.label[i] % 8];
+  }
+  return pixels;
+}
 
 // A CSG test scene of the sharp-features spec: exact normals, a colour per face; J-mode samples
 // also get the dissertation's radius (the mean distance to the 5 nearest), R-mode ones none
@@ -24,26 +45,55 @@ int generate_csg(const GenerateOptions& o) {
   const CsgScene scene = csg_scene(o.scene);
   const bool jittered = o.sampling == "j";
   CsgSamples s = sample_csg(scene, jittered ? SamplingMode::Jittered : SamplingMode::Random, o.seed);
-  for (std::uint32_t label : s.labels) s.points.colors.push_back(kPalette[label % 8]);
+  for (std::uint32_t label : s.labels) s.points.colors.push_back(kLabelPalette[label % 8]);
   if (jittered) {
     ThreadPool pool(o.threads);
     CloudRadiusOptions radius;
     radius.coverage = 1.0f;
     s.points.radii = cloud_radii(s.points.positions, pool, Progress::none(), radius);
   }
+  // The image first: a bad camera option then leaves no file behind.
+  const std::vector<Rgb8> reference =
+      o.reference_output.empty() ? std::vector<Rgb8>{} : reference_image(o, scene, s.points);
   write_ply(o.output, s.points);
+  if (!o.reference_output.empty()) {
+    write_png_rgb8(o.reference_output, o.view.width, o.view.height, reference);
+  }
   if (!o.quiet) {
     std::printf("generated %zu samples of test scene %s (%s sampling, exact normals, a colour "
                 "per face) -> %s\n",
                 s.points.size(), o.scene.c_str(), jittered ? "jittered grid" : "random",
                 o.output.c_str());
+    if (!o.reference_output.empty()) {
+      std::printf("exact label reference (ray cast, unlit, a colour per face) %dx%d -> %s\n",
+                  o.view.width, o.view.height, o.reference_output.c_str());
+    }
   }
   return 0;
+}
+
+void check_options(const GenerateOptions& o) {
+  check_outputs({}, {{"-o", o.output}, {"--reference", o.reference_output}});
+  if (o.reference_output.empty()) return;
+  if (o.scene.empty() || o.scene[0] != 'T') {
+    throw OptionError("--reference writes the exact label image of a sharp-features test scene; "
+                      "give --scene T1 (or another T*), not '" + o.scene + "'");
+  }
+  std::string ext = std::filesystem::path(o.reference_output).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext != ".png") {
+    throw OptionError("--reference " + o.reference_output +
+                      ": the reference is a PNG image; give a path ending in .png");
+  }
 }
 
 }  // namespace
 
 int run_generate(const GenerateOptions& o) {
+  check_options(o);
+  for (const std::string& w : o.warnings) {
+    std::fprintf(stderr, "pointillist generate: warning: %s\n", w.c_str());
+  }
   if (!o.scene.empty() && o.scene[0] == 'T') return generate_csg(o);
   AnalyticScene scene;
   if (o.scene == "demo") {
@@ -91,9 +141,33 @@ Command add_generate_command(CLI::App& app) {
       ->check(CLI::Range(std::size_t{1}, std::size_t{2'000'000'000}));
   cmd->add_option("--seed", o->seed, "Random seed")->default_val(1);
   cmd->add_flag("--with-normals", o->with_normals, "Also write exact normals");
+  cmd->add_option("--reference", o->reference_output,
+                  "Test scenes T*: also write the exact ray-cast image of the scene, unlit, each "
+                  "pixel its face's colour, with the camera `render` uses for the .ply and the "
+                  "same camera options")
+      ->group(kGroupOutput);
+  auto camera = std::make_shared<CameraText>();
+  add_camera_options(cmd, o->view, *camera);
+  auto background = std::make_shared<std::string>("0,0,0");
+  cmd->add_option("--background", *background,
+                  "With --reference: background color R,G,B (0-255; render's default 0,0,0)")
+      ->group(kGroupCamera);
   add_threads(cmd, o->threads);
   cmd->add_flag("-q,--quiet", o->quiet, "No summary line");
-  return {cmd, [o] { return run_generate(*o); }};
+  return {cmd, [o, camera, background, cmd] {
+            parse_camera_options(*camera, o->view);
+            o->background = parse_rgb8(*background, "--background");
+            if (o->reference_output.empty()) {
+              for (const char* name : {"--size", "--view", "--distance", "--fov", "--eye",
+                                       "--target", "--up", "--background"}) {
+                if (cmd->count(name) > 0) {
+                  o->warnings.push_back(std::string(name) +
+                                        " is ignored: it applies to the --reference image");
+                }
+              }
+            }
+            return run_generate(*o);
+          }};
 }
 
 }  // namespace pointillist::cli

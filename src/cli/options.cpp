@@ -105,6 +105,35 @@ Rgb8 parse_rgb8(const std::string& text, const std::string& option) {
           static_cast<std::uint8_t>(c.z)};
 }
 
+void add_camera_options(CLI::App* app, ViewOptions& view, CameraText& text) {
+  app->add_option("--size", text.size, "Image size WxH")
+      ->default_str("1280x720")
+      ->group(kGroupCamera);
+  app->add_option("--view", text.view, "Orbit view AZ,EL in degrees (default 0,0)")
+      ->group(kGroupCamera);
+  app->add_option("--distance", view.distance,
+                  "Eye distance in model radii (default: whole model in view)")
+      ->group(kGroupCamera);
+  app->add_option("--fov", view.fov_deg, "Vertical field of view, degrees")
+      ->default_val(30.0f)
+      ->group(kGroupCamera);
+  app->add_option("--eye", text.eye, "Explicit eye X,Y,Z (with --target)")->group(kGroupCamera);
+  app->add_option("--target", text.target, "Explicit target X,Y,Z (with --eye)")
+      ->group(kGroupCamera);
+  app->add_option("--up", text.up,
+                  "Up vector X,Y,Z: with --eye/--target the camera's (default 0,1,0); otherwise "
+                  "the up axis for --view and --path (default: the model's, +Z for LAS scans, "
+                  "else +Y)")
+      ->group(kGroupCamera);
+}
+
+void parse_camera_options(const CameraText& text, ViewOptions& view) {
+  parse_size_and_view(text.size, text.view, view);
+  if (!text.eye.empty()) view.eye = parse_vec3(text.eye, "--eye");
+  if (!text.target.empty()) view.target = parse_vec3(text.target, "--target");
+  if (!text.up.empty()) view.up = parse_vec3(text.up, "--up");
+}
+
 void add_columns(CLI::App* app, std::string& columns) {
   app->add_option("--columns", columns,
                   "Text inputs (.xyz .pts .csv .txt): what each column holds, e.g. "

@@ -59,6 +59,16 @@ CLI::Option* add_enum(CLI::App* app, const std::string& name, E& target,
   return option;
 }
 
+// The camera options (--size, --view, --distance, --fov, --eye, --target, --up) as typed: `render`
+// takes them, and `generate --reference` too, so that its image matches a render of the
+// generated samples pixel for pixel. parse_camera_options fills `view` from them once CLI11 has
+// read the line; its parsers throw OptionError naming the option.
+struct CameraText {
+  std::string size = "1280x720", view, eye, target, up;
+};
+void add_camera_options(CLI::App* app, ViewOptions& view, CameraText& text);
+void parse_camera_options(const CameraText& text, ViewOptions& view);
+
 void add_columns(CLI::App* app, std::string& columns);
 void add_threads(CLI::App* app, unsigned& threads);
 // The scan preparation options (--normals, --k, --radius-scale, --drop-outliers,

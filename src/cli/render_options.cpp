@@ -13,32 +13,13 @@ namespace {
 
 // Text options parsed after CLI11 has read the line.
 struct RenderText {
-  std::string size = "1280x720", view, eye, target, up, background = "0,0,0", path, memory,
-              read_per_frame;
+  CameraText camera;
+  std::string background = "0,0,0", path, memory, read_per_frame;
+  bool unlit = false;
   bool no_chunk_culling = false;
   bool features = false, no_features = false;
   FeatureOptions feature;
 };
-
-void add_camera(CLI::App* cmd, RenderOptions& o, RenderText& t) {
-  cmd->add_option("--size", t.size, "Image size WxH")->default_str("1280x720")->group(kGroupCamera);
-  cmd->add_option("--view", t.view, "Orbit view AZ,EL in degrees (default 0,0)")
-      ->group(kGroupCamera);
-  cmd->add_option("--distance", o.view.distance,
-                  "Eye distance in model radii (default: whole model in view)")
-      ->group(kGroupCamera);
-  cmd->add_option("--fov", o.view.fov_deg, "Vertical field of view, degrees")
-      ->default_val(30.0f)
-      ->group(kGroupCamera);
-  cmd->add_option("--eye", t.eye, "Explicit eye X,Y,Z (with --target)")->group(kGroupCamera);
-  cmd->add_option("--target", t.target, "Explicit target X,Y,Z (with --eye)")
-      ->group(kGroupCamera);
-  cmd->add_option("--up", t.up,
-                  "Up vector X,Y,Z: with --eye/--target the camera's (default 0,1,0); otherwise "
-                  "the up axis for --view and --path (default: the model's, +Z for LAS scans, "
-                  "else +Y)")
-      ->group(kGroupCamera);
-}
 
 void add_look(CLI::App* cmd, RenderOptions& o, RenderText& t) {
   add_enum<Rasterizer>(cmd, "--mode", o.frame.rasterizer,
@@ -63,6 +44,10 @@ void add_look(CLI::App* cmd, RenderOptions& o, RenderText& t) {
       ->check(CLI::Range(0.01f, 100.0f))
       ->group(kGroupLook);
   cmd->add_option("--background", t.background, "Background color R,G,B (0-255)")
+      ->group(kGroupLook);
+  cmd->add_flag("--unlit", t.unlit,
+                "Show each splat's own colour, unshaded (ambient 1, no diffuse or specular): "
+                "the face colours of generate --scene T*, for compare --labels")
       ->group(kGroupLook);
   add_enum<Reconstruction>(cmd, "--reconstruction", o.frame.quality.reconstruction,
                            {{"zrange", Reconstruction::ZRange},
@@ -201,7 +186,7 @@ std::vector<std::string> ignored_options(const CLI::App& cmd, const RenderOption
       ignored(name, "it prepares scans, and the inputs are splat models");
     }
   }
-  if (!t.eye.empty() || !t.target.empty()) {
+  if (!t.camera.eye.empty() || !t.camera.target.empty()) {
     ignored("--view", "--eye/--target place the camera");
     ignored("--distance", "--eye/--target place the camera");
   }
@@ -224,7 +209,7 @@ Command add_render_command(CLI::App& app) {
       ->group(kGroupOutput);
   cmd->add_option("--stats", o->stats_output, "Write statistics as JSON (- = stdout)")
       ->group(kGroupOutput);
-  add_camera(cmd, *o, *t);
+  add_camera_options(cmd, o->view, t->camera);
   add_look(cmd, *o, *t);
   add_detail(cmd, *o, *t);
   add_features(cmd, *t);
@@ -244,11 +229,13 @@ Command add_render_command(CLI::App& app) {
               o->features = t->feature;
             }
             o->frame.features = !t->no_features;
-            parse_size_and_view(t->size, t->view, o->view);
-            if (!t->eye.empty()) o->view.eye = parse_vec3(t->eye, "--eye");
-            if (!t->target.empty()) o->view.target = parse_vec3(t->target, "--target");
-            if (!t->up.empty()) o->view.up = parse_vec3(t->up, "--up");
+            parse_camera_options(t->camera, o->view);
             o->settings.background = parse_rgb8(t->background, "--background");
+            if (t->unlit) {
+              o->settings.ambient = 1.0f;
+              o->settings.diffuse = 0.0f;
+              o->settings.specular = 0.0f;
+            }
             if (!t->path.empty()) o->orbit_frames = parse_orbit_path(t->path);
             if (!t->memory.empty()) o->memory_cap = parse_bytes(t->memory, "--memory");
             if (!t->read_per_frame.empty()) {

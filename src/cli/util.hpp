@@ -3,9 +3,18 @@
 
 #include <string>
 
+#include "pointillist/core/math.hpp"
+
 namespace pointillist::cli {
 
 // "1.23 MB"-style size.
 std::string human_bytes(double bytes);
+
+// Eight well-separated face colours (spec §4.1), so that any blending of two faces shows:
+// `generate --scene T*` colours face label l with kLabelPalette[l % 8], samples and --reference
+// image alike, and `compare --labels` reads the labels back from them.
+inline constexpr Rgb8 kLabelPalette[8] = {{230, 25, 75},  {60, 180, 75},  {0, 130, 200},
+                                          {255, 225, 25}, {245, 130, 48}, {145, 30, 180},
+                                          {70, 240, 240}, {240, 50, 230}};
 
 }  // namespace pointillist::cli

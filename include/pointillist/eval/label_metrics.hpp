@@ -1,0 +1,142 @@
+// Label metrics of the sharp-features specification (specs/sharp-features.md §4.5) measured from
+// two images: an exact reference that shows each pixel's face label as a palette colour (or the
+// background), and a test render of the same view drawn UNLIT with the same palette, so that a
+// test pixel shows one palette colour unless it blends surfaces.
+//
+// Labels. A reference pixel's label L*(p) is the palette entry within `tolerance` levels (every
+// channel) of its colour, or background when it equals the background colour exactly; any other
+// colour is an error. A test pixel's label L(p) is background when it equals the background
+// colour, else the palette entry within `tolerance` levels, else MIXED (a blend of surfaces, or
+// of a surface and the background). Faces that share a palette colour are one label.
+//
+// Pixel sets (all Chebyshev distances in pixels, 8-neighbourhoods; outside the image counts as
+// background):
+//   covered C*      reference pixels with a label;
+//   interior I      covered pixels whose 8 neighbours are covered (count_holes' interior): the
+//                   pixels "off the silhouette";
+//   boundary ∂      covered pixels with a 4-neighbour of another covered label: both sides of a
+//                   crease or intersection curve as it projects; silhouettes (label next to
+//                   background) are not boundaries;
+//   band B_k        covered pixels within k px of a boundary pixel (∂ ⊂ B_k).
+//
+// Metrics:
+//   HOLE        interior pixels that are background in the test (count_holes on the two
+//               foreground masks; a MIXED pixel is foreground).
+//   OVERSHOOT   test pixels that are not background where the reference is background more than
+//               1 px from every covered reference pixel (the 1 px allows the renderer's 0.75 px
+//               screen low-pass); out of the reference background pixels that far away.
+//   LER         pixels of B_4 (resp. of C*) whose L differs from L* (another label, MIXED or
+//               background), over |B_4| (resp. |C*|).
+//   WRONG       covered pixels whose L is another palette label (a pure wrong colour).
+//   MIX         MIXED test pixels at interior pixels (over all of I, and inside B_8 ∩ I), and
+//               the latter per boundary pixel (∂ counts both sides of a crease, so a crease of
+//               length ℓ px seen straight has about 2ℓ boundary pixels). MIXED test pixels outside
+//               I (on or beyond the reference silhouette) are counted apart.
+//   EDGE DISPLACEMENT and TRANSITION WIDTH on profiles across the reference label boundaries:
+//     - direction: at boundary pixel p of label a, the normal n is the normalised sum of the
+//       offsets q − p to the pixels q of another covered label in the 7×7 window around p (it
+//       points across the boundary);
+//     - samples: the pixels nearest to p + t·n for t = −⌊L/2⌋, …, L − 1 − ⌊L/2⌋ (L samples
+//       1 px apart, p itself among them; L = profile_length_px = 40);
+//     - a profile is valid when every sample lies in the image and is covered in the reference,
+//       and the reference labels along it are a…a b…b (two labels, one switch); this keeps
+//       profiles away from corners, crease ends and silhouettes (the spec's "middle 60 %" of
+//       each crease, which two images cannot delimit);
+//     - up to max_profiles valid profiles are used, evenly spaced in raster order of the
+//       valid boundary pixels;
+//     - the reference switch s* lies halfway between the last a and the first b sample; the
+//       test switch s is the split of the samples into "a before, b after" that disagrees with
+//       the fewest test labels (MIXED and background disagree with both), the mean of all
+//       splits that tie; a profile whose test samples show no a or no b is not measured
+//       (counted as unmatched);
+//     - EDGE DISPLACEMENT |Δ| = |s − s*| in px (mean and max over the measured profiles);
+//     - TRANSITION WIDTH: the number of MIXED samples of the profile whose share w of a lies in
+//       (0.1, 0.9), w the least-squares fit of the sample's colour c ≈ w·c_a + (1 − w)·c_b
+//       clamped to [0, 1] (mean and max over the measured profiles).
+//
+// Left out: the see-through part of HOLE (L ≠ L* and the test's depth behind the reference's by
+// more than 2 mean splat radii) needs depth, which colour images do not carry; normal error and
+// the weight of a second label (MIX's 2 % threshold) need the renderer's debug output. The
+// tolerance decides which blends show: one whose second colour carries weight w moves some
+// channel by w·d levels, d the largest channel difference of the two colours, so it is MIXED
+// when w·d > tolerance + 0.5.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "pointillist/core/math.hpp"
+#include "pointillist/eval/image_compare.hpp"
+
+namespace pointillist {
+
+struct LabelCompareOptions {
+  // The label colours, index = label. At most 250 entries, no two within 2·tolerance + 1 levels
+  // of each other or of the background.
+  std::span<const Rgb8> palette;
+  // Background colour of both images; unset = the reference's top-left pixel.
+  std::optional<Rgb8> background;
+  // Largest per-channel difference (levels) at which a pixel still shows a palette colour.
+  // 2 absorbs the rounding of a renderer's blend of one colour; raise it for noisier renders,
+  // lower it to see fainter blends (see the top of this file).
+  int tolerance = 2;
+  int band_px = 4;       // k of B_k for LER (the spec's B_4)
+  int mix_band_px = 8;   // k of B_k for MIX (the spec's B_8)
+  int max_profiles = 64;         // profiles for edge displacement and transition width
+  int profile_length_px = 40;    // samples per profile (one a pixel)
+  // Names the reference in error messages (e.g. its path).
+  std::string reference_name = "the reference";
+};
+
+// Codes of label_image: palette indices are 0 … palette.size() − 1.
+constexpr std::uint8_t kLabelBackground = 254;
+constexpr std::uint8_t kLabelMixed = 255;
+
+struct LabelComparison {
+  Rgb8 background;
+  std::uint64_t covered_count = 0;        // |C*|
+  std::uint64_t interior_count = 0;       // |I|
+  std::uint64_t boundary_count = 0;       // |∂|
+  std::uint64_t hole_count = 0;           // HOLE (interior pixels background in the test)
+  std::uint64_t far_background_count = 0; // reference background pixels > 1 px from C*
+  std::uint64_t overshoot_count = 0;      // OVERSHOOT: of those, not background in the test
+  std::uint64_t band_count = 0;           // |B_4|
+  std::uint64_t band_error_count = 0;     // pixels of B_4 with L ≠ L*
+  double ler_band = 0;                    // band_error_count / band_count (0 when empty)
+  std::uint64_t covered_error_count = 0;  // pixels of C* with L ≠ L*
+  double ler_covered = 0;                 // covered_error_count / covered_count
+  std::uint64_t wrong_count = 0;          // pixels of C* showing another palette label
+  std::uint64_t mixed_count = 0;          // MIX: MIXED test pixels at interior pixels
+  std::uint64_t mix_band_count = 0;       // |B_8 ∩ I|
+  std::uint64_t mixed_band_count = 0;     // MIXED test pixels in B_8 ∩ I
+  double mixed_per_boundary_px = 0;       // mixed_band_count / boundary_count
+  std::uint64_t mixed_outside_count = 0;  // MIXED test pixels outside I
+  std::uint64_t profile_count = 0;        // measured profiles
+  std::uint64_t unmatched_profile_count = 0;  // valid profiles whose test lacks a or b
+  double displacement_mean_px = 0, displacement_max_px = 0;  // EDGE DISPLACEMENT |Δ|
+  double transition_mean_px = 0, transition_max_px = 0;      // TRANSITION WIDTH
+};
+
+// The label of every pixel of `image` (row-major): a palette index, kLabelBackground or
+// kLabelMixed, as the test image's labels are defined above. Throws Error when the palette is
+// empty or has more than 250 colours.
+std::vector<std::uint8_t> label_image(ImageRgb8View image, std::span<const Rgb8> palette,
+                                      Rgb8 background, int tolerance);
+
+// The reference's labels: as label_image, but a pixel that is neither background nor a palette
+// colour is an Error naming the pixel (x, y), its colour and options.reference_name.
+std::vector<std::uint8_t> reference_label_image(ImageRgb8View reference,
+                                                const LabelCompareOptions& options,
+                                                Rgb8 background);
+
+// Every metric above for `test` against `reference` (same size). Throws Error when the sizes
+// differ or are empty, the options are out of range (palette, tolerance, band widths, profile
+// length), the palette colours are not told apart at this tolerance (naming the two entries), or
+// the reference holds a colour that is not background or a palette colour (naming the pixel).
+LabelComparison compare_labels(ImageRgb8View reference, ImageRgb8View test,
+                               const LabelCompareOptions& options);
+
+}  // namespace pointillist

@@ -1,0 +1,230 @@
+// Label metrics (spec §4.5 from two images) on hand-built images with known answers: a square of
+// two labels split by a straight boundary, and test images that move, blend, hole or overshoot it.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "pointillist/core/error.hpp"
+#include "pointillist/eval/label_metrics.hpp"
+
+using namespace pointillist;
+
+namespace {
+
+constexpr Rgb8 kPalette[3] = {{230, 25, 75}, {60, 180, 75}, {0, 130, 200}};
+constexpr Rgb8 kBlack{0, 0, 0};
+constexpr int kSize = 64, kLo = 8, kHi = 56;  // the square [8, 56)² on a 64×64 black image
+
+struct Image {
+  int width = kSize, height = kSize;
+  std::vector<Rgb8> pixels = std::vector<Rgb8>(std::size_t(kSize) * kSize, kBlack);
+  Rgb8& at(int x, int y) { return pixels[std::size_t(y) * width + x]; }
+  ImageRgb8View view() const { return {width, height, pixels}; }
+};
+
+// The square, label 0 left of column `split` and label 1 from it on (vertical boundary), or
+// above row `split` and below it (horizontal).
+Image two_labels(int split, bool vertical = true) {
+  Image img;
+  for (int y = kLo; y < kHi; ++y) {
+    for (int x = kLo; x < kHi; ++x) img.at(x, y) = kPalette[(vertical ? x : y) < split ? 0 : 1];
+  }
+  return img;
+}
+
+Rgb8 blend(Rgb8 a, Rgb8 b, double share_of_a) {
+  const auto mix = [&](int u, int v) {
+    return static_cast<std::uint8_t>(u * share_of_a + v * (1 - share_of_a) + 0.5);
+  };
+  return {mix(a.r, b.r), mix(a.g, b.g), mix(a.b, b.b)};
+}
+
+LabelComparison compare(const Image& ref, const Image& test) {
+  return compare_labels(ref.view(), test.view(), {.palette = kPalette});
+}
+
+}  // namespace
+
+TEST(LabelMetrics, IdenticalImagesHaveNoErrors) {
+  const Image ref = two_labels(32);
+  const LabelComparison c = compare(ref, ref);
+  EXPECT_EQ(c.covered_count, 48u * 48u);
+  EXPECT_EQ(c.interior_count, 46u * 46u);
+  EXPECT_EQ(c.boundary_count, 2u * 48u);      // columns 31 and 32
+  EXPECT_EQ(c.band_count, 10u * 48u);         // columns 27..36
+  EXPECT_EQ(c.far_background_count, 64u * 64u - 50u * 50u);
+  EXPECT_EQ(c.hole_count + c.overshoot_count + c.covered_error_count + c.mixed_count, 0u);
+  EXPECT_EQ(c.ler_band, 0.0);
+  EXPECT_EQ(c.profile_count, 64u);
+  EXPECT_EQ(c.displacement_max_px, 0.0);
+  EXPECT_EQ(c.transition_max_px, 0.0);
+}
+
+TEST(LabelMetrics, BoundaryMovedTwoPixelsIsDisplacedByTwo) {
+  for (bool vertical : {true, false}) {
+    const LabelComparison c = compare(two_labels(32, vertical), two_labels(34, vertical));
+    EXPECT_EQ(c.profile_count, 64u);
+    EXPECT_DOUBLE_EQ(c.displacement_mean_px, 2.0);
+    EXPECT_DOUBLE_EQ(c.displacement_max_px, 2.0);
+    EXPECT_EQ(c.transition_max_px, 0.0);
+    // Two columns (rows) of 48 pixels show the wrong label: inside B_4 and among C*.
+    EXPECT_EQ(c.wrong_count, 96u);
+    EXPECT_EQ(c.band_error_count, 96u);
+    EXPECT_DOUBLE_EQ(c.ler_band, 96.0 / 480.0);
+    EXPECT_DOUBLE_EQ(c.ler_covered, 96.0 / 2304.0);
+    EXPECT_EQ(c.mixed_count, 0u);
+    EXPECT_EQ(c.hole_count, 0u);
+  }
+}
+
+TEST(LabelMetrics, DiagonalBoundaryMovedIsDisplacedAlongItsNormal) {
+  // x − y < 0 against x − y < 4: moved 4/√2 ≈ 2.83 px along the normal; the profiles step in
+  // whole pixels along the diagonal, so the measure lies within a pixel of it.
+  Image ref, test;
+  for (int y = kLo; y < kHi; ++y) {
+    for (int x = kLo; x < kHi; ++x) {
+      ref.at(x, y) = kPalette[x - y < 0 ? 0 : 1];
+      test.at(x, y) = kPalette[x - y < 4 ? 0 : 1];
+    }
+  }
+  const LabelComparison c = compare(ref, test);
+  ASSERT_GT(c.profile_count, 0u);
+  EXPECT_GT(c.displacement_mean_px, 1.83);
+  EXPECT_LT(c.displacement_mean_px, 3.83);
+}
+
+TEST(LabelMetrics, BlendedStripIsItsTransitionWidth) {
+  const Image ref = two_labels(32);
+  Image test = ref;
+  // Columns 31, 32, 33 blend the two labels half and half.
+  for (int y = kLo; y < kHi; ++y) {
+    for (int x = 31; x <= 33; ++x) test.at(x, y) = blend(kPalette[0], kPalette[1], 0.5);
+  }
+  const LabelComparison c = compare(ref, test);
+  EXPECT_EQ(c.profile_count, 64u);
+  EXPECT_DOUBLE_EQ(c.transition_mean_px, 3.0);
+  EXPECT_DOUBLE_EQ(c.transition_max_px, 3.0);
+  // The best splits put the switch anywhere in the strip: at 31, 32, 33 or 34 (first pixel of
+  // the right label), mean 32.5 against the reference's 32.
+  EXPECT_DOUBLE_EQ(c.displacement_max_px, 0.5);
+  EXPECT_EQ(c.mixed_count, 3u * 46u);       // interior rows 9..54
+  EXPECT_EQ(c.mixed_band_count, 3u * 46u);
+  EXPECT_EQ(c.mixed_outside_count, 3u * 2u);  // rows 8 and 55 touch the silhouette
+  EXPECT_DOUBLE_EQ(c.mixed_per_boundary_px, 138.0 / 96.0);
+}
+
+TEST(LabelMetrics, FaintBlendsAreMixedButNotTransition) {
+  const Image ref = two_labels(32);
+  Image test = ref;
+  // Shares of the left label 0.95, 0.5, 0.5, 0.05: all four mixed, two in the transition.
+  const double shares[4] = {0.95, 0.5, 0.5, 0.05};
+  for (int y = kLo; y < kHi; ++y) {
+    for (int k = 0; k < 4; ++k) test.at(30 + k, y) = blend(kPalette[0], kPalette[1], shares[k]);
+  }
+  const LabelComparison c = compare(ref, test);
+  EXPECT_EQ(c.mixed_count, 4u * 46u);
+  EXPECT_DOUBLE_EQ(c.transition_max_px, 2.0);
+  EXPECT_DOUBLE_EQ(c.transition_mean_px, 2.0);
+}
+
+TEST(LabelMetrics, ColoursWithinTheToleranceKeepTheirLabel) {
+  const Image ref = two_labels(32);
+  Image test = ref;
+  const Rgb8 a = kPalette[0];
+  test.at(12, 12) = {std::uint8_t(a.r - 2), std::uint8_t(a.g + 2), a.b};  // within 2 levels
+  test.at(14, 12) = {std::uint8_t(a.r - 3), a.g, a.b};                     // 3 levels off
+  const LabelComparison c = compare(ref, test);
+  EXPECT_EQ(c.mixed_count, 1u);
+  EXPECT_EQ(c.covered_error_count, 1u);
+  const LabelComparison loose =
+      compare_labels(ref.view(), test.view(), {.palette = kPalette, .tolerance = 3});
+  EXPECT_EQ(loose.mixed_count, 0u);
+}
+
+TEST(LabelMetrics, HoleOfKnownSize) {
+  const Image ref = two_labels(32);
+  Image test = ref;
+  for (int y = 20; y < 24; ++y) {
+    for (int x = 12; x < 17; ++x) test.at(x, y) = kBlack;  // 5×4 inside label 0
+  }
+  test.at(kLo, 40) = kBlack;  // on the silhouette: a miss, not a hole
+  const LabelComparison c = compare(ref, test);
+  EXPECT_EQ(c.hole_count, 20u);
+  EXPECT_EQ(c.covered_error_count, 21u);
+  EXPECT_EQ(c.wrong_count, 0u);
+  EXPECT_EQ(c.mixed_count, 0u);
+  EXPECT_EQ(c.band_error_count, 0u);
+}
+
+TEST(LabelMetrics, OvershootBeyondOnePixelOfTheSilhouette) {
+  const Image ref = two_labels(32);
+  Image test = ref;
+  for (int y = kLo; y < kHi; ++y) {
+    for (int x = 4; x < kLo; ++x) test.at(x, y) = kPalette[0];  // columns 4..7
+  }
+  test.at(60, 2) = blend(kPalette[0], kBlack, 0.5);  // a stray blend far away
+  const LabelComparison c = compare(ref, test);
+  // Column 7 touches the square (within 1 px): columns 4, 5, 6 of 48 rows, and the stray pixel.
+  EXPECT_EQ(c.overshoot_count, 3u * 48u + 1u);
+  EXPECT_EQ(c.far_background_count, 64u * 64u - 50u * 50u);
+  EXPECT_EQ(c.mixed_outside_count, 1u);
+  EXPECT_EQ(c.covered_error_count, 0u);
+}
+
+TEST(LabelMetrics, MixedPixelsCountedInsideAndOutsideTheBand) {
+  const Image ref = two_labels(32);
+  Image test = ref;
+  const Rgb8 grey{128, 128, 128};
+  for (int k = 0; k < 5; ++k) test.at(12 + k, 40) = grey;  // interior, far from the boundary
+  test.at(36, 20) = grey;                                   // interior, 4 px from column 32
+  test.at(45, kLo) = grey;                                  // on the silhouette
+  const LabelComparison c = compare(ref, test);
+  EXPECT_EQ(c.mixed_count, 6u);
+  EXPECT_EQ(c.mixed_band_count, 1u);
+  EXPECT_EQ(c.mixed_outside_count, 1u);
+  EXPECT_EQ(c.mix_band_count, 18u * 46u);  // columns 23..40 of the interior rows
+  EXPECT_EQ(c.wrong_count, 0u);
+}
+
+TEST(LabelMetrics, TestWithoutOneOfTheLabelsIsUnmatched) {
+  Image test;
+  for (int y = kLo; y < kHi; ++y) {
+    for (int x = kLo; x < kHi; ++x) test.at(x, y) = kPalette[2];
+  }
+  const LabelComparison c = compare(two_labels(32), test);
+  EXPECT_EQ(c.profile_count, 0u);
+  EXPECT_EQ(c.unmatched_profile_count, 64u);
+  EXPECT_EQ(c.wrong_count, 48u * 48u);
+  EXPECT_DOUBLE_EQ(c.ler_covered, 1.0);
+}
+
+TEST(LabelMetrics, ReferenceColourOutsideThePaletteNamesThePixel) {
+  Image ref = two_labels(32);
+  ref.at(40, 30) = {1, 2, 3};
+  try {
+    compare_labels(ref.view(), ref.view(), {.palette = kPalette, .reference_name = "ref.png"});
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("ref.png: pixel (40, 30) is 1,2,3"), std::string::npos) << m;
+    EXPECT_NE(m.find("generate --reference"), std::string::npos) << m;
+  }
+}
+
+TEST(LabelMetrics, RejectsPaletteThatCannotBeToldApartAndSizeMismatch) {
+  const Image ref = two_labels(32);
+  const Rgb8 close[2] = {{100, 100, 100}, {103, 100, 100}};
+  try {
+    compare_labels(ref.view(), ref.view(), {.palette = close});
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("palette colours 0 and 1"), std::string::npos)
+        << e.what();
+  }
+  const Rgb8 dark[1] = {{2, 0, 0}};
+  EXPECT_THROW(compare_labels(ref.view(), ref.view(), {.palette = dark}), Error);
+  std::vector<Rgb8> small(32 * 32, kBlack);
+  EXPECT_THROW(compare_labels(ref.view(), {32, 32, small}, {.palette = kPalette}), Error);
+  EXPECT_THROW(compare_labels(ref.view(), ref.view(), {}), Error);  // no palette
+}
