@@ -30,6 +30,12 @@ std::string render_report_json(const RenderReport& r) {
   j["nodes_visited"] = s.nodes_visited;
   j["culled_frustum"] = s.culled_frustum;
   j["culled_backface"] = s.culled_backface;
+  if (r.frame.features) {
+    // Sharp features drawn in the last frame (zeros when no model has them).
+    j["clipped_splats"] = s.clipped_splats;
+    j["clipped_fragments"] = s.clipped_fragments;
+    j["other_surface_fragments"] = s.other_surface_fragments;
+  }
   j["width"] = s.width;
   j["height"] = s.height;
   j["threads"] = s.threads;

@@ -69,6 +69,15 @@ void frame_pass(const Camera& camera, const RenderSettings& settings,
     rasterize_splats(frame.splats, cam, settings, pool, frame.scratch, frame.color, frame.depth);
   }
   fill_stats(frame, selection, cam, pool.thread_count(), start, selected, Clock::now());
+  if (frame.splats.has_features) {
+    RenderStats& s = frame.stats;
+    for (std::size_t c = 0; c < frame.splats.chunk_count; ++c) {
+      const SplatChunk& chunk = frame.splats.chunks[c];
+      for (std::size_t i = 0; i < chunk.count; ++i) s.clipped_splats += clip_count(chunk.clip_code[i]) != 0;
+    }
+    s.clipped_fragments = quality ? scratch->clipped_fragments : frame.scratch.clipped_fragments;
+    s.other_surface_fragments = quality ? scratch->other_surface_fragments : 0;
+  }
 }
 
 }  // namespace pointillist::render_detail

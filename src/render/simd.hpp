@@ -45,6 +45,10 @@ inline Float4 sqrt4(Float4 v) {
 #endif
 }
 // Truncation toward zero (the lanes must be within the int range).
+// Lanes set in a mask (each -1 or 0).
+inline std::uint64_t lane_count(Int4 m) {
+  return static_cast<std::uint64_t>(-(m[0] + m[1] + m[2] + m[3]));
+}
 inline Int4 to_int4(Float4 v) { return __builtin_convertvector(v, Int4); }
 inline Float4 to_float4(Int4 v) { return __builtin_convertvector(v, Float4); }
 

@@ -321,6 +321,85 @@ TEST(FeaturesRender, PagedModelsDrawThemAsModelsHeldWhole) {
   }
 }
 
+// The frame's statistics of what the features did, for the fast rasterizer against a brute-force
+// count: every pixel centre inside a clipped splat's circle (or, covering none, the pixel holding
+// its centre) whose ray meets the splat's plane where its planes discard (clip_discards).
+TEST(FeaturesRender, StatisticsCountClippedFragmentsAndOtherSurfaces) {
+  ThreadPool pool(2);
+  const auto m = make_model("T1", pool);
+  const Camera cam = look({2.0f, 2.1f, 1.9f}, {1, 1, 1}, 128);
+  RenderSettings settings;
+  settings.shape = SplatShape::Circle;
+  FrameSettings fs;
+  Renderer renderer;
+  Frame frame;
+  const SceneInstance instance{&m->render, {}};
+  renderer.render({&instance, 1}, cam, settings, fs, pool, frame);
+  const CameraFrame cf = make_camera_frame(cam);
+  std::uint64_t clipped_splats = 0, oracle = 0;
+  for (std::size_t c = 0; c < frame.splats.chunk_count; ++c) {
+    const SplatChunk& ch = frame.splats.chunks[c];
+    for (std::size_t i = 0; i < ch.count; ++i) {
+      const std::uint32_t count = clip_count(ch.clip_code[i]);
+      if (count == 0) continue;
+      ++clipped_splats;
+      const std::span<const ClipPlane> planes(ch.clip_planes.data() + ch.clip_first[i], count);
+      const float r = 0.5f * ch.size_px[i], x = ch.x_px[i], y = ch.y_px[i];
+      const auto discards = [&](int px, int py) {
+        const Vec3f ray = pixel_ray(cf, px, py);
+        const float t = dot(ch.normal[i], ch.center[i] - cf.eye) / dot(ch.normal[i], ray);
+        const Vec3f p = t > 0 && std::isfinite(t) ? cf.eye + ray * t : ch.center[i];
+        return clip_discards(planes, clip_mode(ch.clip_code[i]), p);
+      };
+      bool any = false;
+      for (int py = std::max(0, int(y - r) - 1); py <= std::min(127, int(y + r) + 1); ++py) {
+        for (int px = std::max(0, int(x - r) - 1); px <= std::min(127, int(x + r) + 1); ++px) {
+          const float dx = px + 0.5f - x, dy = py + 0.5f - y;
+          if (dx * dx + dy * dy > r * r) continue;
+          any = true;
+          oracle += discards(px, py);
+        }
+      }
+      if (!any && x >= 0 && y >= 0 && x < 128 && y < 128) oracle += discards(int(x), int(y));
+    }
+  }
+  const RenderStats& st = frame.stats;
+  std::cout << "fast: clipped splats " << st.clipped_splats << " fragments "
+            << st.clipped_fragments << " (brute force " << oracle << ")\n";
+  EXPECT_EQ(st.clipped_splats, clipped_splats);
+  EXPECT_GT(oracle, 500u);
+  EXPECT_NEAR(double(st.clipped_fragments), double(oracle), 0.01 * double(oracle));
+  EXPECT_EQ(st.other_surface_fragments, 0u);  // the fast mode draws opaque discs
+
+  // Quality: fragments clipped at the cube's creases (its discs reach further: the low-pass
+  // and the drawn radius); fragments of the other sphere left out where T9's spheres cross (no
+  // clip there: the ids separate them), the same for any thread count; none of either on the
+  // smooth sphere, and none counted without features.
+  fs.rasterizer = Rasterizer::Quality;
+  renderer.render({&instance, 1}, cam, settings, fs, pool, frame);
+  EXPECT_GT(frame.stats.clipped_fragments, oracle / 4);
+  const auto spheres = make_model("T9", pool);
+  const SceneInstance crossing{&spheres->render, {}};
+  const Camera curve = look({0.3f, 0.6f, 2.05f}, {0, 0, 0.8f}, 128);
+  renderer.render({&crossing, 1}, curve, settings, fs, pool, frame);
+  std::cout << "T9 quality: other-surface fragments " << frame.stats.other_surface_fragments
+            << ", clipped " << frame.stats.clipped_fragments << "\n";
+  EXPECT_GT(frame.stats.other_surface_fragments, 100u);
+  const std::uint64_t two_threads = frame.stats.other_surface_fragments;
+  ThreadPool one(1);
+  renderer.render({&crossing, 1}, curve, settings, fs, one, frame);
+  EXPECT_EQ(frame.stats.other_surface_fragments, two_threads);
+  fs.features = false;
+  renderer.render({&crossing, 1}, curve, settings, fs, pool, frame);
+  EXPECT_EQ(frame.stats.clipped_fragments + frame.stats.other_surface_fragments, 0u);
+  const auto sphere = make_model("T13", pool);
+  const SceneInstance smooth{&sphere->render, {}};
+  fs.features = true;
+  renderer.render({&smooth, 1}, look({1.5f, 1.2f, 2.5f}, {0, 0, 0}, 128), settings, fs, pool,
+                  frame);
+  EXPECT_EQ(frame.stats.clipped_fragments + frame.stats.other_surface_fragments, 0u);
+}
+
 TEST(FeaturesRender, QuantizedModelsKeepMostOfIt) {
   // The same scenes as a .ptl v2 file decodes them: centres, normals and radii quantized, colours
   // in RGB 565 (so the pure-colour test compares with the quantized palette).

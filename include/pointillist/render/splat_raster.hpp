@@ -24,6 +24,7 @@ struct RasterScratch {
   };
   std::vector<Chunk> chunks;
   std::vector<Buffer<std::uint32_t>> band_colors;  // one packed-color band per thread
+  std::uint64_t clipped_fragments = 0;  // the last frame's (RenderStats::clipped_fragments)
 };
 
 // Clears color to settings.background and depth to +infinity, then draws every splat of

@@ -86,6 +86,11 @@ struct Band {
   float* acc;      // kGroupFloats per group
   float* layer;    // kLayerFloats per group (layered rendering only)
   float* ids;      // kIdFloats per group (opaque rendering with features only)
+  // The worker's counts (features only): covered pixels discarded by clip planes, counted in
+  // the first pass that clips; fragments of another surface than the pixel's front one, counted
+  // in the accumulation pass.
+  std::uint64_t* clipped;
+  std::uint64_t* other_surface;
   float* ids_at(int j, int k) const {
     return ids + (static_cast<std::size_t>(j - row0) * groups + k) * kIdFloats;
   }
@@ -153,7 +158,12 @@ void draw_splat(const float* s, const float* planes, const View& v, const Band& 
       if (!any4(cover)) continue;
       if constexpr (kFeat != kNoFeatures) {
         if (float_to_bits(s[kClipCode]) & 31u) {
-          cover &= ~clipped_lanes(s, planes, t, a, b, u, valid);
+          const Int4 cut = cover & clipped_lanes(s, planes, t, a, b, u, valid);
+          // Counted once a frame: in the first pass of the opaque or the layered rule.
+          if (kFeat == kFindFront || (kFeat == kClipOnly && !kAccumulate)) {
+            *band.clipped += render_detail::lane_count(cut);
+          }
+          cover &= ~cut;
           if (!any4(cover)) continue;
         }
       }
@@ -174,7 +184,11 @@ void draw_splat(const float* s, const float* planes, const View& v, const Band& 
         Int4 id;
         std::memcpy(&id, band.ids_at(j, k) + kFrontId * kLanes, sizeof id);
         const std::int32_t mine = static_cast<std::int32_t>(float_to_bits(s[kSurface]));
-        if (mine != kMixedId) cover &= (id == mine) | (id == kMixedId);
+        if (mine != kMixedId) {
+          const Int4 same = (id == mine) | (id == kMixedId);
+          if constexpr (kAccumulate) *band.other_surface += render_detail::lane_count(cover & ~same);
+          cover &= same;
+        }
         if (!any4(cover)) continue;
       }
       float* acc = band.acc_at(j, k);
@@ -468,13 +482,16 @@ void rasterize_quality(const SplatStream& stream, const CameraFrame& camera, con
   }
   const std::size_t band_count = static_cast<std::size_t>(bands.count);
   std::atomic<std::size_t> next_band{0};
+  std::atomic<std::uint64_t> clipped{0}, other_surface{0};
   pool.run(workers, [&](std::size_t worker) {
     float* buffer = scratch.band_buffers[worker].data();
+    std::uint64_t clipped_here = 0, other_here = 0;
     for (std::size_t b = next_band++; b < band_count; b = next_band++) {
       const int row0 = static_cast<int>(b) * bands.rows;
       const Band band{row0, std::min(camera.height, row0 + bands.rows), groups, buffer,
                       buffer + band_groups * kGroupFloats,
-                      buffer + band_groups * (kGroupFloats + (layered ? kLayerFloats : 0))};
+                      buffer + band_groups * (kGroupFloats + (layered ? kLayerFloats : 0)),
+                      &clipped_here, &other_here};
       clear_planes(band, layered, surface_rule);
       if (surface_rule) {
         band_pass(stream, scratch, b, band_count, v, band,
@@ -513,7 +530,11 @@ void rasterize_quality(const SplatStream& stream, const CameraFrame& camera, con
       }
       band_shader.finish_layers(band, out);
     }
+    clipped += clipped_here;
+    other_surface += other_here;
   });
+  scratch.clipped_fragments = clipped;
+  scratch.other_surface_fragments = other_surface;
 }
 
 }  // namespace pointillist

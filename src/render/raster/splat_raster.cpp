@@ -56,6 +56,7 @@ struct Target {
   int width, height;
   int row_begin, row_end;
   float width_f, height_f;
+  std::uint64_t* clipped;  // the worker's count of covered pixels discarded by clip planes
 };
 
 // v clamped to [lo, hi]; NaN gives lo. Keeps coordinates of splats next to the eye (huge or
@@ -84,7 +85,9 @@ inline void plot(const Target& t, int i, int j, float z, std::uint32_t c) {
 // No clip test: every covered pixel is drawn.
 struct NoClip {
   Int4 operator()(Float4, float) const { return Int4{}; }
+  void tally(Int4) const {}
 };
+
 
 // The clip test of a splat with sharp-feature planes (clip_lanes.hpp), per pixel: the pixel's
 // ray meets the splat's plane at P (the centre where it misses); one plane test per plane.
@@ -94,6 +97,9 @@ struct PixelClip {
   const float* planes;
   std::uint32_t count;
   ClipMode mode;
+  std::uint64_t* discarded;  // the band's count of covered pixels discarded
+  // Adds the lanes of `m` (covered pixels this test discarded) to the count.
+  void tally(Int4 m) const { *discarded += render_detail::lane_count(m); }
   // Lanes of pixel centres (px, py) whose fragment is discarded.
   Int4 operator()(Float4 px, float py) const {
     const Float4 a = (px - half_w) * inv_f;
@@ -159,13 +165,20 @@ inline void fill_box(const Target& t, const PixelBox& b, float x, float y, float
     // (s + k + 0.5) is exact, so each lane rounds once, as nearest_centre does.
     const Float4 px = static_cast<float>(s) + lane_centre;
     const auto row_test = inside(px - x);
+    // Lanes of pixels before i were seen by the previous group (the last group shifted left).
+    [[maybe_unused]] const Int4 fresh = Int4{0, 1, 2, 3} + s >= i;
     float* depth = t.depth + static_cast<std::size_t>(b.j0) * w + s;
     std::uint32_t* color = t.color + static_cast<std::size_t>(b.j0 - t.row_begin) * w + s;
     float cy = static_cast<float>(b.j0) + 0.5f;
     for (int j = b.j0; j <= b.j1; ++j, cy += 1.0f, depth += w, color += w) {
       const Float4 old_depth = load4(depth);
-      Int4 m = row_test(cy - y) & (zv < old_depth);
-      if constexpr (!std::is_same_v<Clip, NoClip>) m &= ~clip(px, cy);
+      const Int4 cover = row_test(cy - y);
+      Int4 m = cover & (zv < old_depth);
+      if constexpr (!std::is_same_v<Clip, NoClip>) {
+        const Int4 cut = cover & clip(px, cy);
+        clip.tally(cut & fresh);
+        m &= ~cut;
+      }
       store4(depth, select4(m, zv, old_depth));
       store4(color, select4(m, cv, load4(color)));
     }
@@ -180,7 +193,12 @@ inline void fill_box_narrow(const Target& t, const PixelBox& b, float x, float y
     const float dy = static_cast<float>(j) + 0.5f - y;
     for (int i = b.i0; i <= b.i1; ++i) {
       const float px = static_cast<float>(i) + 0.5f;
-      if (inside(splat4(px - x))(dy)[0] && !clip(splat4(px), dy + y)[0]) plot(t, i, j, z, c);
+      if (!inside(splat4(px - x))(dy)[0]) continue;
+      if (clip(splat4(px), dy + y)[0]) {
+        clip.tally(Int4{-1, 0, 0, 0});
+        continue;
+      }
+      plot(t, i, j, z, c);
     }
   }
 }
@@ -200,7 +218,10 @@ template <class Clip>
 inline void plot_nearest(const Target& t, const NearestCentre& n, float z, std::uint32_t c,
                          const Clip& clip) {
   if constexpr (!std::is_same_v<Clip, NoClip>) {
-    if (clip(splat4(static_cast<float>(n.i) + 0.5f), static_cast<float>(n.j) + 0.5f)[0]) return;
+    if (clip(splat4(static_cast<float>(n.i) + 0.5f), static_cast<float>(n.j) + 0.5f)[0]) {
+      clip.tally(Int4{-1, 0, 0, 0});
+      return;
+    }
   }
   plot(t, n.i, n.j, z, c);
 }
@@ -381,7 +402,7 @@ inline void draw_one(const Target& t, const SplatChunk& s, const RasterScratch::
       const PixelClip clip{ce.x, ce.y, ce.z, ne.x, ne.y, ne.z, dot(ne, ce),
                            0.5f * t.width_f, 0.5f * t.height_f, 1.0f / cam.focal_px,
                            sc.planes.data() + 4 * static_cast<std::size_t>(s.clip_first[i]),
-                           clip_count(code), clip_mode(code)};
+                           clip_count(code), clip_mode(code), t.clipped};
       draw_shape<kShape>(t, s, sc, i, clip);
       return;
     }
@@ -495,7 +516,9 @@ void rasterize_splats(const SplatStream& stream, const CameraFrame& camera,
   scratch.band_colors.resize(std::max(scratch.band_colors.size(), workers));
   for (std::size_t k = 0; k < workers; ++k) scratch.band_colors[k].resize(band_pixels);
   std::atomic<int> next_band{0};
+  std::atomic<std::uint64_t> clipped{0};
   pool.run(workers, [&](std::size_t worker) {
+    std::uint64_t clipped_here = 0;
     for (int b = next_band++; b < bands.count; b = next_band++) {
       const Target t{scratch.band_colors[worker].data(),
                      depth.data(),
@@ -504,7 +527,8 @@ void rasterize_splats(const SplatStream& stream, const CameraFrame& camera,
                      b << bands.rows_log2,
                      std::min(camera.height, (b + 1) << bands.rows_log2),
                      static_cast<float>(camera.width),
-                     static_cast<float>(camera.height)};
+                     static_cast<float>(camera.height),
+                     &clipped_here};
       clear_band(t, settings.background);
       const bool f = stream.has_features;
       switch (settings.shape) {
@@ -523,7 +547,9 @@ void rasterize_splats(const SplatStream& stream, const CameraFrame& camera,
       }
       unpack_band(t, color);
     }
+    clipped += clipped_here;
   });
+  scratch.clipped_fragments = clipped;
 }
 
 }  // namespace pointillist
