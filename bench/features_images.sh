@@ -189,5 +189,10 @@ if ((markdown)); then
 fi
 [[ -z $tsv_out ]] || cp "$rows" "$tsv_out"
 echo
+case " $scenes " in *" T8 "*)
+  echo "T8: generate labels each box's faces, so the L-shaped front, back and left faces are two labels" \
+    "each (a seam on one plane, which the renderer rightly blends) and 12 labels share 8 colours:" \
+    "its LER, MIX and transition width count the seam too." ;;
+esac
 echo "size ${size}x${size}, $total renders; V1 --view 35,25, V2 eye 1.5 from the feature point;" \
   "$(nproc) cores; binary $bin"

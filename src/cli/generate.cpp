@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -22,18 +23,18 @@ namespace pointillist::cli {
 
 namespace {
 
-// The exact ray-cast image of the scene, unlit: each pixel its face label's palette colour, the
-// background where the ray misses. The camera is the one `render` builds for the generated
+// The exact ray-cast image of the scene, unlit: each pixel the palette colour of its face's
+// surface (`group`, csg_surface_groups), the background where the ray misses. The camera is the one `render` builds for the generated
 // .ply with the same camera options: the orbit around the samples' view sphere (the centre of
 // their bounding box and the largest distance to a sample, as the hierarchy built from the file
 // computes it), +Y up (the samples record no other up axis).
 std::vector<Rgb8> reference_image(const GenerateOptions& o, const CsgScene& scene,
-                                  const PointSet& samples) {
+                                  const PointSet& samples, std::span<const std::uint32_t> group) {
   const Camera camera = make_camera(o.view, view_sphere(samples.positions), samples.up);
   const CsgImage image = ray_cast_csg_image(scene, camera);
   std::vector<Rgb8> pixels(image.label.size(), o.background);
   for (std::size_t i = 0; i < pixels.size(); ++i) {
-    if (image.label[i] != kNoLabel) pixels[i] = kLabelPalette[image.label[i] % 8];
+    if (image.label[i] != kNoLabel) pixels[i] = kLabelPalette[group[image.label[i]] % 8];
   }
   return pixels;
 }
@@ -45,7 +46,10 @@ int generate_csg(const GenerateOptions& o) {
   const CsgScene scene = csg_scene(o.scene);
   const bool jittered = o.sampling == "j";
   CsgSamples s = sample_csg(scene, jittered ? SamplingMode::Jittered : SamplingMode::Random, o.seed);
-  for (std::uint32_t label : s.labels) s.points.colors.push_back(kLabelPalette[label % 8]);
+  // A colour per surface of the result: faces of two primitives on one plane (the step's front)
+  // are one surface, so they share it, as they blend when drawn.
+  const std::vector<std::uint32_t> group = csg_surface_groups(scene, s);
+  for (std::uint32_t label : s.labels) s.points.colors.push_back(kLabelPalette[group[label] % 8]);
   if (jittered) {
     ThreadPool pool(o.threads);
     CloudRadiusOptions radius;
@@ -54,7 +58,8 @@ int generate_csg(const GenerateOptions& o) {
   }
   // The image first: a bad camera option then leaves no file behind.
   const std::vector<Rgb8> reference =
-      o.reference_output.empty() ? std::vector<Rgb8>{} : reference_image(o, scene, s.points);
+      o.reference_output.empty() ? std::vector<Rgb8>{}
+                                 : reference_image(o, scene, s.points, group);
   write_ply(o.output, s.points);
   if (!o.reference_output.empty()) {
     write_png_rgb8(o.reference_output, o.view.width, o.view.height, reference);

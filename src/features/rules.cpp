@@ -90,7 +90,7 @@ void deduplicate(std::vector<ClipPlane>& planes, std::vector<Vec3f>& centres, fl
 // the splat's plane lies on a's kept side (convex pair) or on its clipped side (reflex pair).
 constexpr float kSameCreaseSin = 0.0872f;  // sin 5°
 ClipMode combine_pairs(const Disc& s, const std::vector<ClipPlane>& planes,
-                       const std::vector<Vec3f>& centres) {
+                       const std::vector<Vec3f>& centres, std::span<const Vec3f> continuous) {
   if (planes.size() == 1) return ClipMode::Union;
   const float tol = kClassifyTolerance * s.r;
   bool convex = false, reflex = false;
@@ -109,7 +109,27 @@ ClipMode combine_pairs(const Disc& s, const std::vector<ClipPlane>& planes,
       reflex |= side < -tol;
     }
   }
-  if (convex && reflex) return ClipMode::Nearest;
+  if (convex && reflex) {
+    // A mixed corner by the partners' centres (the step's riser at the corner where it meets
+    // floor and front: one partner convex, one concave). What decides the region to keep is
+    // the splat's own face there: when none of its surface (its centre and smooth neighbours)
+    // lies on the clipped side of any plane, the face is a convex corner of its polygon, kept
+    // where every plane keeps (union of the clipped regions); otherwise the nearest plane
+    // decides, pixel by pixel. (With random sampling's large discs, the nearest-plane rule let
+    // the riser's discs show past the front at the corner in a wedge of 45–272 pixels.)
+    const float side_tol = kSideTolerance * s.r;
+    bool beyond = false;
+    for (std::size_t k = 0; k <= continuous.size() && !beyond; ++k) {
+      const Vec3f x = k == 0 ? s.c : continuous[k - 1];
+      for (const ClipPlane& p : planes) {
+        if (dot(p.n, x - s.c) - (p.h - dot(p.n, s.c)) < -side_tol) {
+          beyond = true;
+          break;
+        }
+      }
+    }
+    return beyond ? ClipMode::Nearest : ClipMode::Union;
+  }
   return reflex ? ClipMode::Intersection : ClipMode::Union;
 }
 
@@ -234,11 +254,13 @@ std::vector<std::uint8_t> reflex_partners(const Disc& s, std::span<const Vec3f> 
     const Vec3f la = line[a];
     // One plane: the surface continues past it, but only beside the disc's chord on the line
     // where the planes meet (a splat near such a corner whose disc does not reach the other
-    // plane). Straight across the chord lies none of the surface beyond the plane.
-    if (const float d = -beyond(through[a], sa, s.c); d > tol) {
+    // plane). Straight across the chord lies none of the surface beyond the plane. The centre
+    // is on the near side, or within the tolerance of the plane (a centre 0.07 r below the
+    // step's floor, its disc reaching 0.93 r above it: random sampling puts splats there).
+    if (const float d = -beyond(through[a], sa, s.c); d > -tol) {
       // Distance from s's centre to the line, within s's plane: d over the sine of the angle.
       const float sin_angle = length(cross(through[a].n, s.n));
-      const float to_line = d / std::max(sin_angle, 1e-3f);
+      const float to_line = std::fabs(d) / std::max(sin_angle, 1e-3f);
       if (to_line < s.r) {
         const float half = std::sqrt(s.r * s.r - to_line * to_line);
         bool empty = true;
@@ -310,7 +332,7 @@ ClipResult classify_partners(const Disc& s, std::span<const Disc> partners,
     centres.resize(kMaxClipPlanes);
   }
   switch (rule) {
-    case ClipRule::Classified: result.mode = combine_pairs(s, planes, centres); break;
+    case ClipRule::Classified: result.mode = combine_pairs(s, planes, centres, continuous); break;
     case ClipRule::Dissertation:
       result.mode = c.union_rule ? ClipMode::Union : ClipMode::Intersection;
       break;

@@ -1,6 +1,7 @@
 #include "pointillist/scene/csg.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -472,6 +473,38 @@ Aabb csg_bounds(const CsgScene& scene) {
     box.extend(p.center + half);
   }
   return box;
+}
+
+std::vector<std::uint32_t> csg_surface_groups(const CsgScene& scene, const CsgSamples& samples) {
+  const std::uint32_t labels = scene.label_count();
+  constexpr std::uint32_t kUnset = 0xffffffffu;
+  // A planar face's plane (normal, offset) from its first sample, rounded to 0.01.
+  std::vector<std::array<long, 4>> plane(labels);
+  std::vector<bool> seen(labels, false);
+  for (std::size_t i = 0; i < samples.labels.size() && i < samples.points.positions.size(); ++i) {
+    const std::uint32_t l = samples.labels[i];
+    if (l >= labels || seen[l]) continue;
+    seen[l] = true;
+    const Vec3f n = samples.points.normals[i];
+    const float h = dot(n, samples.points.positions[i]);
+    plane[l] = {std::lround(n.x * 100), std::lround(n.y * 100), std::lround(n.z * 100),
+                std::lround(h * 100)};
+  }
+  std::vector<std::uint32_t> group(labels, kUnset);
+  std::uint32_t next = 0;
+  for (std::uint32_t l = 0; l < labels; ++l) {
+    if (group[l] != kUnset) continue;
+    group[l] = next;
+    if (seen[l] && csg_face_is_planar(scene, l)) {
+      for (std::uint32_t k = l + 1; k < labels; ++k) {
+        if (seen[k] && group[k] == kUnset && csg_face_is_planar(scene, k) && plane[k] == plane[l]) {
+          group[k] = next;
+        }
+      }
+    }
+    ++next;
+  }
+  return group;
 }
 
 }  // namespace pointillist

@@ -9,6 +9,7 @@
 #include <map>
 #include <tuple>
 
+#include "pointillist/eval/label_metrics.hpp"
 #include "pointillist/format/ptl_v2.hpp"
 #include "pointillist/format/ptl_v2_pages.hpp"
 #include "pointillist/lod/tree_features.hpp"
@@ -36,32 +37,22 @@ struct Model {
   std::vector<int> colour_of_label;
 };
 
-int plane_key_colour(std::map<std::tuple<int, int, int, int>, int>& keys, Vec3f n, float h) {
-  const auto key = std::make_tuple(int(std::lround(n.x * 100)), int(std::lround(n.y * 100)),
-                                   int(std::lround(n.z * 100)), int(std::lround(h * 100)));
-  return keys.emplace(key, int(keys.size()) % 8).first->second;
-}
+std::unique_ptr<Model> make_model(const std::string& id, ThreadPool& pool, bool quantized = false,
+                                  SamplingMode mode = SamplingMode::Jittered);
 
-std::unique_ptr<Model> make_model(const std::string& id, ThreadPool& pool, bool quantized = false);
-
-std::unique_ptr<Model> make_model(const std::string& id, ThreadPool& pool, bool quantized) {
+// Spec §4.1: J mode, radius = the mean distance to the 5 nearest (coverage 1); R mode, uniform
+// random samples with Pointillist's default radii (coverage 2.5).
+std::unique_ptr<Model> make_model(const std::string& id, ThreadPool& pool, bool quantized,
+                                  SamplingMode mode) {
   auto m = std::make_unique<Model>();
   m->scene = csg_scene(id);
-  CsgSamples s = sample_csg(m->scene, SamplingMode::Jittered, 9);
+  CsgSamples s = sample_csg(m->scene, mode, 9);
   CloudRadiusOptions radius;
-  radius.coverage = 1.0f;
+  if (mode == SamplingMode::Jittered) radius.coverage = 1.0f;
   s.points.radii = cloud_radii(s.points.positions, pool, Progress::none(), radius);
-  // Colour by plane for planar faces (curved faces: by label).
-  std::map<std::tuple<int, int, int, int>, int> keys;
-  m->colour_of_label.assign(m->scene.label_count(), -1);
-  for (std::size_t i = 0; i < s.labels.size(); ++i) {
-    const std::uint32_t l = s.labels[i];
-    if (m->colour_of_label[l] >= 0) continue;
-    const Vec3f n = s.points.normals[i];
-    m->colour_of_label[l] = csg_face_is_planar(m->scene, l)
-                                ? plane_key_colour(keys, n, dot(n, s.points.positions[i]))
-                                : int(l % 8);
-  }
+  // A colour per surface of the result (faces on one plane share it).
+  const std::vector<std::uint32_t> group = csg_surface_groups(m->scene, s);
+  for (const std::uint32_t g : group) m->colour_of_label.push_back(int(g % 8));
   for (std::uint32_t l : s.labels) s.points.colors.push_back(kColors[m->colour_of_label[l]]);
   m->tree = build_sphere_tree(s.points, pool);
   if (quantized) {
@@ -145,6 +136,64 @@ Camera look(Vec3f eye, Vec3f target, int size = 256) {
   c.target = target;
   c.width = c.height = size;
   return c;
+}
+
+// The reference of spec §4.1 as an image: each pixel the colour of its face (black: background).
+Image reference_image(const Model& m, const Camera& camera) {
+  const CsgImage ref = ray_cast_csg_image(m.scene, camera);
+  Image out{std::vector<Rgb8>(ref.label.size(), Rgb8{0, 0, 0}), ref.width, ref.height};
+  for (std::size_t p = 0; p < ref.label.size(); ++p) {
+    if (ref.label[p] != kNoLabel) out.color[p] = kColors[m.colour_of_label[ref.label[p]]];
+  }
+  return out;
+}
+
+LabelComparison label_metrics(const Model& m, const Camera& camera, const Image& test) {
+  const Image ref = reference_image(m, camera);
+  LabelCompareOptions o;
+  o.palette = kColors;
+  o.background = Rgb8{0, 0, 0};
+  return compare_labels({ref.width, ref.height, ref.color}, {test.width, test.height, test.color},
+                        o);
+}
+
+TEST(FeaturesRender, PlanarCreasesMeetTheA2Bars) {
+  // Spec §4.6 A2 on the cube (T1) and the step (T8), overview (V1) and close-up (V2), in both
+  // sampling modes, quality mode: no holes, no blended pixels off the silhouette, label errors
+  // <= 0.2 % of the crease band B_4, the label switch across a crease within 0.25 px of the
+  // reference's on average (at most 1 px) and no transition wider than 1 px.
+  ThreadPool pool(2);
+  for (const SamplingMode mode : {SamplingMode::Jittered, SamplingMode::Random}) {
+    for (const char* id : {"T1", "T8"}) {
+      const auto m = make_model(id, pool, false, mode);
+      const bool cube = std::string(id) == "T1";
+      const Camera close = cube ? look({2.0f, 2.1f, 1.9f}, {1, 1, 1}, 320)
+                                : look({1.0f, 0.9f, 2.1f}, {0, 0, 1}, 320);
+      const Camera overview = look({3.2f, 2.4f, 4.1f}, {0, 0, 0}, 320);
+      for (int v = 0; v < 2; ++v) {
+        const Camera& cam = v == 0 ? close : overview;
+        const LabelComparison c = label_metrics(*m, cam, render(*m, cam, pool, true));
+        const LabelComparison off = label_metrics(*m, cam, render(*m, cam, pool, false));
+        const char* which = v == 0 ? "V2" : "V1";
+        std::cout << id << " " << (mode == SamplingMode::Jittered ? "J " : "R ") << which
+                  << ": holes " << c.hole_count << " mixed " << c.mixed_count << " LER(B4) "
+                  << 100 * c.ler_band << "% (" << c.band_error_count << " of " << c.band_count
+                  << " px, " << c.wrong_count << " wrong) displacement " << c.displacement_mean_px << "/"
+                  << c.displacement_max_px << " transition " << c.transition_max_px
+                  << " profiles " << c.profile_count << " / without: mixed " << off.mixed_count
+                  << " LER(B4) " << 100 * off.ler_band << "% transition "
+                  << off.transition_max_px << "\n";
+        EXPECT_EQ(c.hole_count, 0u) << id << " " << which;
+        EXPECT_EQ(c.mixed_count, 0u) << id << " " << which;
+        EXPECT_LE(c.ler_band, 0.002) << id << " " << which;
+        EXPECT_GT(c.profile_count, 8u) << id << " " << which;
+        EXPECT_LE(c.displacement_mean_px, 0.25) << id << " " << which;
+        EXPECT_LE(c.displacement_max_px, 1.0) << id << " " << which;
+        EXPECT_LE(c.transition_max_px, 1.0) << id << " " << which;
+        EXPECT_GT(off.mixed_count, 50u) << id << " " << which;  // what the bars measure
+      }
+    }
+  }
 }
 
 TEST(FeaturesRender, CubeCornerIsSharpWithoutHolesOrBlends) {

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <set>
 
 #include "pointillist/core/error.hpp"
 
@@ -86,3 +87,29 @@ TEST(CsgScenes, UnknownIdIsRefusedWithTheKnownOnes) {
 }
 
 }  // namespace
+
+TEST(CsgSurfaceGroups, FacesOnOnePlaneAreOneSurface) {
+  // The step is two boxes: their front faces (z = 1), back faces and left faces (x = -1) lie on
+  // one plane each, so its 11 sampled faces make 8 surfaces (spec §4.5: T8 has 8 faces); the
+  // cube's 6 faces stay 6; two spheres are 2.
+  const std::pair<const char*, std::size_t> expected[] = {{"T8", 8}, {"T1", 6}, {"T9", 2}};
+  for (const auto& [id, count] : expected) {
+    const CsgScene scene = csg_scene(id);
+    const CsgSamples s = sample_csg(scene, SamplingMode::Jittered, 1);
+    const std::vector<std::uint32_t> group = csg_surface_groups(scene, s);
+    ASSERT_EQ(group.size(), scene.label_count()) << id;
+    std::set<std::uint32_t> distinct;  // surfaces with samples (the step's inner face has none)
+    for (const std::uint32_t l : s.labels) distinct.insert(group[l]);
+    EXPECT_EQ(distinct.size(), count) << id;
+    // Samples of one group lie on one plane (planar faces) or one primitive's face.
+    for (std::size_t i = 0; i < s.labels.size(); ++i) {
+      for (std::size_t j = i + 1; j < s.labels.size(); j += 997) {
+        if (group[s.labels[i]] != group[s.labels[j]] || s.labels[i] == s.labels[j]) continue;
+        EXPECT_NEAR(dot(s.points.normals[i], s.points.normals[j]), 1.0f, 1e-4f) << id;
+        EXPECT_NEAR(dot(s.points.normals[i], s.points.positions[i] - s.points.positions[j]), 0.0f,
+                    1e-4f)
+            << id;
+      }
+    }
+  }
+}

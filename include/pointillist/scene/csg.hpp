@@ -73,6 +73,13 @@ struct CsgSamples {
 // outside the others, the others' inside the first with their normals flipped).
 CsgSamples sample_csg(const CsgScene& scene, SamplingMode mode, std::uint64_t seed);
 
+// The result's surfaces as groups of face labels: faces of different primitives on one plane
+// (the step's L-shaped front is two boxes' faces) are one surface of the result, so they share
+// a group; any other face is a group of its own. Groups are numbered 0, 1, ... in label order;
+// one entry per label of the scene (planes are told apart from the samples' normals and
+// positions, to 0.01; a face with no samples is its own group).
+std::vector<std::uint32_t> csg_surface_groups(const CsgScene& scene, const CsgSamples& samples);
+
 // Whether point p of the plane of face `label` lies on that face of the result: within the
 // face's extent (a box face's rectangle, a cap's disc) and on the result's boundary. Exact for
 // the planar faces (box faces, caps); for a curved face (sphere, cylinder side) only the
