@@ -32,6 +32,22 @@ SphereTree cube_tree(ThreadPool& pool) {
   return build_sphere_tree(s.points, pool);
 }
 
+// The cube written in small pages, and the features of the leaves as that file decodes them
+// (as convert --features computes them), stored in a second file at `path` (the tree
+// re-quantized once more, with the same node order).
+struct Stored {
+  SphereTree decoded;  // the first file's tree
+  TreeFeatures features;
+};
+Stored write_cube_with_features(const std::string& path, ThreadPool& pool) {
+  write_ptl_v2(path, cube_tree(pool), "", {.page_bytes = 1024});
+  Stored out;
+  out.decoded = PtlV2File::open(path)->decode_all();
+  out.features = compute_tree_features(out.decoded.view(), pool);
+  write_ptl_v2(path, out.decoded, "", {.page_bytes = 1024, .features = &out.features});
+  return out;
+}
+
 std::string read_all(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
@@ -92,13 +108,9 @@ TEST(PtlV2Features, EveryPageCarriesItsNodesFeatures) {
   // the features of exactly the nodes the page holds (matched by decoding the page's nodes
   // against the tree's: page records in page order are tree nodes, found by their spheres).
   ThreadPool pool(2);
-  const SphereTree tree = cube_tree(pool);
   pointillist::testing::TempDir dir;
   const std::string path = dir.file("cube.ptl");
-  write_ptl_v2(path, tree, "", {.page_bytes = 1024});
-  const SphereTree decoded = PtlV2File::open(path)->decode_all();
-  const TreeFeatures f = compute_tree_features(decoded.view(), pool);
-  write_ptl_v2(path, decoded, "", {.page_bytes = 1024, .features = &f});
+  const auto [decoded, f] = write_cube_with_features(path, pool);
   const auto file = PtlV2File::open(path);
   ASSERT_TRUE(file->page_features_stored());
   ASSERT_GT(file->page_count(), 8u);
@@ -228,13 +240,9 @@ std::string version1_section(const SphereTree& tree, const TreeFeatures& f) {
 
 TEST(PtlV2Features, FilesOfTheFirstSectionVersionStillLoad) {
   ThreadPool pool(2);
-  const SphereTree tree = cube_tree(pool);
   pointillist::testing::TempDir dir;
   const std::string path = dir.file("cube.ptl");
-  write_ptl_v2(path, tree, "", {.page_bytes = 1024});
-  const SphereTree decoded = PtlV2File::open(path)->decode_all();
-  const TreeFeatures f = compute_tree_features(decoded.view(), pool);
-  write_ptl_v2(path, decoded, "", {.page_bytes = 1024, .features = &f});
+  const TreeFeatures f = write_cube_with_features(path, pool).features;
   // Swap the section (the file's last bytes) for a version 1 one, and its size in the header.
   std::string bytes = read_all(path);
   std::uint64_t size = 0;

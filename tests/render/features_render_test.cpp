@@ -74,12 +74,18 @@ struct Image {
   int width = 0, height = 0;
 };
 
-Image render(const Model& m, const Camera& camera, ThreadPool& pool, bool features,
-             Rasterizer rasterizer = Rasterizer::Quality, LodScheme lod = LodScheme::QSplat) {
+// Unlit: each splat its own colour.
+RenderSettings unlit() {
   RenderSettings settings;
   settings.ambient = 1.0f;
   settings.diffuse = 0.0f;
   settings.specular = 0.0f;
+  return settings;
+}
+
+Image render(const Model& m, const Camera& camera, ThreadPool& pool, bool features,
+             Rasterizer rasterizer = Rasterizer::Quality, LodScheme lod = LodScheme::QSplat) {
+  const RenderSettings settings = unlit();
   FrameSettings fs;
   fs.rasterizer = rasterizer;
   fs.features = features;
@@ -320,10 +326,7 @@ TEST(FeaturesRender, SequentialPointTreesDrawThemToo) {
 // Renders until every page the view needs is loaded (a paged model), as `render` does.
 Image render_paged(const RenderModel& model, const Camera& camera, ThreadPool& pool,
                    bool features, Rasterizer rasterizer, const RendererOptions& options = {}) {
-  RenderSettings settings;
-  settings.ambient = 1.0f;
-  settings.diffuse = 0.0f;
-  settings.specular = 0.0f;
+  const RenderSettings settings = unlit();
   FrameSettings fs;
   fs.rasterizer = rasterizer;
   fs.features = features;
