@@ -89,6 +89,11 @@ void deduplicate(std::vector<ClipPlane>& planes, std::vector<Vec3f>& centres, fl
 // Union or intersection from the pairs of planes (spec §4.8 item 4): b's centre projected into
 // the splat's plane lies on a's kept side (convex pair) or on its clipped side (reflex pair).
 constexpr float kSameCreaseSin = 0.0872f;  // sin 5°
+// n·x − h for a point x near the splat's centre c, computed relative to c for precision.
+float side_near(const ClipPlane& p, Vec3f x, Vec3f c) {
+  return dot(p.n, x - c) - (p.h - dot(p.n, c));
+}
+
 ClipMode combine_pairs(const Disc& s, const std::vector<ClipPlane>& planes,
                        const std::vector<Vec3f>& centres, std::span<const Vec3f> continuous) {
   if (planes.size() == 1) return ClipMode::Union;
@@ -103,8 +108,7 @@ ClipMode combine_pairs(const Disc& s, const std::vector<ClipPlane>& planes,
       // by a degree or two): union and intersection of the two keep the same region but for a
       // sliver, and their pair says nothing about the corner.
       if (a == b || length(cross(line[a], line[b])) < kSameCreaseSin) continue;
-      // Relative to the splat's centre for precision: n·(x − c) − (h − n·c).
-      const float side = dot(planes[a].n, x - s.c) - (planes[a].h - dot(planes[a].n, s.c));
+      const float side = side_near(planes[a], x, s.c);
       convex |= side > tol;
       reflex |= side < -tol;
     }
@@ -122,7 +126,7 @@ ClipMode combine_pairs(const Disc& s, const std::vector<ClipPlane>& planes,
     for (std::size_t k = 0; k <= continuous.size() && !beyond; ++k) {
       const Vec3f x = k == 0 ? s.c : continuous[k - 1];
       for (const ClipPlane& p : planes) {
-        if (dot(p.n, x - s.c) - (p.h - dot(p.n, s.c)) < -side_tol) {
+        if (side_near(p, x, s.c) < -side_tol) {
           beyond = true;
           break;
         }

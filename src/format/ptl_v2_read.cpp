@@ -5,7 +5,6 @@
 #include <cassert>
 #include <cmath>
 #include <cstring>
-#include <mutex>
 #include <string>
 #include <utility>
 #include <vector>
@@ -14,6 +13,7 @@
 #include "ptl_v2_codec.hpp"
 #include "ptl_v2_features.hpp"
 #include "ptl_v2_layout.hpp"
+#include "ptl_v2_mapping.hpp"
 #include "pointillist/core/file_bytes.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/format/ptl.hpp"
@@ -21,14 +21,6 @@
 #include "pointillist/lod/pages.hpp"
 
 namespace pointillist {
-
-struct PtlV2File::Mapping {
-  FileBytes bytes;
-  // The features section's fixed fields, read on first use.
-  std::once_flag features_once;
-  ptl2::FeatureSection features;
-  TreeFeatures summary;  // surface count, options, statistics
-};
 
 namespace {
 
@@ -264,73 +256,6 @@ std::unique_ptr<PtlV2File> PtlV2File::open(const std::string& path) {
 
 PtlV2File::~PtlV2File() = default;
 
-const ptl2::FeatureSection& PtlV2File::feature_section() const {
-  std::call_once(map_->features_once, [&] {
-    const std::string_view view = map_->bytes.view();
-    map_->features = decode_feature_header(view.substr(features_offset_, features_size_),
-                                           features_offset_, leaf_count_, page_count(), path_);
-    map_->summary.surface_count = map_->features.surfaces;
-    map_->summary.options = map_->features.options;
-    map_->summary.stats = map_->features.stats;
-  });
-  return map_->features;
-}
-
-const TreeFeatures* PtlV2File::feature_summary() const {
-  if (features_size_ == 0) return nullptr;
-  feature_section();
-  return &map_->summary;
-}
-
-bool PtlV2File::page_features_stored() const {
-  return features_size_ != 0 && feature_section().version >= 2;
-}
-
-void PtlV2File::page_features(std::uint32_t page, const std::function<bool(std::uint32_t)>& is_leaf,
-                              PageFeatures& out) const {
-  const ptl2::FeatureSection& section = feature_section();
-  if (section.version < 2) {
-    throw FormatError(path_ + ": its sharp features are stored for the whole model (a file of an "
-                      "earlier Pointillist), not per page; convert it again to draw them page by "
-                      "page");
-  }
-  const std::string_view view = map_->bytes.view();
-  decode_page_features(view.substr(features_offset_, features_size_), features_offset_, section,
-                       page, pages_.at(page).node_count, is_leaf, path_, out);
-}
-
-std::uint64_t PtlV2File::page_feature_memory(std::uint32_t page) const {
-  if (!page_features_stored()) return 0;
-  const ptl2::FeatureSection& f = feature_section();
-  return PageFeatures::memory_bytes(pages_.at(page).node_count, f.clipped.at(page),
-                                    f.planes.at(page));
-}
-
-std::optional<FeatureData> PtlV2File::features() const {
-  if (features_size_ == 0) return std::nullopt;
-  const ptl2::FeatureSection& section = feature_section();
-  if (section.version == 1) {
-    const std::string_view view = map_->bytes.view();
-    return decode_leaf_features(view.substr(features_offset_, features_size_), features_offset_,
-                                section, leaf_count_, path_);
-  }
-  TreeFeatures tree;
-  const SphereTree whole = decode_all(&tree);
-  FeatureData out;
-  out.options = tree.options;
-  out.stats = tree.stats;
-  out.clip_offset.push_back(0);
-  for (std::size_t k = 0; k < whole.nodes.size(); ++k) {
-    if (whole.nodes[k].child_count != 0) continue;
-    out.surface_id.push_back(tree.surface[k]);
-    out.clip_mode.push_back(tree.clip_mode[k]);
-    const auto planes = tree.planes(k);
-    out.clip_planes.insert(out.clip_planes.end(), planes.begin(), planes.end());
-    out.clip_offset.push_back(static_cast<std::uint32_t>(out.clip_planes.size()));
-  }
-  return out;
-}
-
 template <class OnRecord>
 std::uint32_t PtlV2File::scan_page(std::uint32_t page, std::vector<Sphere>& root_spheres,
                                    std::vector<std::uint8_t>& root_child_counts,
@@ -558,10 +483,7 @@ SphereTree PtlV2File::decode_all(TreeFeatures* features) const {
   // Breadth-first over the linked pages: the order in which the tree was written.
   SphereTree tree;
   tree.nodes.reserve(node_count_);
-  struct Ref {
-    std::uint32_t page, record;
-  };
-  std::vector<Ref> refs;
+  std::vector<NodeRef> refs;
   refs.reserve(node_count_);
   tree.nodes.push_back(pages[0].nodes[0]);
   refs.push_back({0, 0});
@@ -573,13 +495,13 @@ SphereTree PtlV2File::decode_all(TreeFeatures* features) const {
       ++depth;
       level_end = tree.nodes.size();
     }
-    const Ref ref = refs[i];
+    const NodeRef ref = refs[i];
     const SphereNode& src = pages[ref.page].nodes[ref.record];
     if (src.child_count == 0) {
       ++leaves;
       continue;
     }
-    Ref child{ref.page, src.first_child};
+    NodeRef child{ref.page, src.first_child};
     if (ref.record >= pages[ref.page].last_level_begin) {
       const Link& l = links[ref.page][ref.record];
       child = {l.page, l.first};
@@ -611,35 +533,7 @@ SphereTree PtlV2File::decode_all(TreeFeatures* features) const {
   tree.view_sphere = view_sphere_;
   tree.origin = origin_;
   tree.up = up_;
-  if (features && features_size_ != 0) {
-    const ptl2::FeatureSection& section = feature_section();
-    if (section.version == 1) {
-      *features = tree_features(tree.nodes, *this->features());
-    } else {
-      // Each page's block, then every node's features from its page and record.
-      std::vector<PageFeatures> blocks(page_count);
-      for (std::uint32_t p = 0; p < page_count; ++p) {
-        const PtlV2Page& pg = pages[p];
-        page_features(
-            p, [&](std::uint32_t k) { return pg.nodes[k].child_count == 0; }, blocks[p]);
-      }
-      TreeFeatures& f = *features;
-      f = {};
-      f.surface_count = section.surfaces;
-      f.options = section.options;
-      f.stats = section.stats;
-      f.surface.resize(tree.nodes.size());
-      f.clip_mode.resize(tree.nodes.size());
-      f.clip_offset.assign(tree.nodes.size() + 1, 0);
-      for (std::size_t i = 0; i < tree.nodes.size(); ++i) {
-        const Ref ref = refs[i];
-        f.surface[i] = blocks[ref.page].surface[ref.record];
-        const auto planes = blocks[ref.page].planes_of(ref.record, f.clip_mode[i]);
-        f.clip_planes.insert(f.clip_planes.end(), planes.begin(), planes.end());
-        f.clip_offset[i + 1] = static_cast<std::uint32_t>(f.clip_planes.size());
-      }
-    }
-  }
+  if (features && features_size_ != 0) gather_features(tree, pages, refs, *features);
   return tree;
 }
 

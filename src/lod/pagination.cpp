@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cassert>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,11 +22,11 @@ class InMemoryPages final : public PageSource {
     summary_ = tree;
     summary_.nodes = {};
     summary_.features = nullptr;
-    has_features_ = tree.features != nullptr;
     if (tree.features) {
-      features_.surface_count = tree.features->surface_count;
-      features_.options = tree.features->options;
-      features_.stats = tree.features->stats;
+      features_.emplace();
+      features_->surface_count = tree.features->surface_count;
+      features_->options = tree.features->options;
+      features_->stats = tree.features->stats;
     }
     if (tree.nodes.empty()) return;
     // Global indices of each page's nodes, in page order, and of the anchors of new pages.
@@ -84,7 +85,7 @@ class InMemoryPages final : public PageSource {
            (p.features.empty() ? 0 : p.features.memory_bytes());
   }
   const TreeFeatures* features() const override {
-    return has_features_ ? &features_ : nullptr;
+    return features_ ? &*features_ : nullptr;
   }
   std::uint64_t open_bytes() const override { return 0; }
   SphereTreeView summary() const override { return summary_; }
@@ -96,12 +97,12 @@ class InMemoryPages final : public PageSource {
   // The features of the nodes `global` (tree indices, in page order).
   static void add_features(const TreeFeatures& f, const std::vector<std::uint32_t>& global,
                            PageFeatures& out) {
+    out.clipped_first.assign(1, 0);
     for (std::size_t k = 0; k < global.size(); ++k) {
       const std::uint32_t g = global[k];
       out.surface.push_back(f.surface[g]);
       const auto planes = f.planes(g);
       if (planes.empty()) continue;
-      if (out.clipped.empty()) out.clipped_first.push_back(0);
       out.clipped.push_back(static_cast<std::uint32_t>(k));
       out.clipped_mode.push_back(f.clip_mode[g]);
       out.planes.insert(out.planes.end(), planes.begin(), planes.end());
@@ -111,8 +112,7 @@ class InMemoryPages final : public PageSource {
 
   SphereTreeView summary_;
   std::vector<HierarchyPage> pages_;
-  TreeFeatures features_;  // counts, options and statistics only
-  bool has_features_ = false;
+  std::optional<TreeFeatures> features_;  // counts, options and statistics only
 };
 
 }  // namespace

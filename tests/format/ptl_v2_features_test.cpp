@@ -48,6 +48,25 @@ Stored write_cube_with_features(const std::string& path, ThreadPool& pool) {
   return out;
 }
 
+// The size of the features section (header bytes 240..247; the section ends the file).
+std::uint64_t section_size(const std::string& file) {
+  std::uint64_t size = 0;
+  for (int i = 0; i < 8; ++i) size |= std::uint64_t(std::uint8_t(file[240 + i])) << (8 * i);
+  return size;
+}
+
+// The message of the FormatError `f` throws; fails the test when it throws none.
+template <class F>
+std::string format_error(F&& f, const char* what) {
+  try {
+    f();
+  } catch (const FormatError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << what;
+  return {};
+}
+
 std::string read_all(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
@@ -245,8 +264,7 @@ TEST(PtlV2Features, FilesOfTheFirstSectionVersionStillLoad) {
   const TreeFeatures f = write_cube_with_features(path, pool).features;
   // Swap the section (the file's last bytes) for a version 1 one, and its size in the header.
   std::string bytes = read_all(path);
-  std::uint64_t size = 0;
-  for (int i = 0; i < 8; ++i) size |= std::uint64_t(std::uint8_t(bytes[240 + i])) << (8 * i);
+  const std::uint64_t size = section_size(bytes);
   const SphereTree stored = PtlV2File::open(path)->decode_all();
   const std::string old = version1_section(stored, f);
   bytes = bytes.substr(0, bytes.size() - size) + old;
@@ -282,48 +300,32 @@ TEST(PtlV2Features, ADamagedSectionNamesTheByte) {
   // Page 0's block follows the fixed fields (264 bytes), the page count and the block table
   // (16 bytes a page, and one more);
   // its first run's surface id (after the run count) set past the surface count.
-  const std::size_t section = good.size() - [&] {
-    std::uint64_t size = 0;
-    for (int i = 0; i < 8; ++i) size |= std::uint64_t(std::uint8_t(good[240 + i])) << (8 * i);
-    return size;
-  }();
+  const std::size_t section = good.size() - section_size(good);
   const std::size_t first_id = section + 264 + 8 + 16 * (pages + 1) + 4;
   std::string bad = good;
   bad[first_id + 3] = '\x7f';
   write_all(path, bad);
-  try {
-    (void)PtlV2File::open(path)->features();
-    FAIL() << "a damaged features section was read";
-  } catch (const FormatError& e) {
-    const std::string m = e.what();
-    EXPECT_NE(m.find(path + ": byte " + std::to_string(first_id)), std::string::npos) << m;
-    EXPECT_NE(m.find("surface id"), std::string::npos) << m;
-  }
+  const std::string m = format_error([&] { (void)PtlV2File::open(path)->features(); },
+                                     "a damaged features section was read");
+  EXPECT_NE(m.find(path + ": byte " + std::to_string(first_id)), std::string::npos) << m;
+  EXPECT_NE(m.find("surface id"), std::string::npos) << m;
   // The same damage found when the page is loaded for paged rendering.
   {
     const auto file = PtlV2File::open(path);
     const auto source = ptl_v2_page_source(*file);
     HierarchyPage page;
-    try {
-      source->load(0, page);
-      FAIL() << "a damaged page block was loaded";
-    } catch (const FormatError& e) {
-      EXPECT_NE(std::string(e.what()).find("byte " + std::to_string(first_id)), std::string::npos)
-          << e.what();
-    }
+    const std::string loaded =
+        format_error([&] { source->load(0, page); }, "a damaged page block was loaded");
+    EXPECT_NE(loaded.find("byte " + std::to_string(first_id)), std::string::npos) << loaded;
   }
   // A block table entry out of order is refused with the byte of the entry.
   bad = good;
   const std::size_t entry1 = section + 264 + 8 + 16;
   bad[entry1 + 7] = '\x01';
   write_all(path, bad);
-  try {
-    (void)PtlV2File::open(path)->features();
-    FAIL() << "a damaged block table was read";
-  } catch (const FormatError& e) {
-    EXPECT_NE(std::string(e.what()).find("byte " + std::to_string(entry1)), std::string::npos)
-        << e.what();
-  }
+  const std::string table = format_error([&] { (void)PtlV2File::open(path)->features(); },
+                                         "a damaged block table was read");
+  EXPECT_NE(table.find("byte " + std::to_string(entry1)), std::string::npos) << table;
   // A section that runs past the end of the file is refused on opening.
   write_all(path, good.substr(0, good.size() - 10));
   EXPECT_THROW(PtlV2File::open(path), FormatError);

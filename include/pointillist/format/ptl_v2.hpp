@@ -11,6 +11,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -185,7 +186,14 @@ class PtlV2File {
 
  private:
   struct Mapping;
+  // A node of the hierarchy as decode_all finds it: record `record` of page `page`.
+  struct NodeRef {
+    std::uint32_t page, record;
+  };
   const ptl2::FeatureSection& feature_section() const;
+  // The features of `tree`'s nodes, found at `refs` in the decoded `pages` (decode_all).
+  void gather_features(const SphereTree& tree, std::span<const PtlV2Page> pages,
+                       std::span<const NodeRef> refs, TreeFeatures& out) const;
   // The parent of a record in its page: root `index` of the page's root table, or record `index`.
   struct PageParent {
     bool is_root = false;

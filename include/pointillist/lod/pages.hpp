@@ -79,7 +79,7 @@ struct PageFeatures {
   std::vector<std::uint32_t> surface;        // per node of the page, in page order
   std::vector<std::uint32_t> clipped;        // nodes with clip planes, increasing
   std::vector<ClipMode> clipped_mode;        // per clipped node
-  std::vector<std::uint32_t> clipped_first;  // per clipped node + 1: into planes
+  std::vector<std::uint32_t> clipped_first;  // per clipped node, and one more: into planes
   std::vector<ClipPlane> planes;
 
   bool empty() const { return surface.empty(); }
