@@ -27,7 +27,13 @@ inline Int4 load4(const std::uint32_t* p) {
   std::memcpy(&v, p, sizeof v);
   return v;
 }
+inline Int4 load4(const std::int32_t* p) {
+  Int4 v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
 inline void store4(float* p, Float4 v) { std::memcpy(p, &v, sizeof v); }
+inline void store4(std::int32_t* p, Int4 v) { std::memcpy(p, &v, sizeof v); }
 inline void store4(std::uint32_t* p, Int4 v) { std::memcpy(p, &v, sizeof v); }
 inline Int4 select4(Int4 mask, Int4 a, Int4 b) { return (mask & a) | (~mask & b); }
 inline Float4 select4(Int4 mask, Float4 a, Float4 b) {

@@ -207,22 +207,34 @@ TEST(SplatRaster, ShadingMatchesBlinnPhongComputedByHand) {
   }
 }
 
-TEST(SplatRaster, EqualDepthGoesToTheEarlierSplatForAnyThreadCount) {
+TEST(SplatRaster, EqualDepthGoesToTheSmallerColourInAnyOrderAndThreadCount) {
   const Camera cam = axis_camera(64, 48);
-  const SphereTree tree = root_with_leaves(
-      {leaf({0, 0, -2}, 0.3f, {0, 0, 1}, {255, 0, 0}), leaf({0, 0, -2}, 0.3f, {0, 0, 1}, {0, 255, 0}),
-       leaf({0.01f, 0, -2}, 0.3f, {0, 0, 1}, {0, 0, 255})},
-      true);
-  for (unsigned threads : {1u, 2u, 3u}) {
-    const Frame frame = render_one(tree, cam, {}, threads);
-    // Red shaded with the white highlight: (0.93 + 0.25, 0.25, 0.25) → (255, 64, 64).
-    EXPECT_EQ(frame.color[24 * 64 + 32], (Rgb8{255, 64, 64})) << threads;
+  // Three splats at one depth over the centre pixel, in every order of the stream: the pixel
+  // shows the splat whose packed colour r | g << 8 | b << 16 is smallest, whatever came first.
+  // Shaded with the white highlight: red → (255, 64, 64) = 0x4040FF, green → (64, 255, 64) =
+  // 0x40FF40, blue → (64, 64, 255) = 0xFF4040; the smallest is red.
+  const SphereNode red = leaf({0, 0, -2}, 0.3f, {0, 0, 1}, {255, 0, 0});
+  const SphereNode green = leaf({0.01f, 0, -2}, 0.3f, {0, 0, 1}, {0, 255, 0});
+  const SphereNode blue = leaf({0, 0.01f, -2}, 0.3f, {0, 0, 1}, {0, 0, 255});
+  const std::vector<std::vector<SphereNode>> orders = {
+      {red, green, blue}, {green, red, blue}, {blue, green, red}, {green, blue, red}};
+  for (const auto& order : orders) {
+    const SphereTree tree = root_with_leaves(order, true);
+    for (unsigned threads : {1u, 2u, 3u}) {
+      const Frame frame = render_one(tree, cam, {}, threads);
+      EXPECT_EQ(frame.color[24 * 64 + 32], (Rgb8{255, 64, 64})) << threads;
+    }
   }
-  // A nearer later splat wins.
+  // Without red, green (0x40FF40) beats blue (0xFF4040) in either order.
+  for (const auto& order : std::vector<std::vector<SphereNode>>{{green, blue}, {blue, green}}) {
+    EXPECT_EQ(render_one(root_with_leaves(order, true), cam, {}, 2).color[24 * 64 + 32],
+              (Rgb8{64, 255, 64}));
+  }
+  // A nearer later splat wins whatever its colour.
   const SphereTree nearer = root_with_leaves(
-      {leaf({0, 0, -2}, 0.3f, {0, 0, 1}, {255, 0, 0}), leaf({0, 0, -1.9f}, 0.3f, {0, 0, 1}, {0, 255, 0})},
+      {leaf({0, 0, -2}, 0.3f, {0, 0, 1}, {255, 0, 0}), leaf({0, 0, -1.9f}, 0.3f, {0, 0, 1}, {0, 0, 255})},
       true);
-  EXPECT_EQ(render_one(nearer, cam, {}, 2).color[24 * 64 + 32], (Rgb8{64, 255, 64}));
+  EXPECT_EQ(render_one(nearer, cam, {}, 2).color[24 * 64 + 32], (Rgb8{64, 64, 255}));
 }
 
 TEST(SplatRaster, RejectsInvalidSettings) {

@@ -24,13 +24,16 @@ struct RasterScratch {
   };
   std::vector<Chunk> chunks;
   std::vector<Buffer<std::uint32_t>> band_colors;  // one packed-color band per thread
+  Buffer<std::uint32_t> image;   // per pixel: packed colour, drawing in several batches
   std::uint64_t clipped_fragments = 0;  // the last frame's (RenderStats::clipped_fragments)
 };
 
 // Clears color to settings.background and depth to +infinity, then draws every splat of
 // `stream` (positions and sizes in pixels of `camera`'s image, which must be color's and depth's
-// width × height) with a strict depth test on the splat's centre depth, so at equal depth the
-// earlier splat in stream order wins. Pixels are unit squares with centres at (i + 0.5, j + 0.5);
+// width × height) with a depth test on the splat's centre depth; at equal depth the smaller
+// packed colour (r | g << 8 | b << 16) wins. Each pixel thus shows the minimum of (depth, colour)
+// over the splats covering it: the image depends on the set of splats, not on their order in
+// the stream (occlusion culling draws them in another order and must give the same bits). Pixels are unit squares with centres at (i + 0.5, j + 0.5);
 // a splat covers the pixels whose centre lies inside its shape (closed), and a splat covering no
 // centre covers the pixel that contains its centre:
 //  * Square: |px − x| ≤ d/2 and |py − y| ≤ d/2, d = size_px;
@@ -46,5 +49,18 @@ struct RasterScratch {
 void rasterize_splats(const SplatStream& stream, const CameraFrame& camera,
                       const RenderSettings& settings, ThreadPool& pool, RasterScratch& scratch,
                       std::span<Rgb8> color, std::span<float> depth);
+
+// The same drawing in batches (occlusion culling draws, tests depths, and draws more):
+// begin_splats clears the image held in `scratch` and `depth`; draw_splats draws chunks
+// [first_chunk, end_chunk) of `stream` over what is there; finish_splats writes the colours.
+// Drawing a stream in any split into batches and any order of its chunks gives the image of
+// rasterize_splats over the whole stream. scratch.clipped_fragments sums the batches.
+void begin_splats(const CameraFrame& camera, const RenderSettings& settings, ThreadPool& pool,
+                  RasterScratch& scratch, std::span<float> depth);
+void draw_splats(const SplatStream& stream, std::size_t first_chunk, std::size_t end_chunk,
+                 const CameraFrame& camera, const RenderSettings& settings, ThreadPool& pool,
+                 RasterScratch& scratch, std::span<float> depth);
+void finish_splats(const CameraFrame& camera, ThreadPool& pool, const RasterScratch& scratch,
+                   std::span<Rgb8> color);
 
 }  // namespace pointillist

@@ -2,8 +2,9 @@
 // software and OpenGL drivers of QSplat: Rusinkiewicz & Levoy, SIGGRAPH 2000, section 4.1).
 //
 // Deterministic in parallel: the image is split into horizontal bands; every band draws all the
-// splats that touch it in stream order with a strict depth test, so each pixel sees the same
-// sequence of splats for any band layout and thread count (ties go to the earlier splat).
+// splats that touch it with a depth test on (depth, colour): equal depths go to the smaller
+// packed colour, so what a pixel shows is the minimum over the splats covering it and depends
+// neither on the band layout and thread count nor on the order of the stream.
 #include "pointillist/render/splat_raster.hpp"
 
 #include <algorithm>
@@ -72,13 +73,16 @@ inline int ceil_int(float v) {
   return t + (v > static_cast<float>(t));
 }
 
+// The depth test: nearer wins; at equal depth the smaller packed colour (colours are below 2^24,
+// so signed and unsigned order agree).
 inline void plot(const Target& t, int i, int j, float z, std::uint32_t c) {
   if (i < 0 || i >= t.width || j < t.row_begin || j >= t.row_end) return;
   const std::size_t w = static_cast<std::size_t>(t.width);
   const std::size_t p = static_cast<std::size_t>(j) * w + i;
-  if (z < t.depth[p]) {
+  std::uint32_t& old = t.color[static_cast<std::size_t>(j - t.row_begin) * w + i];
+  if (z < t.depth[p] || (z == t.depth[p] && c < old)) {
     t.depth[p] = z;
-    t.color[static_cast<std::size_t>(j - t.row_begin) * w + i] = c;
+    old = c;
   }
 }
 
@@ -172,15 +176,16 @@ inline void fill_box(const Target& t, const PixelBox& b, float x, float y, float
     float cy = static_cast<float>(b.j0) + 0.5f;
     for (int j = b.j0; j <= b.j1; ++j, cy += 1.0f, depth += w, color += w) {
       const Float4 old_depth = load4(depth);
+      const Int4 old_color = load4(color);
       const Int4 cover = row_test(cy - y);
-      Int4 m = cover & (zv < old_depth);
+      Int4 m = cover & ((zv < old_depth) | ((zv == old_depth) & (cv < old_color)));
       if constexpr (!std::is_same_v<Clip, NoClip>) {
         const Int4 cut = cover & clip(px, cy);
         clip.tally(cut & fresh);
         m &= ~cut;
       }
       store4(depth, select4(m, zv, old_depth));
-      store4(color, select4(m, cv, load4(color)));
+      store4(color, select4(m, cv, old_color));
     }
   }
 }
@@ -227,8 +232,8 @@ inline void plot_nearest(const Target& t, const NearestCentre& n, float z, std::
 }
 
 template <class Clip>
-inline void draw_square(const Target& t, float x, float y, float z, float r, std::uint32_t c,
-                        const Clip& clip) {
+inline void draw_square(const Target& t, float x, float y, float z, float r,
+                        std::uint32_t c, const Clip& clip) {
   if (r < kSquareAlwaysCovers) {
     const NearestCentre n = nearest_centre(t, x, y);
     if (!(std::abs(n.dx) <= r && std::abs(n.dy) <= r)) {
@@ -245,8 +250,8 @@ inline void draw_square(const Target& t, float x, float y, float z, float r, std
 }
 
 template <class Clip>
-inline void draw_circle(const Target& t, float x, float y, float z, float r, std::uint32_t c,
-                        const Clip& clip) {
+inline void draw_circle(const Target& t, float x, float y, float z, float r,
+                        std::uint32_t c, const Clip& clip) {
   const float r2 = r * r;
   if (r < kDiscAlwaysCovers) {
     const NearestCentre n = nearest_centre(t, x, y);
@@ -264,8 +269,8 @@ inline void draw_circle(const Target& t, float x, float y, float z, float r, std
 
 // Ellipse {d : A·dx² + 2B·dx·dy + C·dy² ≤ r²} (see ellipse_parameters).
 template <class Clip>
-inline void draw_ellipse(const Target& t, float x, float y, float z, float r, const float* e,
-                         std::uint32_t c, const Clip& clip) {
+inline void draw_ellipse(const Target& t, float x, float y, float z, float r,
+                         const float* e, std::uint32_t c, const Clip& clip) {
   const float a = e[0], b2 = e[1], cc = e[2];
   const float hx = r * e[3], hy = r * e[4];
   const float r2 = r * r;
@@ -384,7 +389,8 @@ inline void draw_shape(const Target& t, const SplatChunk& s, const RasterScratch
   } else if constexpr (kShape == SplatShape::Circle) {
     draw_circle(t, s.x_px[i], s.y_px[i], s.depth[i], r, c, clip);
   } else {
-    draw_ellipse(t, s.x_px[i], s.y_px[i], s.depth[i], r, &sc.ellipse[kEllipseStride * i], c, clip);
+    draw_ellipse(t, s.x_px[i], s.y_px[i], s.depth[i], r, &sc.ellipse[kEllipseStride * i], c,
+                 clip);
   }
 }
 
@@ -414,10 +420,10 @@ inline void draw_one(const Target& t, const SplatChunk& s, const RasterScratch::
 // rows whose centre is within its radius of y, and the row holding y, so y + r ≥ first row and
 // y − r < end row is a safe test.
 template <SplatShape kShape, bool kFeatures>
-void draw_band(const SplatStream& stream, const RasterScratch& scratch, bool banded,
-               const Target& t) {
+void draw_band(const SplatStream& stream, std::size_t first, std::size_t end,
+               const RasterScratch& scratch, bool banded, const Target& t) {
   const float band_lo = static_cast<float>(t.row_begin), band_hi = static_cast<float>(t.row_end);
-  for (std::size_t c = 0; c < stream.chunk_count; ++c) {
+  for (std::size_t c = first; c < end; ++c) {
     const SplatChunk& s = stream.chunks[c];
     const RasterScratch::Chunk& sc = scratch.chunks[c];
     if (!banded || (sc.y_min_px >= band_lo && sc.y_max_px < band_hi)) {
@@ -435,10 +441,28 @@ void draw_band(const SplatStream& stream, const RasterScratch& scratch, bool ban
 void clear_band(const Target& t, Rgb8 background) {
   const std::size_t w = static_cast<std::size_t>(t.width);
   const std::size_t rows = static_cast<std::size_t>(t.row_end - t.row_begin);
+  const std::size_t first = static_cast<std::size_t>(t.row_begin) * w;
   std::fill(t.color, t.color + rows * w, pack(background));
-  std::fill(t.depth + static_cast<std::size_t>(t.row_begin) * w,
-            t.depth + static_cast<std::size_t>(t.row_end) * w,
-            std::numeric_limits<float>::infinity());
+  std::fill(t.depth + first, t.depth + first + rows * w, std::numeric_limits<float>::infinity());
+}
+
+void draw_chunks(const SplatStream& stream, std::size_t first, std::size_t end,
+                 const RasterScratch& scratch, SplatShape shape, bool banded, const Target& t) {
+  const bool f = stream.has_features;
+  switch (shape) {
+    case SplatShape::Square:
+      (f ? draw_band<SplatShape::Square, true> : draw_band<SplatShape::Square, false>)(
+          stream, first, end, scratch, banded, t);
+      break;
+    case SplatShape::Circle:
+      (f ? draw_band<SplatShape::Circle, true> : draw_band<SplatShape::Circle, false>)(
+          stream, first, end, scratch, banded, t);
+      break;
+    case SplatShape::Ellipse:
+      (f ? draw_band<SplatShape::Ellipse, true> : draw_band<SplatShape::Ellipse, false>)(
+          stream, first, end, scratch, banded, t);
+      break;
+  }
 }
 
 // The band's packed 0x00BBGGRR pixels to 3-byte pixels of the output, four at a time (three
@@ -484,6 +508,38 @@ void unpack_band(const Target& t, std::span<Rgb8> out) {
   }
 }
 
+// Per-chunk preparation of chunks [first, end): ellipse parameters, row extents, eye-space
+// clip planes.
+void prepare_chunks(const SplatStream& stream, std::size_t first, std::size_t end,
+                    const CameraFrame& camera, const RenderSettings& settings, bool banded,
+                    ThreadPool& pool, RasterScratch& scratch) {
+  const bool ellipses = settings.shape == SplatShape::Ellipse;
+  if (scratch.chunks.size() < end) scratch.chunks.resize(end);
+  const bool features = stream.has_features;
+  if (ellipses || banded || features) pool.run(end - first, [&](std::size_t k) {
+    const std::size_t c = first + k;
+    if (ellipses) prepare_ellipses(stream.chunks[c], camera, scratch.chunks[c]);
+    if (banded) row_extent(stream.chunks[c], scratch.chunks[c]);
+    if (features) {
+      render_detail::eye_space_planes(stream.chunks[c], camera, scratch.chunks[c].planes);
+      scratch.chunks[c].camera = &camera;
+    }
+  });
+}
+
+Target band_target(const CameraFrame& camera, const BandLayout& bands, int b,
+                   std::uint32_t* color, float* depth, std::uint64_t* clipped) {
+  return Target{color,
+                depth,
+                camera.width,
+                camera.height,
+                b << bands.rows_log2,
+                std::min(camera.height, (b + 1) << bands.rows_log2),
+                static_cast<float>(camera.width),
+                static_cast<float>(camera.height),
+                clipped};
+}
+
 }  // namespace
 
 void rasterize_splats(const SplatStream& stream, const CameraFrame& camera,
@@ -492,20 +548,9 @@ void rasterize_splats(const SplatStream& stream, const CameraFrame& camera,
   [[maybe_unused]] const std::size_t pixels =
       static_cast<std::size_t>(camera.width) * static_cast<std::size_t>(camera.height);
   assert(color.size() == pixels && depth.size() == pixels);
-  const bool ellipses = settings.shape == SplatShape::Ellipse;
   const BandLayout bands = choose_bands(camera.width, camera.height, pool.thread_count());
   const bool banded = bands.count > 1;
-
-  if (scratch.chunks.size() < stream.chunk_count) scratch.chunks.resize(stream.chunk_count);
-  const bool features = stream.has_features;
-  if (ellipses || banded || features) pool.run(stream.chunk_count, [&](std::size_t c) {
-    if (ellipses) prepare_ellipses(stream.chunks[c], camera, scratch.chunks[c]);
-    if (banded) row_extent(stream.chunks[c], scratch.chunks[c]);
-    if (features) {
-      render_detail::eye_space_planes(stream.chunks[c], camera, scratch.chunks[c].planes);
-      scratch.chunks[c].camera = &camera;
-    }
-  });
+  prepare_chunks(stream, 0, stream.chunk_count, camera, settings, banded, pool, scratch);
 
   // One worker per thread takes bands off a shared counter and packs colors in its own
   // band-sized buffer; which worker draws a band does not matter.
@@ -520,36 +565,68 @@ void rasterize_splats(const SplatStream& stream, const CameraFrame& camera,
   pool.run(workers, [&](std::size_t worker) {
     std::uint64_t clipped_here = 0;
     for (int b = next_band++; b < bands.count; b = next_band++) {
-      const Target t{scratch.band_colors[worker].data(),
-                     depth.data(),
-                     camera.width,
-                     camera.height,
-                     b << bands.rows_log2,
-                     std::min(camera.height, (b + 1) << bands.rows_log2),
-                     static_cast<float>(camera.width),
-                     static_cast<float>(camera.height),
-                     &clipped_here};
+      const Target t = band_target(camera, bands, b, scratch.band_colors[worker].data(),
+                                   depth.data(), &clipped_here);
       clear_band(t, settings.background);
-      const bool f = stream.has_features;
-      switch (settings.shape) {
-        case SplatShape::Square:
-          (f ? draw_band<SplatShape::Square, true> : draw_band<SplatShape::Square, false>)(
-              stream, scratch, banded, t);
-          break;
-        case SplatShape::Circle:
-          (f ? draw_band<SplatShape::Circle, true> : draw_band<SplatShape::Circle, false>)(
-              stream, scratch, banded, t);
-          break;
-        case SplatShape::Ellipse:
-          (f ? draw_band<SplatShape::Ellipse, true> : draw_band<SplatShape::Ellipse, false>)(
-              stream, scratch, banded, t);
-          break;
-      }
+      draw_chunks(stream, 0, stream.chunk_count, scratch, settings.shape, banded, t);
       unpack_band(t, color);
     }
     clipped += clipped_here;
   });
   scratch.clipped_fragments = clipped;
+}
+
+void begin_splats(const CameraFrame& camera, const RenderSettings& settings, ThreadPool& pool,
+                  RasterScratch& scratch, std::span<float> depth) {
+  const std::size_t pixels =
+      static_cast<std::size_t>(camera.width) * static_cast<std::size_t>(camera.height);
+  assert(depth.size() == pixels);
+  if (scratch.image.size() < pixels) scratch.image.resize(pixels);
+  scratch.clipped_fragments = 0;
+  const BandLayout bands = choose_bands(camera.width, camera.height, pool.thread_count());
+  pool.run(static_cast<std::size_t>(bands.count), [&](std::size_t b) {
+    const int band = static_cast<int>(b);
+    std::uint32_t* color = scratch.image.data() +
+                           (static_cast<std::size_t>(band) << bands.rows_log2) *
+                               static_cast<std::size_t>(camera.width);
+    clear_band(band_target(camera, bands, band, color, depth.data(), nullptr),
+               settings.background);
+  });
+}
+
+void draw_splats(const SplatStream& stream, std::size_t first_chunk, std::size_t end_chunk,
+                 const CameraFrame& camera, const RenderSettings& settings, ThreadPool& pool,
+                 RasterScratch& scratch, std::span<float> depth) {
+  if (first_chunk >= end_chunk) return;
+  const BandLayout bands = choose_bands(camera.width, camera.height, pool.thread_count());
+  const bool banded = bands.count > 1;
+  prepare_chunks(stream, first_chunk, end_chunk, camera, settings, banded, pool, scratch);
+  std::atomic<std::uint64_t> clipped{0};
+  pool.run(static_cast<std::size_t>(bands.count), [&](std::size_t b) {
+    const int band = static_cast<int>(b);
+    std::uint64_t clipped_here = 0;
+    std::uint32_t* color = scratch.image.data() +
+                           (static_cast<std::size_t>(band) << bands.rows_log2) *
+                               static_cast<std::size_t>(camera.width);
+    draw_chunks(stream, first_chunk, end_chunk, scratch, settings.shape, banded,
+                band_target(camera, bands, band, color, depth.data(), &clipped_here));
+    clipped += clipped_here;
+  });
+  scratch.clipped_fragments += clipped;
+}
+
+void finish_splats(const CameraFrame& camera, ThreadPool& pool, const RasterScratch& scratch,
+                   std::span<Rgb8> color) {
+  const BandLayout bands = choose_bands(camera.width, camera.height, pool.thread_count());
+  pool.run(static_cast<std::size_t>(bands.count), [&](std::size_t b) {
+    const int band = static_cast<int>(b);
+    const std::uint32_t* packed = scratch.image.data() +
+                                  (static_cast<std::size_t>(band) << bands.rows_log2) *
+                                      static_cast<std::size_t>(camera.width);
+    unpack_band(band_target(camera, bands, band, const_cast<std::uint32_t*>(packed), nullptr,
+                            nullptr),
+                color);
+  });
 }
 
 }  // namespace pointillist
