@@ -64,8 +64,9 @@ constexpr Rgb8 unpack_rgb(std::uint32_t c) {
 }
 
 // Splats in stream order: chunk 0 first, each chunk in order. The order is the depth-first order
-// of the hierarchy and does not depend on the thread count; a rasterizer resolves equal depths in
-// favour of the earlier splat. Chunk boundaries depend only on the tree and the camera.
+// of the hierarchy and does not depend on the thread count; the quality rasterizer sums in it
+// (the fast one's image does not depend on it). Chunk boundaries depend only on the tree and the
+// camera.
 struct SplatStream {
   std::vector<SplatChunk> chunks;  // only the first `chunk_count` are in use
   std::size_t chunk_count = 0;
