@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "frame_pass.hpp"
+#include "renderer_state.hpp"
 #include "select/stream_features.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/render/mesh_reference.hpp"
@@ -16,69 +17,12 @@
 
 namespace pointillist {
 
-namespace {
-
-// Page size when a model held whole is cut into pages (RendererOptions::page_all).
-constexpr std::uint64_t kInMemoryPageBytes = 64 * 1024;
-constexpr std::uint32_t kInMemoryPageLevels = 4;
-
-// The camera as the model sees it: the same image of the model at p as the world camera gives
-// of translate + scale·R·p. Sizes on screen are unchanged (radius and distance scale alike).
-Camera model_camera(const Camera& world, const InstanceTransform& t) {
-  Camera c = world;
-  const float inv_scale = 1.0f / t.scale;
-  c.eye = t.rotate_back(world.eye - t.translate) * inv_scale;
-  c.target = t.rotate_back(world.target - t.translate) * inv_scale;
-  c.up = t.rotate_back(world.up);
-  return c;
-}
-
-// Moves a chunk selected in model space into the world: discs, and depth (model depth × scale).
-void to_world(const InstanceTransform& t, SplatChunk& chunk, bool with_discs) {
-  for (std::size_t i = 0; i < chunk.count; ++i) {
-    chunk.depth[i] *= t.scale;
-    chunk.normal[i] = t.rotate(chunk.normal[i]);
-    if (with_discs) {
-      chunk.center[i] = t.apply(chunk.center[i]);
-      chunk.radius[i] *= t.scale;
-    }
-  }
-}
-
-std::uint8_t to_byte(float v) {
-  return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
-}
-
-// The sharp features of a model: its hierarchy's, or (paged) what its pages carry.
-const TreeFeatures* model_features(const RenderModel& m) {
-  if (m.tree.features) return m.tree.features;
-  return m.pages ? m.pages->features() : nullptr;
-}
-
-void add(SelectionStats& a, const SelectionStats& b) {
-  a.splats += b.splats;
-  a.nodes_visited += b.nodes_visited;
-  a.culled_frustum += b.culled_frustum;
-  a.culled_backface += b.culled_backface;
-}
-
-}  // namespace
+using namespace render_detail;
 
 bool InstanceTransform::is_identity() const {
   return translate == Vec3f{0, 0, 0} && scale == 1.0f && rotation[0] == Vec3f{1, 0, 0} &&
          rotation[1] == Vec3f{0, 1, 0} && rotation[2] == Vec3f{0, 0, 1};
 }
-
-struct Renderer::ModelState {
-  const RenderModel* model = nullptr;
-  std::unique_ptr<PageSource> owned_pages;  // a model held whole, cut into pages
-  const PageSource* pages = nullptr;
-  std::optional<PagedRenderer> paged;
-  std::optional<SequentialPointTree> spt;
-  std::optional<TreeFeatures> spt_features;  // the model's features on the SPT's entries
-  std::uint64_t frame = 0;  // the last frame that drew the model
-  std::uint64_t model_bytes = 0;  // storage bytes of a paged model (open + every page)
-};
 
 Renderer::Renderer(const RendererOptions& options) : options_(options) {}
 Renderer::~Renderer() = default;
@@ -152,9 +96,30 @@ void Renderer::render(std::span<const SceneInstance> scene, const Camera& camera
     }
   }
 
+  const bool occlusion = fs.occlusion.method != OcclusionMethod::None;
+  if (occlusion) {
+    const char* drop = fs.rasterizer != Rasterizer::Fast ? "--mode quality or reference"
+                       : fs.lod == LodScheme::Spt          ? "--lod spt"
+                       : options_.page_all                 ? "--memory and --progressive"
+                                                           : nullptr;
+    for (const SceneInstance& inst : scene) {
+      if (!drop && inst.model->pages) drop = "the paged model (open it whole)";
+    }
+    if (drop) {
+      throw OptionError(std::string("occlusion culling (--occlusion ") +
+                        name(fs.occlusion.method) +
+                        ") works with the fast mode and the QSplat traversal of models held "
+                        "whole so far; drop " + drop + ", or --occlusion");
+    }
+  }
   last_frame_.clear();
   spt_stats_ = {};
+  occlusion_stats_ = {};
   ++frame_number_;
+  if (occlusion) {
+    render_occluded(scene, camera, settings, fs, pool, frame);
+    return;
+  }
   if (fs.rasterizer == Rasterizer::Reference) {
     render_mesh_reference(*scene[0].model->mesh, camera, settings, frame);
     return;

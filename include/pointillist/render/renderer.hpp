@@ -18,6 +18,7 @@
 #include "pointillist/lod/page_cache.hpp"
 #include "pointillist/lod/pages.hpp"
 #include "pointillist/lod/sphere_tree.hpp"
+#include "pointillist/render/occlusion.hpp"
 #include "pointillist/render/quality.hpp"
 #include "pointillist/render/render.hpp"
 #include "pointillist/render/settings.hpp"
@@ -89,6 +90,10 @@ struct FrameSettings {
   // Draw the sharp features of models that have them (TreeFeatures: clip planes, surface ids;
   // QSplat on hierarchies held whole). Off draws as without them.
   bool features = true;
+  // Occlusion culling (occlusion.hpp): with a method other than None, nodes hidden behind what
+  // is already drawn are skipped. The image is the same bits as without culling. The fast
+  // rasterizer and the QSplat traversal of models held whole only (for now).
+  OcclusionSettings occlusion;
 };
 
 struct RendererOptions {
@@ -118,12 +123,16 @@ class Renderer {
   // Draws the instances seen by `camera` into `frame` (resized as needed): every instance's
   // splats are selected (in its own frame, through the inverse of its transform, so the detail
   // is the same as if the model stood there) into one stream, instance after instance, and
-  // rasterized once. Equal depths go to the earlier instance, then the earlier node. The image
-  // does not depend on pool.thread_count(). A paged model draws what is resident and requests
-  // the rest (load_requested, request_in_background). frame.stats sums the instances.
-  // Throws OptionError for combinations that cannot be drawn (the message says what to drop):
-  // the reference rasterizer with SPT, with several or transformed instances, or without a mesh;
-  // SPT on a paged model; invalid settings.
+  // rasterized once. Equal depths go to the smaller colour (fast) or are summed in stream order
+  // (quality). The image does not depend on pool.thread_count(), nor on the occlusion method:
+  // with occlusion culling, a hierarchy over the instances and their models is traversed front
+  // to back and only what the queries find visible is selected and drawn. A paged model draws
+  // what is resident and requests the rest (load_requested, request_in_background).
+  // frame.stats sums the instances. Throws OptionError for combinations that cannot be drawn
+  // (the message says what to drop): the reference rasterizer with SPT, with several or
+  // transformed instances, or without a mesh; SPT on a paged model; occlusion culling other
+  // than with the fast rasterizer and the QSplat traversal of models held whole; invalid
+  // settings.
   void render(std::span<const SceneInstance> scene, const Camera& camera,
               const RenderSettings& settings, const FrameSettings& frame_settings,
               ThreadPool& pool, Frame& frame);
@@ -143,9 +152,15 @@ class Renderer {
   PagingStats paging_stats() const;
   // SPT selection details of the last frame (summed over instances).
   const SptSelectionStats& spt_stats() const { return spt_stats_; }
+  // Occlusion culling counts of the last frame (zero without culling).
+  const OcclusionStats& occlusion_stats() const { return occlusion_stats_; }
 
  private:
   struct ModelState;
+  struct SceneCull;
+  void render_occluded(std::span<const SceneInstance> scene, const Camera& camera,
+                       const RenderSettings& settings, const FrameSettings& fs, ThreadPool& pool,
+                       Frame& frame);
   ModelState& state_for(const RenderModel& model, ThreadPool& pool, const FrameSettings& fs);
   SelectionStats select(std::span<const SceneInstance> scene, const Camera& camera,
                         const CameraFrame& world, const RenderSettings& settings,
@@ -158,6 +173,8 @@ class Renderer {
   QualityScratch quality_scratch_;
   SptSelectionStats spt_stats_;
   std::uint64_t frame_number_ = 0;
+  std::unique_ptr<SceneCull> cull_;  // occlusion culling: the scene's hierarchy and state
+  OcclusionStats occlusion_stats_;
 };
 
 }  // namespace pointillist

@@ -16,6 +16,7 @@
 #include "pointillist/render/selection.hpp"
 #include "shading.hpp"
 #include "select/qsplat_traversal.hpp"
+#include "select/subtree_selection.hpp"
 
 namespace pointillist {
 
@@ -75,6 +76,26 @@ class FlatAccess {
 };
 
 }  // namespace
+
+namespace render_detail {
+
+void select_subtree(std::span<const SphereNode> nodes, std::uint32_t node, std::uint8_t tests,
+                    const ViewConstants& v, bool with_colors, SplatChunk& chunk,
+                    Counters& counters) {
+  const FlatAccess access(nodes);
+  TaskState<FlatAccess> out;
+  thread_local std::vector<FlatAccess::Item> stack;
+  chunk.count = 0;
+  chunk.reserve(kInitialChunkCapacity, with_colors, v.with_discs);
+  walk_subtree(access, FlatAccess::Item{node, tests}, v, with_colors, stack, chunk, out);
+  finish_chunk([&](std::uint32_t i) -> const SphereNode& { return nodes[i]; }, v, with_colors,
+               chunk);
+  counters.visited += out.counters.visited;
+  counters.culled_frustum += out.counters.culled_frustum;
+  counters.culled_backface += out.counters.culled_backface;
+}
+
+}  // namespace render_detail
 
 void select_splats(const SphereTreeView& tree, const CameraFrame& camera,
                    const RenderSettings& settings, ThreadPool& pool, SplatStream& stream,

@@ -1,0 +1,476 @@
+// The renderer with occlusion culling (renderer.hpp, occlusion.hpp): a hierarchy over the scene
+// (a BVH over the instances, then each model's sphere tree down to culling leaves), traversed
+// front to back by stop-and-wait, CHC or CHC++; the culling leaves found visible are selected
+// and drawn batch by batch into the frame, whose depth the queries test through a max-depth
+// pyramid. The fast rasterizer's image depends only on the set of splats drawn (ties go to the
+// smaller colour), and only splats strictly behind what is drawn are skipped, so the image is
+// the same bits as without culling.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include "frame_pass.hpp"
+#include "renderer_state.hpp"
+#include "select/stream_features.hpp"
+#include "select/subtree_selection.hpp"
+#include "shading.hpp"
+#include "pointillist/core/error.hpp"
+
+namespace pointillist {
+
+using namespace render_detail;
+
+namespace render_detail {
+
+ModelCullTree build_cull_tree(std::span<const SphereNode> nodes, std::uint32_t leaf_points) {
+  ModelCullTree t;
+  t.leaf_points = leaf_points;
+  if (nodes.empty()) return t;
+  // Points below each node: children come after their parent, so one backward pass.
+  std::vector<std::uint32_t> points(nodes.size(), 1);
+  for (std::size_t i = nodes.size(); i-- > 0;) {
+    const SphereNode& n = nodes[i];
+    if (n.child_count == 0) continue;
+    std::uint64_t sum = 0;
+    for (std::uint32_t k = 0; k < n.child_count; ++k) sum += points[n.first_child + k];
+    points[i] = static_cast<std::uint32_t>(std::min<std::uint64_t>(sum, UINT32_MAX));
+  }
+  // Depth first from the root; a node with more than leaf_points points is opened.
+  struct Todo {
+    std::uint32_t node, parent;
+  };
+  std::vector<Todo> stack{{0, UINT32_MAX}};
+  while (!stack.empty()) {
+    const Todo todo = stack.back();
+    stack.pop_back();
+    const std::uint32_t local = static_cast<std::uint32_t>(t.nodes.size());
+    t.nodes.push_back({todo.node, todo.parent, 0, 0, 1, points[todo.node]});
+    if (todo.parent != UINT32_MAX) t.children.push_back(local);  // placeholder order fixed below
+    const SphereNode& n = nodes[todo.node];
+    if (n.child_count > 0 && points[todo.node] > leaf_points) {
+      for (std::uint32_t k = n.child_count; k-- > 0;) stack.push_back({n.first_child + k, local});
+    }
+  }
+  // Children lists: each node's children in order, contiguous.
+  t.children.assign(t.nodes.size() > 0 ? t.nodes.size() - 1 : 0, 0);
+  std::vector<std::uint32_t> count(t.nodes.size(), 0);
+  for (std::size_t i = 1; i < t.nodes.size(); ++i) ++count[t.nodes[i].parent];
+  std::uint32_t next = 0;
+  for (std::size_t i = 0; i < t.nodes.size(); ++i) {
+    t.nodes[i].first_child = next;
+    next += count[i];
+  }
+  std::vector<std::uint32_t> filled(t.nodes.size(), 0);
+  for (std::size_t i = 1; i < t.nodes.size(); ++i) {
+    ModelCullTree::Node& p = t.nodes[t.nodes[i].parent];
+    t.children[p.first_child + filled[t.nodes[i].parent]++] = static_cast<std::uint32_t>(i);
+  }
+  for (std::size_t i = 0; i < t.nodes.size(); ++i) t.nodes[i].child_count = count[i];
+  // Culling leaves below each node (children after parents: backward).
+  for (std::size_t i = t.nodes.size(); i-- > 0;) {
+    ModelCullTree::Node& n = t.nodes[i];
+    if (n.child_count == 0) continue;
+    n.culling_leaves = 0;
+    for (std::uint32_t k = 0; k < n.child_count; ++k) {
+      n.culling_leaves += t.nodes[t.children[n.first_child + k]].culling_leaves;
+    }
+  }
+  return t;
+}
+
+}  // namespace render_detail
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// The smallest sphere around `a` and `b` (a sphere holding both).
+Sphere enclose(const Sphere& a, const Sphere& b) {
+  const Vec3f d = b.center - a.center;
+  const float dist = length(d);
+  if (dist + b.radius <= a.radius) return a;
+  if (dist + a.radius <= b.radius) return b;
+  const float r = 0.5f * (dist + a.radius + b.radius);
+  return {a.center + d * ((r - a.radius) / dist), r * (1.0f + 1e-6f)};
+}
+
+Sphere world_sphere(const InstanceTransform& t, const SphereNode& n) {
+  return {t.apply(n.center), n.radius * t.scale * (1.0f + 1e-6f)};
+}
+
+}  // namespace
+
+void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camera& camera,
+                               const RenderSettings& settings, const FrameSettings& fs,
+                               ThreadPool& pool, Frame& frame) {
+  const auto start = Clock::now();
+  const OcclusionSettings& os = fs.occlusion;
+  if (os.leaf_points == 0) {
+    throw OptionError("occlusion culling leaves of 0 points are invalid; give at least 1");
+  }
+  if (!(settings.threshold_px > 0.0f) || !std::isfinite(settings.threshold_px)) {
+    throw OptionError("splat size threshold " + std::to_string(settings.threshold_px) +
+                      " px is invalid; give a positive number of pixels (1 draws every detail)");
+  }
+  const CameraFrame cam = make_camera_frame(camera);
+  size_frame(frame, cam);
+  occlusion_stats_ = {};
+  OcclusionStats& ostats = occlusion_stats_;
+
+  // The models' cull trees and the scene's hierarchy (rebuilt when the scene changes).
+  std::vector<ModelState*> states(scene.size());
+  for (std::size_t i = 0; i < scene.size(); ++i) {
+    ModelState& st = state_for(*scene[i].model, pool, fs);
+    if (st.frame != frame_number_) last_frame_.push_back(&st);
+    st.frame = frame_number_;
+    if (!st.cull_tree || st.cull_tree->leaf_points != os.leaf_points) {
+      st.cull_tree = build_cull_tree(scene[i].model->tree.nodes, os.leaf_points);
+    }
+    states[i] = &st;
+  }
+  if (!cull_ || !cull_->matches(scene, os.leaf_points)) {
+    cull_ = std::make_unique<SceneCull>();
+    SceneCull& c = *cull_;
+    c.leaf_points = os.leaf_points;
+    for (const SceneInstance& inst : scene) c.scene.emplace_back(inst.model, inst.transform);
+    // BVH over the instances' world spheres: median split on the longest axis of the centres.
+    std::vector<std::uint32_t> order(scene.size());
+    std::iota(order.begin(), order.end(), 0u);
+    std::vector<Sphere> world(scene.size());
+    for (std::size_t i = 0; i < scene.size(); ++i) {
+      const auto& nodes = scene[i].model->tree.nodes;
+      world[i] = nodes.empty() ? Sphere{scene[i].transform.translate, 0.0f}
+                               : world_sphere(scene[i].transform, nodes[0]);
+    }
+    c.instance_root.assign(scene.size(), UINT32_MAX);
+    struct Build {
+      std::uint32_t node, lo, hi;
+    };
+    const auto add_node = [&](std::uint32_t parent) {
+      c.h.nodes.push_back({});
+      c.h.nodes.back().parent = parent;
+      c.meta.push_back({});
+      return static_cast<std::uint32_t>(c.h.nodes.size() - 1);
+    };
+    // Splits first (parents before children), spheres afterwards bottom-up.
+    std::vector<std::vector<std::uint32_t>> kids;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> leaf_instance;  // (bvh node, instance)
+    std::vector<Build> todo{{add_node(UINT32_MAX), 0, static_cast<std::uint32_t>(scene.size())}};
+    kids.emplace_back();
+    while (!todo.empty()) {
+      const Build b = todo.back();
+      todo.pop_back();
+      if (b.hi - b.lo == 1) {
+        leaf_instance.emplace_back(b.node, order[b.lo]);
+        continue;
+      }
+      Aabb box;
+      for (std::uint32_t k = b.lo; k < b.hi; ++k) box.extend(world[order[k]].center);
+      const Vec3f e = box.hi - box.lo;
+      const int axis = e.x >= e.y && e.x >= e.z ? 0 : (e.y >= e.z ? 1 : 2);
+      const std::uint32_t mid = b.lo + (b.hi - b.lo) / 2;
+      std::nth_element(order.begin() + b.lo, order.begin() + mid, order.begin() + b.hi,
+                       [&](std::uint32_t a, std::uint32_t b2) {
+                         const float ca = world[a].center[axis], cb = world[b2].center[axis];
+                         return ca < cb || (ca == cb && a < b2);
+                       });
+      for (const auto& [lo, hi] : {std::pair{mid, b.hi}, std::pair{b.lo, mid}}) {
+        const std::uint32_t child = add_node(b.node);
+        kids.emplace_back();
+        kids[b.node].push_back(child);
+        todo.push_back({child, lo, hi});
+      }
+    }
+    // Children lists of the BVH nodes (in split order: lower half first).
+    for (std::uint32_t n = 0; n < kids.size(); ++n) std::reverse(kids[n].begin(), kids[n].end());
+    // Each instance's model nodes, below its BVH leaf (which is the model's root itself).
+    for (const auto& [bvh_leaf, i] : leaf_instance) {
+      const ModelCullTree& t = *states[i]->cull_tree;
+      const auto& nodes = scene[i].model->tree.nodes;
+      if (t.nodes.empty()) continue;
+      const std::uint32_t base = static_cast<std::uint32_t>(c.h.nodes.size()) - 1;
+      // Local node 0 is the BVH leaf; local k > 0 is base + k.
+      const auto global = [&](std::uint32_t local) { return local == 0 ? bvh_leaf : base + local; };
+      c.meta[bvh_leaf] = {i, 0};
+      c.instance_root[i] = bvh_leaf;
+      for (std::uint32_t k = 1; k < t.nodes.size(); ++k) {
+        c.h.nodes.push_back({});
+        c.meta.push_back({i, k});
+        kids.emplace_back();
+      }
+      for (std::uint32_t k = 0; k < t.nodes.size(); ++k) {
+        const ModelCullTree::Node& mn = t.nodes[k];
+        CullHierarchy::Node& hn = c.h.nodes[global(k)];
+        const Sphere s = world_sphere(scene[i].transform, nodes[mn.tree_node]);
+        hn.bound = {s.center, s.radius};
+        hn.culling_leaves = mn.culling_leaves;
+        if (k > 0) hn.parent = global(mn.parent);
+        for (std::uint32_t j = 0; j < mn.child_count; ++j) {
+          kids[global(k)].push_back(global(t.children[mn.first_child + j]));
+        }
+      }
+    }
+    // Flatten children; BVH spheres and leaf counts bottom-up (children after parents).
+    for (std::uint32_t n = 0; n < c.h.nodes.size(); ++n) {
+      c.h.nodes[n].first_child = static_cast<std::uint32_t>(c.h.children.size());
+      c.h.nodes[n].child_count = static_cast<std::uint32_t>(kids[n].size());
+      c.h.children.insert(c.h.children.end(), kids[n].begin(), kids[n].end());
+    }
+    for (std::uint32_t n = static_cast<std::uint32_t>(c.h.nodes.size()); n-- > 0;) {
+      if (c.meta[n].instance != UINT32_MAX) continue;
+      CullHierarchy::Node& hn = c.h.nodes[n];
+      if (hn.child_count == 0) continue;  // an instance without nodes
+      Sphere s{c.h.nodes[kids[n][0]].bound.center, c.h.nodes[kids[n][0]].bound.radius};
+      hn.culling_leaves = 0;
+      for (const std::uint32_t k : kids[n]) {
+        s = enclose(s, {c.h.nodes[k].bound.center, c.h.nodes[k].bound.radius});
+        hn.culling_leaves += c.h.nodes[k].culling_leaves;
+      }
+      hn.bound = {s.center, s.radius};
+    }
+  }
+  SceneCull& c = *cull_;
+
+  // Per-instance views (model space), made when an instance is first reached.
+  struct InstanceView {
+    bool ready = false;
+    bool identity = true;
+    CameraFrame cam;
+    std::optional<Shader> shader;
+    ViewConstants v;
+    std::uint32_t id_base = 0;
+  };
+  std::vector<InstanceView> views(scene.size());
+  bool any_colors = false, any_features = false;
+  for (const SceneInstance& inst : scene) {
+    any_colors = any_colors || inst.model->tree.has_colors;
+    any_features = any_features || inst.model->tree.features;
+  }
+  const bool features = fs.features && any_features;
+  const bool with_discs = features;
+  {
+    std::uint32_t id_base = 0;
+    for (std::size_t i = 0; i < scene.size(); ++i) {
+      views[i].id_base = id_base;
+      if (const TreeFeatures* f = scene[i].model->tree.features) id_base += f->surface_count;
+    }
+  }
+  const std::uint8_t root_tests =
+      static_cast<std::uint8_t>((settings.frustum_culling ? kTestFrustum : 0) |
+                                (settings.backface_culling ? kTestBackface : 0));
+  const auto view_of = [&](std::uint32_t i) -> InstanceView& {
+    InstanceView& iv = views[i];
+    if (!iv.ready) {
+      iv.identity = scene[i].transform.is_identity();
+      iv.cam = iv.identity ? cam : make_camera_frame(model_camera(camera, scene[i].transform));
+      iv.shader.emplace(settings, iv.cam);
+      iv.v = make_view_constants(*iv.shader, iv.cam, settings, with_discs);
+      iv.ready = true;
+    }
+    return iv;
+  };
+
+  // Per node of this frame: the tests left when it is reached (its parent's result) and after.
+  std::vector<std::uint8_t> tests_in(c.h.nodes.size(), root_tests);
+  std::vector<std::uint8_t> tests_out(c.h.nodes.size(), root_tests);
+  Counters counters;
+  const float min_splats = static_cast<float>(os.min_query_splats);
+  CullCallbacks callbacks;
+  callbacks.visit = [&](std::uint32_t n) {
+    CullCallbacks::Visit out;
+    const CullHierarchy::Node& hn = c.h.nodes[n];
+    const SceneCull::Meta& m = c.meta[n];
+    const Vec3f d = hn.bound.center - cam.eye;
+    const float z = dot(d, cam.forward);
+    out.distance = std::max(0.0f, length(d) - hn.bound.radius);
+    out.near = z - hn.bound.radius <= 0.0f;
+    if (m.instance == UINT32_MAX) {
+      // A BVH node: culled when outside a side plane of the view frustum or behind the eye.
+      if (settings.frustum_culling) {
+        if (z <= -hn.bound.radius) return out;
+        for (const Plane& p : cam.planes) {
+          if (p.distance(hn.bound.center) <= -hn.bound.radius) return out;
+        }
+      }
+      out.kind = CullCallbacks::Kind::Interior;
+      return out;
+    }
+    InstanceView& iv = view_of(m.instance);
+    const ModelCullTree& t = *states[m.instance]->cull_tree;
+    const ModelCullTree::Node& mn = t.nodes[m.local];
+    const SphereNode& node = scene[m.instance].model->tree.nodes[mn.tree_node];
+    const std::uint32_t parent = hn.parent;
+    std::uint8_t tests = (m.local == 0 || parent == UINT32_MAX) ? root_tests : tests_out[parent];
+    tests_in[n] = tests;
+    Vec3f dm;
+    float zm;
+    const Decision decision = visit(node, iv.v, tests, counters, dm, zm);
+    tests_out[n] = tests;
+    if (decision == Decision::Cull) return out;
+    if (decision == Decision::Draw) {
+      out.kind = CullCallbacks::Kind::Leaf;  // the detail stops here: one splat
+      out.small = true;
+      return out;
+    }
+    out.kind = mn.child_count == 0 ? CullCallbacks::Kind::Leaf : CullCallbacks::Kind::Interior;
+    // Splats expected: at most its points, about (projected size / threshold)² of them.
+    if (zm > 0) {
+      const float across = node.radius * iv.v.size_per_radius / (zm * settings.threshold_px);
+      out.small = std::min(static_cast<float>(mn.points), across * across) < min_splats;
+    }
+    return out;
+  };
+  // R6: the spheres of the descendants down to tight_depth levels, while they are not much
+  // larger in total than the node's own (Σ r² ≤ ratio · r²).
+  std::vector<std::uint32_t> level, next;
+  callbacks.bounds = [&](std::uint32_t n, std::vector<QueryBound>& out) {
+    const CullHierarchy::Node& hn = c.h.nodes[n];
+    const SceneCull::Meta& m = c.meta[n];
+    if (m.instance == UINT32_MAX) {
+      out.push_back(hn.bound);
+      return;
+    }
+    const auto& nodes = scene[m.instance].model->tree.nodes;
+    const InstanceTransform& tf = scene[m.instance].transform;
+    const std::uint32_t root = states[m.instance]->cull_tree->nodes[m.local].tree_node;
+    level.assign(1, root);
+    for (unsigned depth = 0; depth < os.tight_depth; ++depth) {
+      next.clear();
+      double area = 0, own = 0;
+      for (const std::uint32_t k : level) {
+        const SphereNode& p = nodes[k];
+        own += double(p.radius) * p.radius;
+        if (p.child_count == 0) {
+          next.push_back(k);
+          area += double(p.radius) * p.radius;
+          continue;
+        }
+        for (std::uint32_t j = 0; j < p.child_count; ++j) {
+          next.push_back(p.first_child + j);
+          area += double(nodes[p.first_child + j].radius) * nodes[p.first_child + j].radius;
+        }
+      }
+      if (area > os.tight_area_ratio * own) break;
+      level.swap(next);
+    }
+    for (const std::uint32_t k : level) {
+      const Sphere s = world_sphere(tf, nodes[k]);
+      out.push_back({s.center, s.radius});
+    }
+  };
+
+  // Drawing a batch of visible leaves: each selected into its own chunk, in parallel, then
+  // rasterized into the frame.
+  SplatStream& stream = frame.splats;
+  stream.chunk_count = 0;
+  stream.with_discs = with_discs;
+  stream.has_colors = any_colors;
+  stream.has_features = features;
+  double ms_select = 0, ms_raster = 0;
+  std::vector<Counters> task_counters;
+  std::vector<SoftwareQueries::Rect> rects;
+  std::vector<std::uint8_t> instance_drawn(scene.size(), 0);
+  begin_splats(cam, settings, pool, frame.scratch, frame.depth);
+  c.pyramid.reset(frame.depth, cam.width, cam.height);
+  const Rgb8 base_color{to_byte(settings.base_color.x), to_byte(settings.base_color.y),
+                        to_byte(settings.base_color.z)};
+  const SoftwareQueries::Draw draw = [&](std::span<const std::uint32_t> batch) {
+    const auto t0 = Clock::now();
+    const std::size_t first = stream.chunk_count;
+    if (stream.chunks.size() < first + batch.size()) stream.chunks.resize(first + batch.size());
+    for (const std::uint32_t n : batch) view_of(c.meta[n].instance);
+    task_counters.assign(batch.size(), {});
+    rects.assign(batch.size(), {});
+    pool.run(batch.size(), [&](std::size_t k) {
+      const std::uint32_t n = batch[k];
+      const SceneCull::Meta& m = c.meta[n];
+      const SceneInstance& inst = scene[m.instance];
+      const InstanceView& iv = views[m.instance];
+      const std::uint32_t tree_node = states[m.instance]->cull_tree->nodes[m.local].tree_node;
+      SplatChunk& chunk = stream.chunks[first + k];
+      select_subtree(inst.model->tree.nodes, tree_node, tests_in[n], iv.v,
+                     inst.model->tree.has_colors, chunk, task_counters[k]);
+      chunk.instance = m.instance;
+      if (!iv.identity) to_world(inst.transform, chunk, with_discs);
+      if (features) {
+        attach_features(inst.model->tree.features, iv.identity ? nullptr : &inst.transform,
+                        iv.id_base, chunk);
+      }
+      if (any_colors && !inst.model->tree.has_colors) {
+        chunk.reserve(chunk.count, true, with_discs);
+        std::fill(chunk.color.begin(), chunk.color.begin() + chunk.count, base_color);
+      }
+      if (fs.splat_scale != 1.0f) {
+        for (std::size_t i = 0; i < chunk.count; ++i) chunk.size_px[i] *= fs.splat_scale;
+        if (with_discs) {
+          for (std::size_t i = 0; i < chunk.count; ++i) chunk.radius[i] *= fs.splat_scale;
+        }
+      }
+      // The pixels the chunk may touch (a splat covers its disc or the pixel of its centre).
+      float x0 = std::numeric_limits<float>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
+      for (std::size_t i = 0; i < chunk.count; ++i) {
+        const float r = 0.5f * chunk.size_px[i] + 1.0f;
+        x0 = std::min(x0, chunk.x_px[i] - r);
+        x1 = std::max(x1, chunk.x_px[i] + r);
+        y0 = std::min(y0, chunk.y_px[i] - r);
+        y1 = std::max(y1, chunk.y_px[i] + r);
+      }
+      if (chunk.count > 0) {
+        const auto clampi = [](float v, int hi) {
+          return static_cast<int>(std::clamp(v, 0.0f, static_cast<float>(hi)));
+        };
+        rects[k] = {clampi(std::floor(x0), cam.width), clampi(std::floor(y0), cam.height),
+                    clampi(std::ceil(x1) + 1, cam.width), clampi(std::ceil(y1) + 1, cam.height)};
+      }
+    });
+    SoftwareQueries::Rect dirty{cam.width, cam.height, 0, 0};
+    for (std::size_t k = 0; k < batch.size(); ++k) {
+      counters.visited += task_counters[k].visited;
+      counters.culled_frustum += task_counters[k].culled_frustum;
+      counters.culled_backface += task_counters[k].culled_backface;
+      instance_drawn[c.meta[batch[k]].instance] = 1;
+      if (rects[k].x1 > rects[k].x0 && rects[k].y1 > rects[k].y0) {
+        dirty.x0 = std::min(dirty.x0, rects[k].x0);
+        dirty.y0 = std::min(dirty.y0, rects[k].y0);
+        dirty.x1 = std::max(dirty.x1, rects[k].x1);
+        dirty.y1 = std::max(dirty.y1, rects[k].y1);
+      }
+    }
+    stream.chunk_count = first + batch.size();
+    const auto t1 = Clock::now();
+    draw_splats(stream, first, stream.chunk_count, cam, settings, pool, frame.scratch,
+                frame.depth);
+    ms_select += std::chrono::duration<double, std::milli>(t1 - t0).count();
+    ms_raster += std::chrono::duration<double, std::milli>(Clock::now() - t1).count();
+    return dirty;
+  };
+  SoftwareQueries queries(c.pyramid, cam, QueryFootprint{std::max(1.0f, fs.splat_scale)},
+                          os.query_latency, draw, ostats);
+  cull_frame(c.h, callbacks, os, queries, c.state, ostats);
+  finish_splats(cam, pool, frame.scratch, frame.color);
+
+  SelectionStats selection;
+  selection.splats = stream.size();
+  selection.nodes_visited = counters.visited;
+  selection.culled_frustum = counters.culled_frustum;
+  selection.culled_backface = counters.culled_backface;
+  for (const std::uint8_t d : instance_drawn) ostats.instances_drawn += d;
+  const auto done = Clock::now();
+  fill_stats(frame, selection, cam, pool.thread_count(), start, start, done);
+  frame.stats.ms_select = ms_select;
+  frame.stats.ms_raster = ms_raster;
+  if (features) {
+    RenderStats& s = frame.stats;
+    for (std::size_t ch = 0; ch < stream.chunk_count; ++ch) {
+      const SplatChunk& chunk = stream.chunks[ch];
+      for (std::size_t i = 0; i < chunk.count; ++i) {
+        s.clipped_splats += clip_count(chunk.clip_code[i]) != 0;
+      }
+    }
+    s.clipped_fragments = frame.scratch.clipped_fragments;
+  }
+}
+
+}  // namespace pointillist

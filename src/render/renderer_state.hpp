@@ -1,0 +1,125 @@
+// What the renderer keeps per model across frames, and the helpers its entry points share
+// (renderer.cpp, occlusion_render.cpp). Internal to render.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <optional>
+
+#include "pointillist/lod/tree_features.hpp"
+#include "pointillist/render/occlusion.hpp"
+#include "pointillist/render/paged.hpp"
+#include "pointillist/render/renderer.hpp"
+
+namespace pointillist::render_detail {
+
+// Page size when a model held whole is cut into pages (RendererOptions::page_all).
+inline constexpr std::uint64_t kInMemoryPageBytes = 64 * 1024;
+inline constexpr std::uint32_t kInMemoryPageLevels = 4;
+
+// The camera as the model sees it: the same image of the model at p as the world camera gives
+// of translate + scale·R·p. Sizes on screen are unchanged (radius and distance scale alike).
+inline Camera model_camera(const Camera& world, const InstanceTransform& t) {
+  Camera c = world;
+  const float inv_scale = 1.0f / t.scale;
+  c.eye = t.rotate_back(world.eye - t.translate) * inv_scale;
+  c.target = t.rotate_back(world.target - t.translate) * inv_scale;
+  c.up = t.rotate_back(world.up);
+  return c;
+}
+
+// Moves a chunk selected in model space into the world: discs, and depth (model depth × scale).
+inline void to_world(const InstanceTransform& t, SplatChunk& chunk, bool with_discs) {
+  for (std::size_t i = 0; i < chunk.count; ++i) {
+    chunk.depth[i] *= t.scale;
+    chunk.normal[i] = t.rotate(chunk.normal[i]);
+    if (with_discs) {
+      chunk.center[i] = t.apply(chunk.center[i]);
+      chunk.radius[i] *= t.scale;
+    }
+  }
+}
+
+inline std::uint8_t to_byte(float v) {
+  return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
+}
+
+// The sharp features of a model: its hierarchy's, or (paged) what its pages carry.
+inline const TreeFeatures* model_features(const RenderModel& m) {
+  if (m.tree.features) return m.tree.features;
+  return m.pages ? m.pages->features() : nullptr;
+}
+
+inline void add(SelectionStats& a, const SelectionStats& b) {
+  a.splats += b.splats;
+  a.nodes_visited += b.nodes_visited;
+  a.culled_frustum += b.culled_frustum;
+  a.culled_backface += b.culled_backface;
+}
+
+
+// A model's hierarchy cut for occlusion culling: nodes down to subtrees of at most `leaf_points`
+// points (the culling leaves), in depth-first order, each with its children.
+struct ModelCullTree {
+  struct Node {
+    std::uint32_t tree_node = 0;
+    std::uint32_t parent = UINT32_MAX;              // local index
+    std::uint32_t first_child = 0, child_count = 0;  // into `children`
+    std::uint32_t culling_leaves = 1;
+    std::uint32_t points = 0;  // leaves of the hierarchy below
+  };
+  std::uint32_t leaf_points = 0;
+  std::vector<Node> nodes;
+  std::vector<std::uint32_t> children;
+};
+ModelCullTree build_cull_tree(std::span<const SphereNode> nodes, std::uint32_t leaf_points);
+
+}  // namespace pointillist::render_detail
+
+namespace pointillist {
+
+struct Renderer::ModelState {
+  const RenderModel* model = nullptr;
+  std::unique_ptr<PageSource> owned_pages;  // a model held whole, cut into pages
+  const PageSource* pages = nullptr;
+  std::optional<PagedRenderer> paged;
+  std::optional<SequentialPointTree> spt;
+  std::optional<TreeFeatures> spt_features;  // the model's features on the SPT's entries
+  std::uint64_t frame = 0;  // the last frame that drew the model
+  std::uint64_t model_bytes = 0;  // storage bytes of a paged model (open + every page)
+  std::optional<render_detail::ModelCullTree> cull_tree;  // occlusion culling
+};
+
+
+// The scene's culling hierarchy (BVH nodes first, then each instance's model nodes) and its
+// state across frames.
+struct Renderer::SceneCull {
+  struct Meta {
+    std::uint32_t instance = UINT32_MAX;  // UINT32_MAX: a BVH node
+    std::uint32_t local = 0;              // the node in the instance's model cull tree
+  };
+  std::vector<std::pair<const RenderModel*, InstanceTransform>> scene;  // what it was built for
+  std::uint32_t leaf_points = 0;
+  CullHierarchy h;
+  std::vector<Meta> meta;
+  std::vector<std::uint32_t> instance_root;  // the node of each instance's model root
+  CullState state;
+  DepthPyramid pyramid;
+
+  bool matches(std::span<const SceneInstance> s, std::uint32_t leaves) const {
+    if (s.size() != scene.size() || leaves != leaf_points) return false;
+    for (std::size_t i = 0; i < s.size(); ++i) {
+      const InstanceTransform& a = s[i].transform;
+      const InstanceTransform& b = scene[i].second;
+      if (s[i].model != scene[i].first || !(a.translate == b.translate) || a.scale != b.scale ||
+          !(a.rotation[0] == b.rotation[0]) || !(a.rotation[1] == b.rotation[1]) ||
+          !(a.rotation[2] == b.rotation[2])) {
+        return false;
+      }
+    }
+    return true;
+  }
+};
+
+}  // namespace pointillist
