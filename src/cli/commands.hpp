@@ -66,6 +66,8 @@ struct RenderOptions {
   bool quiet = false;
   // Frame sequences (see README "Frame sequences"): 0 = off.
   unsigned orbit_frames = 0;  // --path orbit:N
+  std::string path_file;      // --path FILE: a camera path file (io/camera_path.hpp)
+  bool fov_given = false;     // --fov was on the command line (it wins over a path file's fov)
   double frame_ms = 0;        // --frame-ms T: hold this frame time
   unsigned refine_frames = 0; // --refine K
   std::string frames_out;     // --frames-out DIR: write every frame there
@@ -107,8 +109,13 @@ int run_demo(const DemoOptions& options);
 
 struct GenerateOptions {
   std::string output;
-  std::string scene = "demo";  // demo, sphere, torus, cube
+  std::string scene = "demo";  // demo, sphere, torus, cube; T*; wall, city, field, row
   std::size_t points = 1'000'000;
+  bool points_given = false;  // --points given (wall|city|field|row: else a 20,000-point statue)
+  // wall|city|field|row (pipeline/generate_scene.hpp): the scanned models, and the factor on
+  // the wall's and panels' grid spacing.
+  std::vector<std::string> models;
+  float spacing_scale = 1.0f;
   std::uint64_t seed = 1;
   bool with_normals = false;  // write the exact normals too
   std::string sampling = "j";  // test scenes T*: j or r

@@ -1,5 +1,6 @@
-// `pointillist generate`: point clouds sampled from the analytic scenes, and the sharp-features
-// test scenes with their exact label reference image.
+// `pointillist generate`: point clouds sampled from the analytic scenes, the sharp-features
+// test scenes with their exact label reference image, and the occlusion-culling scenes of many
+// instances (scene file, models, camera paths).
 #include <cctype>
 #include <cstdio>
 #include <filesystem>
@@ -10,11 +11,13 @@
 
 #include "commands.hpp"
 #include "options.hpp"
+#include "terminal_progress.hpp"
 #include "util.hpp"
 #include "pointillist/core/atomic_file.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/io/ply.hpp"
 #include "pointillist/io/png.hpp"
+#include "pointillist/pipeline/generate_scene.hpp"
 #include "pointillist/prep/radii.hpp"
 #include "pointillist/scene/analytic.hpp"
 #include "pointillist/scene/csg.hpp"
@@ -77,8 +80,49 @@ int generate_csg(const GenerateOptions& o) {
   return 0;
 }
 
+bool is_occlusion_scene(const std::string& scene) {
+  return scene == "wall" || scene == "city" || scene == "field" || scene == "row";
+}
+
+// A scene of many instances for occlusion culling: the scene file, its models and camera paths.
+int generate_occlusion_scene(const GenerateOptions& o) {
+  GenerateSceneOptions g;
+  g.scene = o.scene == "wall"   ? OcclusionScene::Wall
+            : o.scene == "city" ? OcclusionScene::City
+            : o.scene == "field" ? OcclusionScene::Field
+                                 : OcclusionScene::Row;
+  g.output = o.output;
+  g.models = o.models;
+  g.statue_points = o.points_given ? o.points : GenerateSceneOptions{}.statue_points;
+  g.seed = o.seed;
+  g.spacing_scale = o.spacing_scale;
+  ThreadPool pool(o.threads);
+  TerminalProgress progress(!o.quiet && TerminalProgress::stderr_is_terminal());
+  const GeneratedScene r = generate_scene(g, pool, progress);
+  if (o.quiet) return 0;
+  std::string models, paths;
+  for (const GeneratedModel& m : r.models) {
+    models += (models.empty() ? "" : ", ") + m.path + " " + std::to_string(m.points) +
+              " points x" + std::to_string(m.instances);
+  }
+  for (std::size_t i = 0; i < r.path_files.size(); ++i) {
+    paths += (paths.empty() ? "" : ", ") +
+             std::filesystem::path(r.path_files[i]).filename().string() + " " +
+             std::to_string(r.path_frames[i]) + " frames";
+  }
+  std::printf("generated the %s scene: %zu instances, %zu of them scanned models; models: %s; "
+              "paths: %s -> %s\n",
+              o.scene.c_str(), r.instance_count, r.scanned_instance_count, models.c_str(),
+              paths.c_str(), o.output.c_str());
+  return 0;
+}
+
 void check_options(const GenerateOptions& o) {
   check_outputs({}, {{"-o", o.output}, {"--reference", o.reference_output}});
+  if (is_occlusion_scene(o.scene) && !o.reference_output.empty()) {
+    throw OptionError("--reference writes the exact image of a sharp-features test scene (T*); "
+                      "it does not apply to --scene " + o.scene);
+  }
   if (o.reference_output.empty()) return;
   if (o.scene.empty() || o.scene[0] != 'T') {
     throw OptionError("--reference writes the exact label image of a sharp-features test scene; "
@@ -100,6 +144,7 @@ int run_generate(const GenerateOptions& o) {
     std::fprintf(stderr, "pointillist generate: warning: %s\n", w.c_str());
   }
   if (!o.scene.empty() && o.scene[0] == 'T') return generate_csg(o);
+  if (is_occlusion_scene(o.scene)) return generate_occlusion_scene(o);
   AnalyticScene scene;
   if (o.scene == "demo") {
     scene = demo_scene();
@@ -125,23 +170,41 @@ int run_generate(const GenerateOptions& o) {
 Command add_generate_command(CLI::App& app) {
   auto o = std::make_shared<GenerateOptions>();
   auto* cmd = app.add_subcommand(
-      "generate", "Write a point cloud sampled from an analytic scene (for tests and benchmarks)");
-  cmd->add_option("-o,--output", o->output, "Output .ply")->required();
+      "generate", "Write a point cloud sampled from an analytic scene (for tests and benchmarks), "
+                  "or a scene of many instances with its models and camera paths");
+  cmd->add_option("-o,--output", o->output,
+                  "Output .ply; for wall, city, field and row the scene file DIR/NAME.json (its "
+                  "models and camera path files are written beside it)")
+      ->required();
   std::vector<std::string> scenes = {"demo", "sphere", "torus", "cube"};
   for (const std::string& id : csg_scene_ids()) scenes.push_back(id);
+  for (const char* id : {"wall", "city", "field", "row"}) scenes.push_back(id);
   cmd->add_option("--scene", o->scene,
                   "demo, sphere, torus or cube; or a sharp-features test scene T1 (cube), T3 "
                   "(cylinder), T4 (plate with a hole), T5/T6 (union/intersection of two "
                   "spheres), T7 (bitten cube), T8 (step), T9 (two interpenetrating spheres), "
-                  "T10 (crossed cylinders), T11 (thin slab), T13 (sphere)")
+                  "T10 (crossed cylinders), T11 (thin slab), T13 (sphere); or a scene of many "
+                  "instances for occlusion culling: wall, city, field, row")
       ->default_val("demo")
       ->check(CLI::IsMember(scenes));
+  cmd->add_option("--models", o->models,
+                  "wall|city|field|row: the scanned models A,B,C (.ptl, .qs or scans), used in "
+                  "turn, each scaled to radius 1 and stood on y = 0 (default: a generated "
+                  "statue of --points points, 20000 unless given)")
+      ->delimiter(',');
+  cmd->add_option("--spacing-scale", o->spacing_scale,
+                  "wall|city: multiply the grid spacing of the wall and the facade panels "
+                  "(1 = the specification's 0.02 and 0.05; 10 makes them 100 times smaller)")
+      ->default_val(1.0f)
+      ->check(CLI::Range(0.01f, 1000.0f));
   cmd->add_option("--sampling", o->sampling,
                   "Test scenes T*: j (jittered grid at the scene's spacing, radius = mean "
                   "distance to 5 nearest) or r (as many random samples, default radii)")
       ->default_val("j")
       ->check(CLI::IsMember({"j", "r"}));
-  cmd->add_option("--points", o->points, "Number of samples (test scenes T*: set by the scene)")
+  cmd->add_option("--points", o->points,
+                  "Number of samples (test scenes T*: set by the scene; wall|city|field|row: of "
+                  "the generated statue, default 20000)")
       ->default_val(1000000)
       ->check(CLI::Range(std::size_t{1}, std::size_t{2'000'000'000}));
   cmd->add_option("--seed", o->seed, "Random seed")->default_val(1);
@@ -162,6 +225,28 @@ Command add_generate_command(CLI::App& app) {
   return {cmd, [o, camera, background, cmd] {
             parse_camera_options(*camera, o->view);
             o->background = parse_rgb8(*background, "--background");
+            o->points_given = cmd->count("--points") > 0;
+            const bool occlusion = is_occlusion_scene(o->scene);
+            if (!occlusion && cmd->count("--models") > 0) {
+              o->warnings.push_back("--models is ignored: it applies to --scene "
+                                    "wall|city|field|row");
+            }
+            if (o->scene != "wall" && o->scene != "city" && cmd->count("--spacing-scale") > 0) {
+              o->warnings.push_back("--spacing-scale is ignored: it applies to --scene wall|city "
+                                    "(the scenes with grid models)");
+            }
+            if (occlusion && cmd->count("--models") > 0 && cmd->count("--points") > 0) {
+              o->warnings.push_back("--points is ignored: it sizes the generated statue, and "
+                                    "--models gives the models");
+            }
+            if (occlusion) {
+              for (const char* name : {"--with-normals", "--sampling"}) {
+                if (cmd->count(name) > 0) {
+                  o->warnings.push_back(std::string(name) + " is ignored: it applies to point "
+                                        "clouds, not to --scene " + o->scene);
+                }
+              }
+            }
             if (o->reference_output.empty()) {
               for (const char* name : {"--size", "--view", "--distance", "--fov", "--eye",
                                        "--target", "--up", "--background"}) {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <sstream>
 
 #include "pointillist/core/error.hpp"
@@ -88,6 +89,18 @@ unsigned parse_orbit_path(const std::string& text) {
                                  "(e.g. --path orbit:120)");
 }
 
+bool is_orbit_path(const std::string& text) { return text.rfind("orbit:", 0) == 0; }
+
+std::string checked_path_file(const std::string& text) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(text, ec)) {
+    throw OptionError("--path '" + text +
+                      "': no such camera path file; give orbit:N for N frames around the model "
+                      "(e.g. --path orbit:120) or the path of a camera path file");
+  }
+  return text;
+}
+
 Vec3f parse_vec3(const std::string& text, const std::string& option) {
   const auto v = parse_floats(text, 3, ',', option);
   return {v[0], v[1], v[2]};
@@ -121,9 +134,9 @@ void add_camera_options(CLI::App* app, ViewOptions& view, CameraText& text) {
   app->add_option("--target", text.target, "Explicit target X,Y,Z (with --eye)")
       ->group(kGroupCamera);
   app->add_option("--up", text.up,
-                  "Up vector X,Y,Z: with --eye/--target the camera's (default 0,1,0); otherwise "
-                  "the up axis for --view and --path (default: the model's, +Z for LAS scans, "
-                  "else +Y)")
+                  "Up vector X,Y,Z: with --eye/--target, or for the frames of a camera path file "
+                  "that give none, the camera's (default 0,1,0); otherwise the up axis for --view "
+                  "and --path orbit:N (default: the model's, +Z for LAS scans, else +Y)")
       ->group(kGroupCamera);
 }
 

@@ -32,6 +32,11 @@ void parse_size_and_view(const std::string& size, const std::string& view, ViewO
 std::uint64_t parse_bytes(const std::string& text, const std::string& option);
 // "orbit:N" (1 <= N <= 100000) -> N.
 unsigned parse_orbit_path(const std::string& text);
+// Whether a --path value means the orbit ("orbit:..."); anything else names a path file.
+bool is_orbit_path(const std::string& text);
+// A --path value naming a camera path file, returned as it is; throws OptionError (mentioning
+// orbit:N, which may have been meant) when no such file exists.
+std::string checked_path_file(const std::string& text);
 Vec3f parse_vec3(const std::string& text, const std::string& option);
 // "R,G,B" with each component a whole number 0-255.
 Rgb8 parse_rgb8(const std::string& text, const std::string& option);

@@ -13,6 +13,7 @@
 #include "terminal_progress.hpp"
 #include "pointillist/core/atomic_file.hpp"
 #include "pointillist/core/error.hpp"
+#include "pointillist/io/camera_path.hpp"
 #include "pointillist/io/png.hpp"
 #include "pointillist/pipeline/report.hpp"
 #include "pointillist/pipeline/scene.hpp"
@@ -65,18 +66,31 @@ std::string frame_path(const std::string& dir, std::size_t index) {
   return (std::filesystem::path(dir) / name).string();
 }
 
-SequenceOptions sequence_options(const RenderOptions& o) {
+SequenceOptions sequence_options(const RenderOptions& o, std::vector<Camera> path) {
   return {.progressive_frames = o.progressive_frames,
           .read_per_frame = o.read_per_frame,
           .orbit_frames = o.orbit_frames,
+          .path = std::move(path),
           .frame_ms = o.frame_ms,
           .refine_frames = o.refine_frames};
 }
 
+// The cameras of --path FILE (none without one): the file's fov unless --fov was given, --up
+// (else +Y) for frames that give no up vector.
+std::vector<Camera> path_file_cameras(const RenderOptions& o) {
+  if (o.path_file.empty()) return {};
+  const CameraPath path = read_camera_path(o.path_file);
+  const float fov_deg = o.fov_given || !path.fov_deg ? o.view.fov_deg : *path.fov_deg;
+  return path_cameras(path, o.path_file, fov_deg, o.view.width, o.view.height,
+                      o.view.up.value_or(Vec3f{0, 1, 0}));
+}
+
 // Checks what only the command line can get wrong (the library checks the rest).
 void check_options(const RenderOptions& o) {
-  check_outputs(o.inputs, {{"-o", o.output}, {"--depth", o.depth_output},
-                           {"--stats", o.stats_output}});
+  std::vector<std::string> inputs = o.inputs;
+  if (!o.path_file.empty()) inputs.push_back(o.path_file);
+  check_outputs(inputs, {{"-o", o.output}, {"--depth", o.depth_output},
+                         {"--stats", o.stats_output}});
   for (const auto& [option, path] : {std::pair<const char*, const std::string&>{"-o", o.output},
                                      {"--depth", o.depth_output}}) {
     std::string ext = std::filesystem::path(path).extension().string();
@@ -86,15 +100,18 @@ void check_options(const RenderOptions& o) {
                         ": render writes PNG images; give a path ending in .png");
     }
   }
-  check_sequence_options(sequence_options(o));
   if (o.orbit_frames > 0 && (o.view.eye || o.view.target)) {
     throw OptionError("--path orbit:N moves the camera around the orbit; it cannot be combined "
                       "with --eye/--target (use --view, --distance and --up)");
   }
-  if (!o.frames_out.empty() && o.orbit_frames == 0 && o.refine_frames == 0 &&
-      o.progressive_frames == 0) {
+  if (!o.path_file.empty() && (o.view.eye || o.view.target)) {
+    throw OptionError("--path " + o.path_file + ": the camera path file places the camera; it "
+                      "cannot be combined with --eye/--target");
+  }
+  if (!o.frames_out.empty() && o.orbit_frames == 0 && o.path_file.empty() &&
+      o.refine_frames == 0 && o.progressive_frames == 0) {
     throw OptionError("--frames-out writes the frames of a sequence; add --path orbit:N, "
-                      "--refine K or --progressive N");
+                      "--path FILE, --refine K or --progressive N");
   }
   if (o.inputs.size() > 1) {
     for (const std::string& in : o.inputs) {
@@ -104,13 +121,15 @@ void check_options(const RenderOptions& o) {
       }
     }
   }
-  if (!o.frames_out.empty()) {
-    std::error_code ec;
-    std::filesystem::create_directories(o.frames_out, ec);
-    if (ec) {
-      throw IoError(o.frames_out + ": cannot create the frames folder (" + ec.message() +
-                    "); give a writable path to --frames-out");
-    }
+}
+
+void create_frames_folder(const RenderOptions& o) {
+  if (o.frames_out.empty()) return;
+  std::error_code ec;
+  std::filesystem::create_directories(o.frames_out, ec);
+  if (ec) {
+    throw IoError(o.frames_out + ": cannot create the frames folder (" + ec.message() +
+                  "); give a writable path to --frames-out");
   }
 }
 
@@ -118,6 +137,9 @@ void check_options(const RenderOptions& o) {
 
 int run_render(const RenderOptions& o) {
   check_options(o);
+  const SequenceOptions sequence_opts = sequence_options(o, path_file_cameras(o));
+  check_sequence_options(sequence_opts);
+  create_frames_folder(o);
   for (const std::string& w : o.warnings) {
     std::fprintf(stderr, "pointillist render: warning: %s\n", w.c_str());
   }
@@ -131,7 +153,8 @@ int run_render(const RenderOptions& o) {
   open.columns = o.columns;
   open.keep_source = o.frame.rasterizer == Rasterizer::Reference;
   open.paging = paging_asked ? Paging::Always : (paging_possible ? Paging::Auto : Paging::Never);
-  open.frames = std::max<std::uint64_t>(1, std::uint64_t(o.orbit_frames) + o.refine_frames);
+  open.frames = std::max<std::uint64_t>(
+      1, std::uint64_t(o.orbit_frames) + sequence_opts.path.size() + o.refine_frames);
   open.frame_pixels = std::uint64_t(o.view.width) * std::uint64_t(o.view.height);
   open.features = o.features;
   open.stored_features = o.frame.features;
@@ -147,8 +170,9 @@ int run_render(const RenderOptions& o) {
   const Vec3f up = scene.up();
   Renderer renderer({.page_all = paging_asked, .memory_cap = o.memory_cap});
   Frame frame;
-  const bool sequence = o.orbit_frames > 0 || o.refine_frames > 0 || o.frame_ms > 0 ||
-                        o.progressive_frames > 0 || !o.frames_out.empty();
+  const bool sequence = o.orbit_frames > 0 || !sequence_opts.path.empty() ||
+                        o.refine_frames > 0 || o.frame_ms > 0 || o.progressive_frames > 0 ||
+                        !o.frames_out.empty();
   std::vector<SequenceFrame> frames;
   if (sequence) {
     ViewOptions view = o.view;
@@ -158,7 +182,7 @@ int run_render(const RenderOptions& o) {
           view.azimuth_deg = azimuth;
           return make_camera(view, view_sphere, up);
         },
-        o.view.azimuth_deg, o.settings, o.frame, sequence_options(o), pool, frame,
+        o.view.azimuth_deg, o.settings, o.frame, sequence_opts, pool, frame,
         [&](const Frame& f, std::size_t index) {
           if (!o.frames_out.empty()) {
             write_png_rgb8(frame_path(o.frames_out, index), f.width, f.height, f.color);

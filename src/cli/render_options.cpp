@@ -124,7 +124,9 @@ void add_detail(CLI::App* cmd, RenderOptions& o, RenderText& t) {
 void add_sequences_and_paging(CLI::App* cmd, RenderOptions& o, RenderText& t) {
   cmd->add_option("--path", t.path,
                   "Render a sequence of frames along a camera path: orbit:N = N frames around "
-                  "the model (azimuth +0..360 degrees from --view)")
+                  "the model (azimuth +0..360 degrees from --view), or a camera path file (one "
+                  "frame a line: eye x y z, target x y z [, up x y z]; an optional 'fov DEG' "
+                  "line, which --fov overrides)")
       ->group(kGroupSequence);
   cmd->add_option("--frame-ms", o.frame_ms,
                   "With --path: adjust the level of detail frame to frame to hold T ms per frame")
@@ -189,6 +191,9 @@ std::vector<std::string> ignored_options(const CLI::App& cmd, const RenderOption
   if (!t.camera.eye.empty() || !t.camera.target.empty()) {
     ignored("--view", "--eye/--target place the camera");
     ignored("--distance", "--eye/--target place the camera");
+  } else if (!t.path.empty() && !is_orbit_path(t.path)) {
+    ignored("--view", "the camera path file places the camera");
+    ignored("--distance", "the camera path file places the camera");
   }
   return w;
 }
@@ -236,7 +241,12 @@ Command add_render_command(CLI::App& app) {
               o->settings.diffuse = 0.0f;
               o->settings.specular = 0.0f;
             }
-            if (!t->path.empty()) o->orbit_frames = parse_orbit_path(t->path);
+            if (is_orbit_path(t->path)) {
+              o->orbit_frames = parse_orbit_path(t->path);
+            } else if (!t->path.empty()) {
+              o->path_file = checked_path_file(t->path);
+            }
+            o->fov_given = cmd->count("--fov") > 0;
             if (!t->memory.empty()) o->memory_cap = parse_bytes(t->memory, "--memory");
             if (!t->read_per_frame.empty()) {
               o->read_per_frame = parse_bytes(t->read_per_frame, "--read-per-frame");

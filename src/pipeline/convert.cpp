@@ -35,10 +35,8 @@ const char* normal_source_name(NormalSource s) {
   return "?";
 }
 
-}  // namespace
-
-ConvertResult convert(std::span<const std::string> inputs, const std::string& output,
-                      const ConvertOptions& o, ThreadPool& pool, Progress& progress) {
+// Throws OptionError when `output`'s extension is unknown or the options do not fit it.
+void check_convert_options(const std::string& output, const ConvertOptions& o) {
   const bool to_ptl = ends_with(output, ".ptl");
   const bool to_ply = ends_with(output, ".ply");
   const bool to_qs = ends_with(output, ".qs");
@@ -47,7 +45,6 @@ ConvertResult convert(std::span<const std::string> inputs, const std::string& ou
                       "' has an unknown extension; use .ptl (Pointillist model), .qs (QSplat 1.1 "
                       "model) or .ply (points with normals and radii)");
   }
-  check_outputs({inputs.begin(), inputs.end()}, {{"-o", output}});
   if (o.ascii && !to_ply) throw OptionError("convert: --ascii applies only to .ply output");
   if (o.ptl_version != 1 && o.ptl_version != 2) {
     throw OptionError("convert: --ptl-version " + std::to_string(o.ptl_version) +
@@ -60,6 +57,14 @@ ConvertResult convert(std::span<const std::string> inputs, const std::string& ou
   if (o.leaf_trim && !(to_ptl && o.ptl_version == 2)) {
     throw OptionError("convert: --leaf-trim applies only to .ptl version 2 output; drop it");
   }
+}
+
+}  // namespace
+
+ConvertResult convert(std::span<const std::string> inputs, const std::string& output,
+                      const ConvertOptions& o, ThreadPool& pool, Progress& progress) {
+  check_convert_options(output, o);
+  check_outputs({inputs.begin(), inputs.end()}, {{"-o", output}});
   for (const std::string& path : inputs) {
     if (std::filesystem::exists(path) && is_model_file(path)) {
       throw Error(path + ": is already a splat model (" + (is_ptl_file(path) ? ".ptl" : ".qs") +
@@ -67,10 +72,21 @@ ConvertResult convert(std::span<const std::string> inputs, const std::string& ou
                   ") to convert, or render the model directly");
     }
   }
+  std::vector<std::string> warnings;
+  PointSet points = merge_inputs(inputs, pool, progress, {.columns = o.columns}, &warnings);
+  ConvertResult result = convert_points(std::move(points), inputs, output, o, pool, progress);
+  warnings.insert(warnings.end(), result.warnings.begin(), result.warnings.end());
+  result.warnings = std::move(warnings);
+  return result;
+}
 
+ConvertResult convert_points(PointSet points, std::span<const std::string> inputs,
+                             const std::string& output, const ConvertOptions& o, ThreadPool& pool,
+                             Progress& progress) {
+  check_convert_options(output, o);
+  const bool to_ptl = ends_with(output, ".ptl");
+  const bool to_qs = ends_with(output, ".qs");
   ConvertResult result;
-  PointSet points =
-      merge_inputs(inputs, pool, progress, {.columns = o.columns}, &result.warnings);
   result.input_points = points.size();
   // A mesh goes to write_qs as read: like qsplat_make, it computes normals and radii from the
   // faces itself (that is what makes the file byte-identical to the original tool's).

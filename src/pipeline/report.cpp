@@ -99,13 +99,13 @@ std::string render_report_json(const RenderReport& r) {
     }
     Json frames = Json::array();
     for (const SequenceFrame& fr : r.frames) {
-      Json o{{"phase", fr.phase},
-             {"azimuth", fr.azimuth_deg},
-             {"detail", fr.detail},
-             {"splats", fr.stats.splats},
-             {"ms", ms(fr.stats.ms_total)},
-             {"ms_select", ms(fr.stats.ms_select)},
-             {"ms_raster", ms(fr.stats.ms_raster)}};
+      Json o{{"phase", fr.phase}};
+      if (fr.azimuth_deg) o["azimuth"] = *fr.azimuth_deg;  // orbit frames
+      o["detail"] = fr.detail;
+      o["splats"] = fr.stats.splats;
+      o["ms"] = ms(fr.stats.ms_total);
+      o["ms_select"] = ms(fr.stats.ms_select);
+      o["ms_raster"] = ms(fr.stats.ms_raster);
       if (fr.bytes_read >= 0) {
         o["bytes_read"] = fr.bytes_read;
         o["resident_bytes"] = fr.resident_bytes;

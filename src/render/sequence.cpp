@@ -21,11 +21,15 @@ float initial_detail(const RenderSettings& settings, const FrameSettings& fs) {
 }
 
 void check_sequence_options(const SequenceOptions& o) {
-  if (o.frame_ms > 0 && o.orbit_frames == 0) {
+  if (o.frame_ms > 0 && o.orbit_frames == 0 && o.path.empty()) {
     throw OptionError("--frame-ms holds a frame time over a sequence of frames; add --path orbit:N "
-                      "(N frames around the model)");
+                      "(N frames around the model) or --path FILE (a camera path file)");
   }
-  if (o.progressive_frames > 0 && (o.orbit_frames > 0 || o.frame_ms > 0)) {
+  if (o.orbit_frames > 0 && !o.path.empty()) {
+    throw OptionError("a sequence follows either the orbit (--path orbit:N) or a camera path "
+                      "file, not both");
+  }
+  if (o.progressive_frames > 0 && (o.orbit_frames > 0 || !o.path.empty() || o.frame_ms > 0)) {
     throw OptionError("--progressive N renders N frames at one view while pages load; it cannot "
                       "be combined with --path or --frame-ms (use --refine K to refine after it)");
   }
@@ -44,11 +48,13 @@ std::vector<SequenceFrame> render_sequence(
     control.emplace(FrameControlOptions{.target_ms = o.frame_ms, .finest = finest}, start);
   }
   std::vector<SequenceFrame> records;
-  auto draw = [&](const char* phase, float azimuth, float detail) {
+  // Orbit and progressive frames record their azimuth; frames of a path file do not.
+  auto draw = [&](const char* phase, const Camera& camera, std::optional<float> azimuth,
+                  float detail) {
     RenderSettings s = settings;
     FrameSettings f = fs;
     (fs.lod == LodScheme::Spt ? f.epsilon_px : s.threshold_px) = detail;
-    renderer.render(scene, camera_at(azimuth), s, f, pool, frame);
+    renderer.render(scene, camera, s, f, pool, frame);
     SequenceFrame r{phase, azimuth, detail, frame.stats};
     if (renderer.paging()) {
       const PagingStats p = renderer.paging_stats();
@@ -66,11 +72,17 @@ std::vector<SequenceFrame> render_sequence(
       renderer.request_in_background();
     }
   };
-  for (unsigned i = 0; i < o.progressive_frames; ++i) draw("progressive", azimuth_deg, start);
+  for (unsigned i = 0; i < o.progressive_frames; ++i) {
+    draw("progressive", camera_at(azimuth_deg), azimuth_deg, start);
+  }
   for (unsigned i = 0; i < o.orbit_frames; ++i) {
     const float azimuth =
         azimuth_deg + 360.0f * static_cast<float>(i) / static_cast<float>(o.orbit_frames);
-    draw("path", azimuth, control ? control->parameter() : start);
+    draw("path", camera_at(azimuth), azimuth, control ? control->parameter() : start);
+    if (control) control->report(frame.stats.ms_total);
+  }
+  for (const Camera& camera : o.path) {
+    draw("path", camera, std::nullopt, control ? control->parameter() : start);
     if (control) control->report(frame.stats.ms_total);
   }
   if (o.refine_frames > 0) {
@@ -81,7 +93,11 @@ std::vector<SequenceFrame> render_sequence(
                                 static_cast<float>(o.orbit_frames)
             : azimuth_deg;
     for (float detail : refinement_sequence(from, finest, o.refine_frames)) {
-      draw("refine", azimuth, detail);
+      if (o.path.empty()) {
+        draw("refine", camera_at(azimuth), azimuth, detail);
+      } else {
+        draw("refine", o.path.back(), std::nullopt, detail);  // at the path's last camera
+      }
     }
   }
   return records;

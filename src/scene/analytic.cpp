@@ -139,6 +139,14 @@ AnalyticScene demo_scene() {
   return scene;
 }
 
+AnalyticScene statue_scene() {
+  AnalyticShape pedestal{ShapeKind::Cube, {0.0f, 0.35f, 0.0f}, 0.35f, 0.0f};
+  AnalyticShape head{ShapeKind::Sphere, {0.0f, 1.1f, 0.0f}, 0.4f, 0.0f};
+  AnalyticShape ring{ShapeKind::Torus, {0.0f, 1.1f, 0.0f}, 0.55f, 0.1f};
+  set_rotation(ring, {1, 0, 0}, 60.0f);
+  return {{pedestal, head, ring}};
+}
+
 AnalyticScene sphere_scene(float radius) {
   return {{AnalyticShape{ShapeKind::Sphere, {0, 0, 0}, radius, 0}}};
 }

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "pointillist/core/point_set.hpp"
 #include "pointillist/core/progress.hpp"
 #include "pointillist/core/thread_pool.hpp"
 #include "pointillist/features/features.hpp"
@@ -43,5 +44,14 @@ struct ConvertResult {
 // preparing, building and writing throw.
 ConvertResult convert(std::span<const std::string> inputs, const std::string& output,
                       const ConvertOptions& options, ThreadPool& pool, Progress& progress);
+
+// The same for points made in memory (a generated model, say): prepares `points` (normals and
+// radii they have are kept, see prepare_splats) and writes `output` as convert does; `sources`
+// name where the points came from in the model's metadata. Throws OptionError for an unknown
+// output extension or options that do not fit it, and what preparing, building and writing
+// throw.
+ConvertResult convert_points(PointSet points, std::span<const std::string> sources,
+                             const std::string& output, const ConvertOptions& options,
+                             ThreadPool& pool, Progress& progress);
 
 }  // namespace pointillist

@@ -20,8 +20,9 @@ struct RenderReport {
   FrameSettings frame;                 // how the frames were drawn
   std::uint64_t memory_cap = 0;        // bytes; 0 = none
   RenderStats last;                    // the last frame's counts and times
-  // A sequence: its frames (phase, azimuth, detail, splats, times; paging bytes when paged),
-  // and with target_ms > 0 the frame-time target and hit_rate over the frames after `settle`.
+  // A sequence: its frames (phase, the orbit's azimuth, detail, splats, times; paging bytes when
+  // paged), and with target_ms > 0 the frame-time target and hit_rate over the frames after
+  // `settle`.
   bool sequence = false;
   std::span<const SequenceFrame> frames;
   double target_ms = 0;

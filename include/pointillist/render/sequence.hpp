@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -18,8 +19,11 @@ struct SequenceOptions {
   // Storage bytes the loader reads between two progressive frames (at least one page).
   std::uint64_t read_per_frame = 1u << 20;
   unsigned orbit_frames = 0;  // frames around the orbit: azimuth + 360°·i / orbit_frames
-  double frame_ms = 0;        // > 0: hold this frame time along the orbit
-  unsigned refine_frames = 0;  // frames of idle refinement after the orbit, down to full detail
+  // Frames along these cameras instead (a camera path file, io/camera_path.hpp), in order;
+  // orbit_frames must then be 0.
+  std::vector<Camera> path;
+  double frame_ms = 0;        // > 0: hold this frame time along the orbit or the path
+  unsigned refine_frames = 0;  // idle refinement after the orbit or path, down to full detail
 };
 
 // Frames a sequence renders before the frame-time controller is judged (hit_rate).
@@ -27,7 +31,7 @@ inline constexpr std::size_t kSettleFrames = 5;
 
 struct SequenceFrame {
   const char* phase = "";  // "progressive", "path" or "refine"
-  float azimuth_deg = 0;
+  std::optional<float> azimuth_deg;  // the orbit's azimuth; unset for the frames of a path
   float detail = 0;  // level of detail the frame was drawn with (QSplat threshold or SPT ε, px)
   RenderStats stats;
   // Paged models only (else negative): storage bytes read so far and resident page memory,
@@ -43,9 +47,10 @@ float initial_detail(const RenderSettings& settings, const FrameSettings& frame_
 // Throws OptionError for sequence options that cannot go together (the message says which).
 void check_sequence_options(const SequenceOptions& options);
 
-// Renders progressive_frames at `azimuth_deg`, orbit_frames around the orbit (with frame-time
-// control when frame_ms > 0) and refine_frames of idle refinement, each with camera_at(azimuth),
-// calling on_frame(frame, index) after each (may be empty). After each frame a paged model's
+// Renders progressive_frames at `azimuth_deg`, orbit_frames around the orbit with
+// camera_at(azimuth) or else one frame per camera of options.path (with frame-time control when
+// frame_ms > 0), and refine_frames of idle refinement at the last camera, calling
+// on_frame(frame, index) after each (may be empty). After each frame a paged model's
 // pages are loaded: progressive frames wait for the loader (reproducible frames), the others hand
 // the pages to it as a viewer does (frames then depend on timing). Returns every frame's record
 // and leaves the last frame in `frame`.

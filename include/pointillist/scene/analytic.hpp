@@ -34,6 +34,10 @@ struct AnalyticScene {
 
 // The demo scene: a sphere, a torus tilted 60° and a cube turned 30°, side by side, not touching.
 AnalyticScene demo_scene();
+// A stand-in statue for scenes of many instances (generate --scene wall|city|field|row without
+// models): a cube pedestal (half side 0.35) standing on y = 0, a sphere (radius 0.4) on it and a
+// ring (torus 0.55 / 0.1) around the sphere tilted 60° about x, so its front and side differ.
+AnalyticScene statue_scene();
 // Single shapes centred at the origin (for focused tests).
 AnalyticScene sphere_scene(float radius = 1.0f);
 AnalyticScene torus_scene(float major = 1.0f, float minor = 0.35f);
