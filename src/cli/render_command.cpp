@@ -159,6 +159,10 @@ int run_render(const RenderOptions& o) {
   open.features = o.features;
   open.stored_features = o.frame.features;
   if (o.features) open.paging = Paging::Never;  // features need the hierarchy held whole
+  // Occlusion culling draws from hierarchies held whole (so far).
+  if (o.frame.occlusion.method != OcclusionMethod::None && !paging_asked) {
+    open.paging = Paging::Never;
+  }
   const Scene scene = o.inputs.size() == 1 && is_scene_file(o.inputs[0])
                           ? read_scene(o.inputs[0], open, pool, progress)
                           : scene_of_models(o.inputs, open, pool, progress);

@@ -19,6 +19,7 @@ struct RenderText {
   bool no_chunk_culling = false;
   bool features = false, no_features = false;
   FeatureOptions feature;
+  std::vector<std::string> chc_off;
 };
 
 void add_look(CLI::App* cmd, RenderOptions& o, RenderText& t) {
@@ -98,6 +99,51 @@ void add_features(CLI::App* cmd, RenderText& t) {
       ->group(kGroup);
 }
 
+void add_occlusion(CLI::App* cmd, RenderOptions& o, RenderText& t) {
+  constexpr const char* kGroup = "Occlusion culling";
+  OcclusionSettings& oc = o.frame.occlusion;
+  add_enum<OcclusionMethod>(cmd, "--occlusion", oc.method,
+                            {{"none", OcclusionMethod::None},
+                             {"stop-and-wait", OcclusionMethod::StopAndWait},
+                             {"chc", OcclusionMethod::Chc},
+                             {"chc++", OcclusionMethod::ChcPlusPlus}},
+                            "Skip what is hidden behind what is already drawn (the same image): "
+                            "none, stop-and-wait (query each node and wait), chc (coherent "
+                            "hierarchical culling) or chc++ (with batched queries, multiqueries, "
+                            "spread re-queries and tight bounds). Fast mode, QSplat, models held "
+                            "whole",
+                            "none")
+      ->group(kGroup);
+  cmd->add_option("--query-latency", oc.query_latency,
+                  "With --occlusion: a query's answer is usable only after K more flushes of "
+                  "the render queue (emulates a GPU's latency; 0 = at once)")
+      ->default_val(0u)
+      ->check(CLI::Range(0u, 1000u))
+      ->group(kGroup);
+  cmd->add_option("--cull-leaf", oc.leaf_points,
+                  "With --occlusion: cull each model's hierarchy down to subtrees of at most N "
+                  "points")
+      ->default_val(4096u)
+      ->check(CLI::Range(1u, 1u << 30))
+      ->group(kGroup);
+  cmd->add_option("--chc-batch", oc.batch,
+                  "With --occlusion chc++: previously hidden nodes queried together (R1)")
+      ->default_val(50u)
+      ->check(CLI::Range(1u, 100000u))
+      ->group(kGroup);
+  cmd->add_option("--chc-requery", oc.requery_frames,
+                  "With --occlusion chc or chc++: frames between queries of a visible leaf")
+      ->default_val(5u)
+      ->check(CLI::Range(0u, 100000u))
+      ->group(kGroup);
+  cmd->add_option("--chc-off", t.chc_off,
+                  "With --occlusion chc++: switch rules off (to measure them): batching, "
+                  "multiqueries, random, tight")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"batching", "multiqueries", "random", "tight"}))
+      ->group(kGroup);
+}
+
 void add_detail(CLI::App* cmd, RenderOptions& o, RenderText& t) {
   add_enum<LodScheme>(cmd, "--lod", o.frame.lod,
                       {{"qsplat", LodScheme::QSplat}, {"spt", LodScheme::Spt}},
@@ -165,6 +211,14 @@ std::vector<std::string> ignored_options(const CLI::App& cmd, const RenderOption
   };
   const bool spt = o.frame.lod == LodScheme::Spt;
   const bool quality = o.frame.rasterizer == Rasterizer::Quality;
+  if (o.frame.occlusion.method == OcclusionMethod::None) {
+    for (const char* name : {"--query-latency", "--cull-leaf", "--chc-batch", "--chc-requery",
+                             "--chc-off"}) {
+      ignored(name, "it applies with --occlusion");
+    }
+  } else if (o.frame.occlusion.method != OcclusionMethod::ChcPlusPlus) {
+    for (const char* name : {"--chc-batch", "--chc-off"}) ignored(name, "it applies with --occlusion chc++");
+  }
   if (spt) ignored("--threshold", "it is the QSplat traversal's detail; --lod spt uses --epsilon");
   if (!spt) {
     ignored("--epsilon", "it is the Sequential Point Tree's detail; add --lod spt");
@@ -218,6 +272,7 @@ Command add_render_command(CLI::App& app) {
   add_look(cmd, *o, *t);
   add_detail(cmd, *o, *t);
   add_features(cmd, *t);
+  add_occlusion(cmd, *o, *t);
   add_sequences_and_paging(cmd, *o, *t);
   add_prepare_options(cmd, o->prepare, /*with_radius_scale=*/false);
   add_columns(cmd, o->columns);
@@ -234,6 +289,13 @@ Command add_render_command(CLI::App& app) {
               o->features = t->feature;
             }
             o->frame.features = !t->no_features;
+            for (const std::string& rule : t->chc_off) {
+              OcclusionSettings& oc = o->frame.occlusion;
+              (rule == "batching"       ? oc.batching
+               : rule == "multiqueries" ? oc.multiqueries
+               : rule == "random"       ? oc.randomized
+                                        : oc.tight_bounds) = false;
+            }
             parse_camera_options(t->camera, o->view);
             o->settings.background = parse_rgb8(t->background, "--background");
             if (t->unlit) {

@@ -20,6 +20,26 @@ const char* kind_name(ModelKind k) {
   return "?";
 }
 
+Json occlusion_json(const OcclusionSettings& o, const OcclusionStats& s) {
+  return {{"method", name(o.method)},
+          {"query_latency", o.query_latency},
+          {"culling_nodes_visited", s.nodes_visited},
+          {"leaves_drawn", s.leaves_drawn},
+          {"leaves_culled", s.leaves_culled},
+          {"instances_drawn", s.instances_drawn},
+          {"queries_single", s.queries_single},
+          {"queries_multi", s.queries_multi},
+          {"multiquery_nodes", s.multiquery_nodes},
+          {"multiquery_failed", s.multiquery_failed},
+          {"v_queries", s.v_queries},
+          {"queries_skipped_nav", s.queries_skipped},
+          {"flushes", s.flushes},
+          {"stalls", s.stalls},
+          {"hiz_tiles_tested", s.tiles_tested},
+          {"ms_query", ms(s.ms_query)},
+          {"ms_hiz", ms(s.ms_hiz)}};
+}
+
 }  // namespace
 
 std::string render_report_json(const RenderReport& r) {
@@ -56,6 +76,7 @@ std::string render_report_json(const RenderReport& r) {
     j["chunks"] = spt.chunks_total;
     j["chunks_culled"] = spt.chunks_culled;
   }
+  if (f.occlusion.method != OcclusionMethod::None) j["occlusion"] = occlusion_json(f.occlusion, s.occlusion);
   if (r.renderer && r.renderer->paging()) {
     const PagingStats p = r.renderer->paging_stats();
     j["paged"] = true;
@@ -106,6 +127,9 @@ std::string render_report_json(const RenderReport& r) {
       o["ms"] = ms(fr.stats.ms_total);
       o["ms_select"] = ms(fr.stats.ms_select);
       o["ms_raster"] = ms(fr.stats.ms_raster);
+      if (f.occlusion.method != OcclusionMethod::None) {
+        o["occlusion"] = occlusion_json(f.occlusion, fr.stats.occlusion);
+      }
       if (fr.bytes_read >= 0) {
         o["bytes_read"] = fr.bytes_read;
         o["resident_bytes"] = fr.resident_bytes;

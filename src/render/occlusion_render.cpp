@@ -116,8 +116,7 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
   }
   const CameraFrame cam = make_camera_frame(camera);
   size_frame(frame, cam);
-  occlusion_stats_ = {};
-  OcclusionStats& ostats = occlusion_stats_;
+  OcclusionStats ostats;
 
   // The models' cull trees and the scene's hierarchy (rebuilt when the scene changes).
   std::vector<ModelState*> states(scene.size());
@@ -461,6 +460,7 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
   fill_stats(frame, selection, cam, pool.thread_count(), start, start, done);
   frame.stats.ms_select = ms_select;
   frame.stats.ms_raster = ms_raster;
+  frame.stats.occlusion = ostats;
   if (features) {
     RenderStats& s = frame.stats;
     for (std::size_t ch = 0; ch < stream.chunk_count; ++ch) {

@@ -114,7 +114,6 @@ void Renderer::render(std::span<const SceneInstance> scene, const Camera& camera
   }
   last_frame_.clear();
   spt_stats_ = {};
-  occlusion_stats_ = {};
   ++frame_number_;
   if (occlusion) {
     render_occluded(scene, camera, settings, fs, pool, frame);

@@ -8,6 +8,7 @@
 #include "pointillist/core/math.hpp"
 #include "pointillist/core/thread_pool.hpp"
 #include "pointillist/lod/sphere_tree.hpp"
+#include "pointillist/render/occlusion.hpp"
 #include "pointillist/render/selection.hpp"
 #include "pointillist/render/settings.hpp"
 #include "pointillist/render/splat_raster.hpp"
@@ -30,6 +31,8 @@ struct RenderStats {
   int width = 0, height = 0;
   unsigned threads = 1;
   double ms_select = 0, ms_raster = 0, ms_total = 0;  // wall clock (steady_clock)
+  // Occlusion culling (FrameSettings::occlusion; zeros without it).
+  OcclusionStats occlusion;
 };
 
 // The rendered image: 8-bit RGB color, rows top to bottom, and depth along the view direction

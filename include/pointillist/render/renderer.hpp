@@ -152,8 +152,6 @@ class Renderer {
   PagingStats paging_stats() const;
   // SPT selection details of the last frame (summed over instances).
   const SptSelectionStats& spt_stats() const { return spt_stats_; }
-  // Occlusion culling counts of the last frame (zero without culling).
-  const OcclusionStats& occlusion_stats() const { return occlusion_stats_; }
 
  private:
   struct ModelState;
@@ -174,7 +172,6 @@ class Renderer {
   SptSelectionStats spt_stats_;
   std::uint64_t frame_number_ = 0;
   std::unique_ptr<SceneCull> cull_;  // occlusion culling: the scene's hierarchy and state
-  OcclusionStats occlusion_stats_;
 };
 
 }  // namespace pointillist
