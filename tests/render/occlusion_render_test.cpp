@@ -1,0 +1,235 @@
+// Occlusion culling in the renderer: every method gives the image of no culling, bit for bit
+// (colour and depth), for every kernel, thread count and query latency, frame after frame along
+// a camera path; nothing that wins a pixel without culling is culled; and culling does skip the
+// models hidden behind the wall.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <set>
+#include <vector>
+
+#include "pointillist/core/error.hpp"
+#include "pointillist/lod/sphere_tree.hpp"
+#include "pointillist/pipeline/scene.hpp"
+#include "pointillist/render/renderer.hpp"
+#include "pointillist/scene/analytic.hpp"
+#include "render_test_util.hpp"
+
+using namespace pointillist;
+using namespace pointillist::render_test;
+
+namespace {
+
+// A wall x ∈ [−4, 4], y ∈ [0, 3] at z = 0 facing +z (a grid, so that neighbouring splats tie in
+// depth when it is seen square on), coloured by position.
+PointSet wall_points() {
+  PointSet p;
+  const float step = 0.05f;
+  for (int j = 0; j <= 60; ++j) {
+    for (int i = 0; i <= 160; ++i) {
+      p.positions.push_back({-4.0f + step * float(i), step * float(j), 0.0f});
+      p.normals.push_back({0, 0, 1});
+      p.radii.push_back(0.75f * step);
+      p.colors.push_back({static_cast<std::uint8_t>(40 + i), static_cast<std::uint8_t>(60 + 3 * j),
+                          120});
+    }
+  }
+  return p;
+}
+
+// A unit sphere of samples with exact normals; colours unique per sample when `unique`.
+PointSet ball_points(std::size_t count, bool unique) {
+  SurfaceSamples s = sample_scene(sphere_scene(1.0f), count, 3);
+  PointSet p = std::move(s.points);
+  p.normals = s.true_normals;
+  p.radii.assign(p.positions.size(), 0.09f);
+  for (std::size_t i = 0; i < p.positions.size(); ++i) {
+    const std::uint32_t c = unique ? static_cast<std::uint32_t>(i + 1) * 2654435761u >> 8
+                                   : static_cast<std::uint32_t>(i % 7) * 30u;
+    p.colors.push_back({static_cast<std::uint8_t>(c), static_cast<std::uint8_t>(c >> 8),
+                        static_cast<std::uint8_t>(c >> 16)});
+  }
+  return p;
+}
+
+struct TestScene {
+  SphereTree wall_tree, ball_tree;
+  RenderModel wall, ball;
+  std::vector<SceneInstance> instances;
+
+  explicit TestScene(bool unique_colors) {
+    ThreadPool pool(2);
+    wall_tree = build_sphere_tree(wall_points(), pool);
+    ball_tree = build_sphere_tree(ball_points(3000, unique_colors), pool);
+    wall.tree = wall_tree.view();
+    wall.name = "wall";
+    ball.tree = ball_tree.view();
+    ball.name = "ball";
+    instances.push_back({&wall, {}});
+    // Balls behind the wall (hidden from the start), two past its end (seen once the camera
+    // moves), one in front, one half hidden above its top edge.
+    for (int i = 0; i < 5; ++i) {
+      for (int k = 0; k < 2; ++k) {
+        instances.push_back(
+            {&ball, make_transform({-3.2f + 1.6f * float(i), 1.0f, -2.0f - 2.5f * float(k)},
+                                   {0, 36.0f * float(i + k), 0}, 0.8f)});
+      }
+    }
+    instances.push_back({&ball, make_transform({6.0f, 1.0f, -3.0f}, {}, 1.0f)});
+    instances.push_back({&ball, make_transform({7.5f, 1.0f, -6.0f}, {0, 90, 0}, 1.0f)});
+    instances.push_back({&ball, make_transform({-1.5f, 1.0f, 2.5f}, {}, 0.5f)});
+    instances.push_back({&ball, make_transform({1.0f, 3.2f, -1.5f}, {}, 0.6f)});
+  }
+};
+
+// Frame k of a strafe from x = 0 to x = 6 (eye and target together).
+Camera path_camera(int k, int frames) {
+  Camera c;
+  const float x = 6.0f * float(k) / float(frames - 1);
+  c.eye = {x, 1.5f, 9.0f};
+  c.target = {x, 1.5f, 0.0f};
+  c.fov_deg = 40.0f;
+  c.width = 160;
+  c.height = 120;
+  return c;
+}
+
+struct Image {
+  std::vector<Rgb8> color;
+  std::vector<float> depth;
+  std::uint64_t splats = 0;
+  OcclusionStats occlusion;
+};
+
+std::vector<Image> render_path(const TestScene& scene, const RenderSettings& settings,
+                               const FrameSettings& fs, unsigned threads, int frames) {
+  ThreadPool pool(threads);
+  Renderer renderer;
+  Frame frame;
+  std::vector<Image> out;
+  for (int k = 0; k < frames; ++k) {
+    renderer.render(scene.instances, path_camera(k, frames), settings, fs, pool, frame);
+    out.push_back({std::vector<Rgb8>(frame.color.begin(), frame.color.end()),
+                   std::vector<float>(frame.depth.begin(), frame.depth.end()), frame.stats.splats,
+                   frame.stats.occlusion});
+  }
+  return out;
+}
+
+bool same_bits(const Image& a, const Image& b) {
+  return a.color.size() == b.color.size() && a.depth.size() == b.depth.size() &&
+         std::memcmp(a.color.data(), b.color.data(), a.color.size() * sizeof(Rgb8)) == 0 &&
+         std::memcmp(a.depth.data(), b.depth.data(), a.depth.size() * sizeof(float)) == 0;
+}
+
+}  // namespace
+
+TEST(OcclusionRender, EveryMethodGivesTheImageOfNoCullingForEveryKernelThreadsAndLatency) {
+  const TestScene scene(false);
+  constexpr int kFrames = 6;
+  std::size_t compared = 0;
+  for (SplatShape shape : {SplatShape::Square, SplatShape::Circle, SplatShape::Ellipse}) {
+    RenderSettings settings;
+    settings.shape = shape;
+    FrameSettings none;
+    const std::vector<Image> want = render_path(scene, settings, none, 2, kFrames);
+    for (OcclusionMethod m : {OcclusionMethod::StopAndWait, OcclusionMethod::Chc,
+                              OcclusionMethod::ChcPlusPlus}) {
+      for (unsigned latency : {0u, 2u}) {
+        FrameSettings fs;
+        fs.occlusion.method = m;
+        fs.occlusion.query_latency = latency;
+        fs.occlusion.leaf_points = 256;
+        std::vector<Image> by_threads[2];
+        for (unsigned threads : {1u, 2u}) {
+          const std::vector<Image>& got = by_threads[threads - 1] =
+              render_path(scene, settings, fs, threads, kFrames);
+          for (int k = 0; k < kFrames; ++k) {
+            EXPECT_TRUE(same_bits(got[k], want[k]))
+                << name(m) << " shape " << int(shape) << " threads " << threads << " latency "
+                << latency << " frame " << k;
+            ++compared;
+            // Culling skips what the wall hides (the balls behind it hold most of the points).
+            // Plain CHC with latency queries the balls before the wall's answers arrive, finds
+            // them visible, and draws them until their next query n_av frames later (the
+            // conservatism CHC++'s batching removes).
+            if (latency == 0 || m != OcclusionMethod::Chc) {
+              EXPECT_LT(got[k].splats, want[k].splats)
+                  << name(m) << " latency " << latency << " frame " << k;
+            }
+          }
+        }
+        // What culling does and counts does not depend on the thread count.
+        for (int k = 0; k < kFrames; ++k) {
+          const Image& a = by_threads[0][k];
+          const Image& b = by_threads[1][k];
+          EXPECT_EQ(a.splats, b.splats);
+          EXPECT_EQ(a.occlusion.queries_single, b.occlusion.queries_single);
+          EXPECT_EQ(a.occlusion.queries_multi, b.occlusion.queries_multi);
+          EXPECT_EQ(a.occlusion.leaves_culled, b.occlusion.leaves_culled);
+          EXPECT_EQ(a.occlusion.flushes, b.occlusion.flushes);
+        }
+      }
+    }
+  }
+  EXPECT_EQ(compared, 3u * 3u * 2u * 2u * kFrames);
+}
+
+TEST(OcclusionRender, NothingThatWinsAPixelWithoutCullingIsCulled) {
+  // Unlit, every ball sample has its own colour: the colours of the image without culling are
+  // the splats that win a pixel; each must be among the splats the culled frame drew.
+  const TestScene scene(true);
+  RenderSettings settings;
+  settings.ambient = 1.0f;
+  settings.diffuse = 0.0f;
+  settings.specular = 0.0f;
+  settings.threshold_px = 0.5f;
+  ThreadPool pool(2);
+  for (int k : {0, 3, 5}) {
+    const Camera camera = path_camera(k, 6);
+    Renderer plain, culled;
+    Frame a, b;
+    plain.render(scene.instances, camera, settings, {}, pool, a);
+    FrameSettings fs;
+    fs.occlusion.method = OcclusionMethod::ChcPlusPlus;
+    fs.occlusion.leaf_points = 128;
+    culled.render(scene.instances, camera, settings, fs, pool, b);
+    std::set<std::uint32_t> drawn;
+    for (std::size_t c = 0; c < b.splats.chunk_count; ++c) {
+      for (std::size_t i = 0; i < b.splats.chunks[c].count; ++i) {
+        drawn.insert(b.splats.chunks[c].shaded[i]);
+      }
+    }
+    std::size_t checked = 0, missing = 0;
+    for (std::size_t p = 0; p < a.color.size(); ++p) {
+      if (!(a.depth[p] < std::numeric_limits<float>::infinity())) continue;
+      const Rgb8 c = a.color[p];
+      const std::uint32_t packed = c.r | std::uint32_t(c.g) << 8 | std::uint32_t(c.b) << 16;
+      ++checked;
+      missing += drawn.count(packed) == 0;
+    }
+    EXPECT_GT(checked, 1000u);
+    EXPECT_EQ(missing, 0u) << "frame " << k;
+    EXPECT_GT(b.stats.occlusion.leaves_culled, 0u) << "frame " << k;
+  }
+}
+
+TEST(OcclusionRender, CombinationsNotYetSupportedAreRefusedWithAMessage) {
+  const TestScene scene(false);
+  ThreadPool pool(1);
+  Renderer renderer;
+  Frame frame;
+  FrameSettings fs;
+  fs.occlusion.method = OcclusionMethod::ChcPlusPlus;
+  fs.rasterizer = Rasterizer::Quality;
+  try {
+    renderer.render(scene.instances, path_camera(0, 2), {}, fs, pool, frame);
+    FAIL() << "quality mode with occlusion culling was accepted";
+  } catch (const OptionError& e) {
+    EXPECT_NE(std::string(e.what()).find("--mode quality"), std::string::npos) << e.what();
+  }
+  fs.rasterizer = Rasterizer::Fast;
+  fs.lod = LodScheme::Spt;
+  EXPECT_THROW(renderer.render(scene.instances, path_camera(0, 2), {}, fs, pool, frame),
+               OptionError);
+}
