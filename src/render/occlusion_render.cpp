@@ -232,16 +232,10 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
   }
   SceneCull& c = *cull_;
 
-  // Per-instance views (model space), made when an instance is first reached.
-  struct InstanceView {
-    bool ready = false;
-    bool identity = true;
-    CameraFrame cam;
-    std::optional<Shader> shader;
-    ViewConstants v;
-    std::uint32_t id_base = 0;
-  };
-  std::vector<InstanceView> views(scene.size());
+  // Per-instance views (model space), made when an instance is first reached in the frame.
+  std::vector<InstanceView>& views = c.views;
+  views.resize(scene.size());
+  for (InstanceView& v : views) v.ready = false;
   bool any_colors = false, any_features = false;
   for (const SceneInstance& inst : scene) {
     any_colors = any_colors || inst.model->tree.has_colors;
@@ -272,8 +266,10 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
   };
 
   // Per node of this frame: the tests left when it is reached (its parent's result) and after.
-  std::vector<std::uint8_t> tests_in(c.h.nodes.size(), root_tests);
-  std::vector<std::uint8_t> tests_out(c.h.nodes.size(), root_tests);
+  std::vector<std::uint8_t>& tests_in = c.tests_in;
+  std::vector<std::uint8_t>& tests_out = c.tests_out;
+  tests_in.assign(c.h.nodes.size(), root_tests);
+  tests_out.assign(c.h.nodes.size(), root_tests);
   Counters counters;
   const float min_splats = static_cast<float>(os.min_query_splats);
   CullCallbacks callbacks;
@@ -370,7 +366,8 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
   double ms_select = 0, ms_raster = 0;
   std::vector<Counters> task_counters;
   std::vector<SoftwareQueries::Rect> rects;
-  std::vector<std::uint8_t> instance_drawn(scene.size(), 0);
+  std::vector<std::uint8_t>& instance_drawn = c.instance_drawn;
+  instance_drawn.assign(scene.size(), 0);
   begin_splats(cam, settings, pool, frame.scratch, frame.depth);
   c.pyramid.reset(frame.depth, cam.width, cam.height);
   const Rgb8 base_color{to_byte(settings.base_color.x), to_byte(settings.base_color.y),

@@ -11,6 +11,8 @@
 #include "pointillist/render/occlusion.hpp"
 #include "pointillist/render/paged.hpp"
 #include "pointillist/render/renderer.hpp"
+#include "select/traversal_common.hpp"
+#include "shading.hpp"
 
 namespace pointillist::render_detail {
 
@@ -73,6 +75,16 @@ struct ModelCullTree {
   std::vector<Node> nodes;
   std::vector<std::uint32_t> children;
 };
+// How an instance sees the frame's camera (occlusion culling selects instance by instance).
+struct InstanceView {
+  bool ready = false;
+  bool identity = true;
+  CameraFrame cam;
+  std::optional<Shader> shader;
+  ViewConstants v;
+  std::uint32_t id_base = 0;  // its first surface id (sharp features)
+};
+
 ModelCullTree build_cull_tree(std::span<const SphereNode> nodes, std::uint32_t leaf_points);
 
 }  // namespace pointillist::render_detail
@@ -106,6 +118,10 @@ struct Renderer::SceneCull {
   std::vector<std::uint32_t> instance_root;  // the node of each instance's model root
   CullState state;
   DepthPyramid pyramid;
+  // Work buffers of a frame, kept for the next: per node the per-node tests left when it is
+  // reached and after its visit; per instance whether it drew.
+  std::vector<std::uint8_t> tests_in, tests_out, instance_drawn;
+  std::vector<render_detail::InstanceView> views;
 
   bool matches(std::span<const SceneInstance> s, std::uint32_t leaves) const {
     if (s.size() != scene.size() || leaves != leaf_points) return false;

@@ -5,6 +5,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <map>
+#include <memory>
+#include <mutex>
 #include <string>
 
 #include "pointillist/core/camera.hpp"
@@ -50,11 +53,8 @@ class Shader {
     diffuse_ = s.diffuse;
     specular_ = s.specular;
     base_ = s.base_color;
-    for (int i = 0; i <= kTableIntervals; ++i) {
-      const float p = std::pow(static_cast<float>(i) / kTableIntervals, s.shininess);
-      power_[i] = p < 1e-30f ? 0.0f : p;  // no denormals in the interpolation
-    }
-    power_[kTableIntervals + 1] = 1.0f;  // interpolation guard
+    table_ = power_table(s.shininess);
+    power_ = table_->data();
   }
 
   Vec3f base_color() const { return base_; }
@@ -105,7 +105,27 @@ class Shader {
  private:
   Vec3f light_, base_;
   float ambient_ = 0, diffuse_ = 0, specular_ = 0;
-  std::array<float, kTableIntervals + 2> power_{};
+  using PowerTable = std::array<float, kTableIntervals + 2>;
+  // t^shininess at the table's points, computed once per shininess (a scene of thousands of
+  // instances makes a Shader per instance and frame).
+  static std::shared_ptr<const PowerTable> power_table(float shininess) {
+    static std::mutex mutex;
+    static std::map<float, std::shared_ptr<const PowerTable>> tables;
+    std::lock_guard lock(mutex);
+    std::shared_ptr<const PowerTable>& slot = tables[shininess];
+    if (!slot) {
+      auto t = std::make_shared<PowerTable>();
+      for (int i = 0; i <= kTableIntervals; ++i) {
+        const float p = std::pow(static_cast<float>(i) / kTableIntervals, shininess);
+        (*t)[i] = p < 1e-30f ? 0.0f : p;  // no denormals in the interpolation
+      }
+      (*t)[kTableIntervals + 1] = 1.0f;  // interpolation guard
+      slot = std::move(t);
+    }
+    return slot;
+  }
+  std::shared_ptr<const PowerTable> table_;
+  const float* power_ = nullptr;
 };
 
 }  // namespace pointillist::render_detail

@@ -52,7 +52,8 @@ bool leaf_is_drawable(const SphereNode& n, const Camera& cam) {
 }  // namespace
 
 TEST(Selection, StreamIsTheDepthFirstOrderOfDrawableLeaves) {
-  const PointSet pts = splat_samples(torus_scene(), 3000, 7);
+  // Enough points for several selection tasks (one per ~2048 expected splats).
+  const PointSet pts = splat_samples(torus_scene(), 20000, 7);
   const SphereTree tree = make_test_tree(pts);
   const Camera cam = orbit_camera(tree.view_sphere, {.azimuth_deg = 30, .elevation_deg = 20,
                                                      .width = 120, .height = 90});
@@ -71,7 +72,7 @@ TEST(Selection, StreamIsTheDepthFirstOrderOfDrawableLeaves) {
   dfs(0);
   for (unsigned threads : {1u, 2u}) {
     const Frame f = render_with(tree, cam, s, threads);
-    EXPECT_GT(f.splats.chunk_count, 64u);  // the top was split into many subtrees
+    EXPECT_GE(f.splats.chunk_count, 8u);  // the top was split into several subtrees
     EXPECT_EQ(stream_nodes(f.splats), want) << threads << " threads";
     EXPECT_EQ(f.stats.splats, want.size());
     EXPECT_EQ(f.stats.nodes_visited, tree.nodes.size());  // nothing culled, every node tested

@@ -226,6 +226,9 @@ struct CullState {
   };
   std::vector<Node> nodes;
   std::uint64_t frame = 0;
+  // Work buffers of a frame, kept for the next.
+  std::vector<CullCallbacks::Visit> visits;
+  std::vector<std::uint8_t> was_visible;
 };
 
 // One frame of `settings.method` (not None) over `h`: visible leaves are queued on `queries`

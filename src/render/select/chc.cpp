@@ -30,9 +30,10 @@ class Culler {
  public:
   Culler(const CullHierarchy& h, const CullCallbacks& cb, const OcclusionSettings& s,
          OcclusionQueries& q, CullState& state, OcclusionStats& stats)
-      : h_(h), cb_(cb), s_(s), q_(q), st_(state.nodes), stats_(stats), f_(state.frame) {
+      : h_(h), cb_(cb), s_(s), q_(q), st_(state.nodes), stats_(stats), f_(state.frame),
+        visit_(state.visits), was_(state.was_visible) {
     visit_.resize(h.nodes.size());
-    was_.assign(h.nodes.size(), 0);
+    was_.resize(h.nodes.size());  // written for each node visited before it is read
   }
 
   void run() {
@@ -250,8 +251,8 @@ class Culler {
   std::vector<CullState::Node>& st_;
   OcclusionStats& stats_;
   const std::uint64_t f_;
-  std::vector<CullCallbacks::Visit> visit_;
-  std::vector<std::uint8_t> was_;
+  std::vector<CullCallbacks::Visit>& visit_;
+  std::vector<std::uint8_t>& was_;
   std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> heap_;
   std::deque<Pending> pending_;
   std::vector<std::uint32_t> i_queue_;

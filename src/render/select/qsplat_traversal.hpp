@@ -4,7 +4,8 @@
 // (paged_render.cpp). Internal to render.
 //
 // Parallel and deterministic: the top of the tree is expanded level by level, in depth-first
-// order, until there are about kTargetTasks pending subtrees; each subtree is then walked by one
+// order, until there are about target_tasks(expected splats) pending subtrees (at most
+// kTargetTasks); each subtree is then walked by one
 // task into its own chunk of the stream, and the chunks are read in order, so the stream is the
 // plain depth-first order whatever the thread count. A node is expanded at the top only when its
 // children are resident; anything else is left for its task.
@@ -133,7 +134,8 @@ void select_qsplat(const Access& access, const ViewConstants& v, std::uint8_t te
   std::vector<Item> items{access.root(tests)};
   std::vector<Item> next;
   SphereNode scratch[4];
-  while (items.size() < kTargetTasks) {
+  const std::size_t target = target_tasks(expected);
+  while (items.size() < target) {
     bool expanded = false;
     next.clear();
     for (const Item& p : items) {

@@ -115,11 +115,13 @@ void select_splats(const SphereTreeView& tree, const CameraFrame& camera,
   const std::uint8_t tests =
       static_cast<std::uint8_t>((settings.frustum_culling ? kTestFrustum : 0) |
                                 (settings.backface_culling ? kTestBackface : 0));
+  const Sphere root_sphere{tree.nodes[0].center, tree.nodes[0].radius};
   std::vector<TaskState<FlatAccess>> tasks;
   Counters top;
   std::vector<std::uint32_t> top_pages;
   select_qsplat(FlatAccess(tree.nodes), v, tests, tree.has_colors,
-                expected_splats(tree.leaf_count, camera), pool, stream, tasks, top, top_pages);
+                expected_splats(tree.leaf_count, camera, &root_sphere, settings.threshold_px), pool,
+                stream, tasks, top, top_pages);
 
   stats.nodes_visited = top.visited;
   stats.culled_frustum = top.culled_frustum;

@@ -20,6 +20,13 @@ constexpr std::uint8_t kTestFrustum = 1;
 constexpr std::uint8_t kTestBackface = 2;
 constexpr std::uint8_t kDecidedDraw = 4;  // top-level item already visited: just draw it
 constexpr std::size_t kTargetTasks = 128;
+// A task for about this many expected splats at least: a small model (an instance among
+// thousands in a scene) is walked by a few tasks, not kTargetTasks chunks' worth of buffers.
+constexpr std::uint64_t kSplatsPerTask = 2048;
+inline std::size_t target_tasks(std::uint64_t expected) {
+  return static_cast<std::size_t>(
+      std::clamp<std::uint64_t>(expected / kSplatsPerTask, 1, kTargetTasks));
+}
 constexpr std::size_t kInitialChunkCapacity = 128;
 // A chunk's first capacity: an even share of `expected` splats (Buffer memory that is never
 // written is never touched, so a first frame sized generously costs no page faults for what it
@@ -30,9 +37,23 @@ inline std::size_t first_chunk_capacity(std::uint64_t expected, std::size_t chun
 }
 // The splats a view is expected to draw at most, for sizing a first frame: no more than the
 // model's leaves, and no more than a few per pixel.
-inline std::uint64_t expected_splats(std::uint64_t leaves, const CameraFrame& camera) {
+// `bound`, when given, is the model's bounding sphere: a model far away covers few pixels, and
+// draws at most a few splats per pixel it covers (a scene of thousands of instances then sizes
+// its chunks by what each instance can draw, not by its points).
+inline std::uint64_t expected_splats(std::uint64_t leaves, const CameraFrame& camera,
+                                     const Sphere* bound = nullptr, float threshold_px = 1.0f) {
   const std::uint64_t pixels = static_cast<std::uint64_t>(camera.width) * camera.height;
-  return std::min(leaves, 2 * pixels);
+  std::uint64_t expected = std::min(leaves, 2 * pixels);
+  if (bound) {
+    const float z = dot(bound->center - camera.eye, camera.forward) - bound->radius;
+    if (z > 0) {
+      const double rho = double(bound->radius) * camera.focal_px / z;  // pixels, at least
+      const double t = std::max(0.25, double(threshold_px));
+      const double covered = 4.0 * 3.14159265 * (rho + 1) * (rho + 1) / (t * t);
+      if (covered < double(expected)) expected = static_cast<std::uint64_t>(covered) + 1;
+    }
+  }
+  return expected;
 }
 constexpr float kMaxCoordinate = 1e9f;  // pixels; larger (or NaN) splat coordinates are dropped
 
