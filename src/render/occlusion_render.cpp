@@ -270,6 +270,7 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
   std::vector<std::uint8_t>& tests_out = c.tests_out;
   tests_in.assign(c.h.nodes.size(), root_tests);
   tests_out.assign(c.h.nodes.size(), root_tests);
+  c.weight.resize(c.h.nodes.size());
   Counters counters;
   const float min_splats = static_cast<float>(os.min_query_splats);
   CullCallbacks callbacks;
@@ -307,13 +308,16 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
     if (decision == Decision::Draw) {
       out.kind = CullCallbacks::Kind::Leaf;  // the detail stops here: one splat
       out.small = true;
+      c.weight[n] = 1.0f;
       return out;
     }
     out.kind = mn.child_count == 0 ? CullCallbacks::Kind::Leaf : CullCallbacks::Kind::Interior;
     // Splats expected: at most its points, about (projected size / threshold)² of them.
+    c.weight[n] = static_cast<float>(mn.points);
     if (zm > 0) {
       const float across = node.radius * iv.v.size_per_radius / (zm * settings.threshold_px);
-      out.small = std::min(static_cast<float>(mn.points), across * across) < min_splats;
+      c.weight[n] = std::min(c.weight[n], across * across);
+      out.small = c.weight[n] < min_splats;
     }
     return out;
   };
@@ -372,23 +376,53 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
   c.pyramid.reset(frame.depth, cam.width, cam.height);
   const Rgb8 base_color{to_byte(settings.base_color.x), to_byte(settings.base_color.y),
                         to_byte(settings.base_color.z)};
+  // A batch's leaves are selected in groups (one chunk each, in parallel): leaves of one instance
+  // up to about kGroupSplats expected splats together, so a thousand leaves drawn as one coarse
+  // splat each do not make a thousand chunks. The fast rasterizer's image does not depend on
+  // how the splats are grouped or ordered.
+  constexpr float kGroupSplats = 4096.0f;
+  std::vector<std::uint32_t> order;
+  std::vector<std::pair<std::size_t, std::size_t>> groups;
   const SoftwareQueries::Draw draw = [&](std::span<const std::uint32_t> batch) {
     const auto t0 = Clock::now();
+    order.assign(batch.begin(), batch.end());
+    std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+      return c.meta[a].instance < c.meta[b].instance ||
+             (c.meta[a].instance == c.meta[b].instance && a < b);
+    });
+    groups.clear();
+    float weight = 0;
+    for (std::size_t k = 0; k < order.size(); ++k) {
+      const std::uint32_t n = order[k];
+      view_of(c.meta[n].instance);
+      instance_drawn[c.meta[n].instance] = 1;
+      if (groups.empty() || c.meta[n].instance != c.meta[order[k - 1]].instance ||
+          weight + c.weight[n] > kGroupSplats) {
+        groups.emplace_back(k, k);
+        weight = 0;
+      }
+      groups.back().second = k + 1;
+      weight += c.weight[n];
+    }
     const std::size_t first = stream.chunk_count;
-    if (stream.chunks.size() < first + batch.size()) stream.chunks.resize(first + batch.size());
-    for (const std::uint32_t n : batch) view_of(c.meta[n].instance);
-    task_counters.assign(batch.size(), {});
-    rects.assign(batch.size(), {});
-    pool.run(batch.size(), [&](std::size_t k) {
-      const std::uint32_t n = batch[k];
-      const SceneCull::Meta& m = c.meta[n];
-      const SceneInstance& inst = scene[m.instance];
-      const InstanceView& iv = views[m.instance];
-      const std::uint32_t tree_node = states[m.instance]->cull_tree->nodes[m.local].tree_node;
-      SplatChunk& chunk = stream.chunks[first + k];
-      select_subtree(inst.model->tree.nodes, tree_node, tests_in[n], iv.v,
-                     inst.model->tree.has_colors, chunk, task_counters[k]);
-      chunk.instance = m.instance;
+    if (stream.chunks.size() < first + groups.size()) stream.chunks.resize(first + groups.size());
+    task_counters.assign(groups.size(), {});
+    rects.assign(groups.size(), {});
+    pool.run(groups.size(), [&](std::size_t g) {
+      thread_local std::vector<SubtreeRoot> roots;
+      roots.clear();
+      const std::uint32_t instance = c.meta[order[groups[g].first]].instance;
+      for (std::size_t k = groups[g].first; k < groups[g].second; ++k) {
+        const std::uint32_t n = order[k];
+        roots.push_back({states[instance]->cull_tree->nodes[c.meta[n].local].tree_node,
+                         tests_in[n]});
+      }
+      const SceneInstance& inst = scene[instance];
+      const InstanceView& iv = views[instance];
+      SplatChunk& chunk = stream.chunks[first + g];
+      select_subtrees(inst.model->tree.nodes, roots, iv.v, inst.model->tree.has_colors, chunk,
+                      task_counters[g]);
+      chunk.instance = instance;
       if (!iv.identity) to_world(inst.transform, chunk, with_discs);
       if (features) {
         attach_features(inst.model->tree.features, iv.identity ? nullptr : &inst.transform,
@@ -417,24 +451,23 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
         const auto clampi = [](float v, int hi) {
           return static_cast<int>(std::clamp(v, 0.0f, static_cast<float>(hi)));
         };
-        rects[k] = {clampi(std::floor(x0), cam.width), clampi(std::floor(y0), cam.height),
+        rects[g] = {clampi(std::floor(x0), cam.width), clampi(std::floor(y0), cam.height),
                     clampi(std::ceil(x1) + 1, cam.width), clampi(std::ceil(y1) + 1, cam.height)};
       }
     });
     SoftwareQueries::Rect dirty{cam.width, cam.height, 0, 0};
-    for (std::size_t k = 0; k < batch.size(); ++k) {
-      counters.visited += task_counters[k].visited;
-      counters.culled_frustum += task_counters[k].culled_frustum;
-      counters.culled_backface += task_counters[k].culled_backface;
-      instance_drawn[c.meta[batch[k]].instance] = 1;
-      if (rects[k].x1 > rects[k].x0 && rects[k].y1 > rects[k].y0) {
-        dirty.x0 = std::min(dirty.x0, rects[k].x0);
-        dirty.y0 = std::min(dirty.y0, rects[k].y0);
-        dirty.x1 = std::max(dirty.x1, rects[k].x1);
-        dirty.y1 = std::max(dirty.y1, rects[k].y1);
+    for (std::size_t g = 0; g < groups.size(); ++g) {
+      counters.visited += task_counters[g].visited;
+      counters.culled_frustum += task_counters[g].culled_frustum;
+      counters.culled_backface += task_counters[g].culled_backface;
+      if (rects[g].x1 > rects[g].x0 && rects[g].y1 > rects[g].y0) {
+        dirty.x0 = std::min(dirty.x0, rects[g].x0);
+        dirty.y0 = std::min(dirty.y0, rects[g].y0);
+        dirty.x1 = std::max(dirty.x1, rects[g].x1);
+        dirty.y1 = std::max(dirty.y1, rects[g].y1);
       }
     }
-    stream.chunk_count = first + batch.size();
+    stream.chunk_count = first + groups.size();
     const auto t1 = Clock::now();
     draw_splats(stream, first, stream.chunk_count, cam, settings, pool, frame.scratch,
                 frame.depth);

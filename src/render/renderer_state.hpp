@@ -121,6 +121,7 @@ struct Renderer::SceneCull {
   // Work buffers of a frame, kept for the next: per node the per-node tests left when it is
   // reached and after its visit; per instance whether it drew.
   std::vector<std::uint8_t> tests_in, tests_out, instance_drawn;
+  std::vector<float> weight;  // splats a node drawn as a leaf is expected to give
   std::vector<render_detail::InstanceView> views;
 
   bool matches(std::span<const SceneInstance> s, std::uint32_t leaves) const {

@@ -79,15 +79,17 @@ class FlatAccess {
 
 namespace render_detail {
 
-void select_subtree(std::span<const SphereNode> nodes, std::uint32_t node, std::uint8_t tests,
-                    const ViewConstants& v, bool with_colors, SplatChunk& chunk,
-                    Counters& counters) {
+void select_subtrees(std::span<const SphereNode> nodes, std::span<const SubtreeRoot> roots,
+                     const ViewConstants& v, bool with_colors, SplatChunk& chunk,
+                     Counters& counters) {
   const FlatAccess access(nodes);
   TaskState<FlatAccess> out;
   thread_local std::vector<FlatAccess::Item> stack;
   chunk.count = 0;
   chunk.reserve(kInitialChunkCapacity, with_colors, v.with_discs);
-  walk_subtree(access, FlatAccess::Item{node, tests}, v, with_colors, stack, chunk, out);
+  for (const SubtreeRoot& r : roots) {
+    walk_subtree(access, FlatAccess::Item{r.node, r.tests}, v, with_colors, stack, chunk, out);
+  }
   finish_chunk([&](std::uint32_t i) -> const SphereNode& { return nodes[i]; }, v, with_colors,
                chunk);
   counters.visited += out.counters.visited;

@@ -11,12 +11,18 @@
 
 namespace pointillist::render_detail {
 
-// Walks the subtree of node `node` of `nodes`, with the per-node tests `tests` still to do (as
-// the whole traversal would reach it), into `chunk` (emptied first; its buffers sized with
-// colours and discs as asked), shaded as select_splats shades: the splats the whole traversal
-// would draw from that subtree, in the same order. Adds to `counters`.
-void select_subtree(std::span<const SphereNode> nodes, std::uint32_t node, std::uint8_t tests,
-                    const ViewConstants& v, bool with_colors, SplatChunk& chunk,
-                    Counters& counters);
+// A subtree to walk: its root and the per-node tests still to do when the whole traversal
+// reaches it.
+struct SubtreeRoot {
+  std::uint32_t node;
+  std::uint8_t tests;
+};
+
+// Walks the subtrees `roots` of `nodes` one after the other into `chunk` (emptied first; its
+// buffers sized with colours and discs as asked), shaded as select_splats shades: the splats the
+// whole traversal would draw from those subtrees, in the same order. Adds to `counters`.
+void select_subtrees(std::span<const SphereNode> nodes, std::span<const SubtreeRoot> roots,
+                     const ViewConstants& v, bool with_colors, SplatChunk& chunk,
+                     Counters& counters);
 
 }  // namespace pointillist::render_detail
