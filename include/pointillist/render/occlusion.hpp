@@ -222,6 +222,9 @@ struct CullState {
     bool visible = false;
     std::uint64_t last_visited = 0;  // frame
     std::uint64_t last_visible = 0;  // frame
+    // First frame of the node's current run of frames visited and found hidden (R4's
+    // persistence i = frame − hidden_since + 1; a node seen for the first time has i = 1).
+    std::uint64_t hidden_since = 0;
     std::uint64_t next_query = 0;    // frame at which a visible leaf is queried again
   };
   std::vector<Node> nodes;

@@ -107,8 +107,11 @@ class Culler {
     ++stats_.nodes_visited;
     const CullCallbacks::Visit& v = visit_[n];
     CullState::Node& s = st_[n];
-    const bool was = s.visible && s.last_visited + 1 == f_;
+    const bool seen_last_frame = s.last_visited + 1 == f_;
+    const bool was = s.visible && seen_last_frame;
     was_[n] = was;
+    // A run of hidden frames goes on only from a frame that visited it and found it hidden.
+    if (was || !seen_last_frame) s.hidden_since = f_;
     s.last_visited = f_;
     s.visible = false;  // CHC: visited nodes start invisible; pull-up marks the visible
     if (v.near || v.small) {
@@ -187,7 +190,7 @@ class Culler {
     }
     keyed_.clear();
     for (const std::uint32_t n : i_queue_) {
-      keyed_.push_back({keep_probability(f_ - st_[n].last_visible), n});
+      keyed_.push_back({keep_probability(f_ - st_[n].hidden_since + 1), n});
     }
     std::sort(keyed_.begin(), keyed_.end(), [](const auto& a, const auto& b) {
       return a.first > b.first || (a.first == b.first && a.second < b.second);
