@@ -325,10 +325,32 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
   // larger in total than the node's own (Σ r² ≤ ratio · r²).
   std::vector<std::uint32_t> level, next;
   callbacks.bounds = [&](std::uint32_t n, std::vector<QueryBound>& out) {
-    const CullHierarchy::Node& hn = c.h.nodes[n];
     const SceneCull::Meta& m = c.meta[n];
     if (m.instance == UINT32_MAX) {
-      out.push_back(hn.bound);
+      // A BVH node: its children's spheres, levels down while they are not much larger in
+      // total (an instance's root stands for its model).
+      level.assign(1, n);
+      for (unsigned depth = 0; depth < os.tight_depth; ++depth) {
+        next.clear();
+        double area = 0, own = 0;
+        for (const std::uint32_t k : level) {
+          const CullHierarchy::Node& p = c.h.nodes[k];
+          own += double(p.bound.radius) * p.bound.radius;
+          if (c.meta[k].instance != UINT32_MAX || p.child_count == 0) {
+            next.push_back(k);
+            area += double(p.bound.radius) * p.bound.radius;
+            continue;
+          }
+          for (std::uint32_t j = 0; j < p.child_count; ++j) {
+            const std::uint32_t ch = c.h.children[p.first_child + j];
+            next.push_back(ch);
+            area += double(c.h.nodes[ch].bound.radius) * c.h.nodes[ch].bound.radius;
+          }
+        }
+        if (area > os.tight_area_ratio * own) break;
+        level.swap(next);
+      }
+      for (const std::uint32_t k : level) out.push_back(c.h.nodes[k].bound);
       return;
     }
     const auto& nodes = scene[m.instance].model->tree.nodes;
