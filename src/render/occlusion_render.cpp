@@ -80,6 +80,23 @@ ModelCullTree build_cull_tree(std::span<const SphereNode> nodes, std::uint32_t l
   return t;
 }
 
+ModelCullTree build_spt_cull_tree(const SequentialPointTree& spt) {
+  ModelCullTree t;
+  t.nodes.push_back({kSptTopList + 1, UINT32_MAX, 0, 0, 0,
+                     static_cast<std::uint32_t>(spt.node_count())});
+  const auto leaf = [&](std::uint32_t range, std::uint32_t entries) {
+    t.children.push_back(static_cast<std::uint32_t>(t.nodes.size()));
+    t.nodes.push_back({range, 0, 0, 0, 1, entries});
+  };
+  if (spt.top_end > 0) leaf(kSptTopList, spt.top_end);
+  for (std::uint32_t k = 0; k < spt.chunks.size(); ++k) {
+    leaf(k, spt.chunks[k].end - spt.chunks[k].begin);
+  }
+  t.nodes[0].child_count = static_cast<std::uint32_t>(t.nodes.size() - 1);
+  t.nodes[0].culling_leaves = t.nodes[0].child_count;
+  return t;
+}
+
 }  // namespace render_detail
 
 namespace {
@@ -96,8 +113,11 @@ Sphere enclose(const Sphere& a, const Sphere& b) {
   return {a.center + d * ((r - a.radius) / dist), r * (1.0f + 1e-6f)};
 }
 
+Sphere world_sphere(const InstanceTransform& t, const Sphere& s) {
+  return {t.apply(s.center), s.radius * t.scale * (1.0f + 1e-6f)};
+}
 Sphere world_sphere(const InstanceTransform& t, const SphereNode& n) {
-  return {t.apply(n.center), n.radius * t.scale * (1.0f + 1e-6f)};
+  return world_sphere(t, Sphere{n.center, n.radius});
 }
 
 }  // namespace
@@ -118,30 +138,48 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
   size_frame(frame, cam);
   OcclusionStats ostats;
 
+  const bool spt = fs.lod == LodScheme::Spt;
   // The models' cull trees and the scene's hierarchy (rebuilt when the scene changes).
   std::vector<ModelState*> states(scene.size());
   for (std::size_t i = 0; i < scene.size(); ++i) {
     ModelState& st = state_for(*scene[i].model, pool, fs);
     if (st.frame != frame_number_) last_frame_.push_back(&st);
     st.frame = frame_number_;
-    if (!st.cull_tree || st.cull_tree->leaf_points != os.leaf_points) {
+    if (spt) {
+      if (!st.spt_cull_tree) st.spt_cull_tree = build_spt_cull_tree(*st.spt);
+    } else if (!st.cull_tree || st.cull_tree->leaf_points != os.leaf_points) {
       st.cull_tree = build_cull_tree(scene[i].model->tree.nodes, os.leaf_points);
     }
     states[i] = &st;
   }
-  if (!cull_ || !cull_->matches(scene, os.leaf_points)) {
+  // The cull tree of instance i's model, and a node's sphere in model space.
+  const auto cull_tree = [&](std::uint32_t i) -> const ModelCullTree& {
+    return spt ? *states[i]->spt_cull_tree : *states[i]->cull_tree;
+  };
+  const auto model_bound = [&](std::uint32_t i, const ModelCullTree::Node& mn) -> Sphere {
+    if (!spt) {
+      const SphereNode& n = scene[i].model->tree.nodes[mn.tree_node];
+      return {n.center, n.radius};
+    }
+    const SequentialPointTree& t = *states[i]->spt;
+    return mn.tree_node >= kSptTopList ? spt_top_bounds(t) : t.chunks[mn.tree_node].bounds;
+  };
+  if (!cull_ || !cull_->matches(scene, os.leaf_points, fs.lod)) {
     cull_ = std::make_unique<SceneCull>();
     SceneCull& c = *cull_;
     c.leaf_points = os.leaf_points;
+    c.lod = fs.lod;
     for (const SceneInstance& inst : scene) c.scene.emplace_back(inst.model, inst.transform);
     // BVH over the instances' world spheres: median split on the longest axis of the centres.
     std::vector<std::uint32_t> order(scene.size());
     std::iota(order.begin(), order.end(), 0u);
     std::vector<Sphere> world(scene.size());
     for (std::size_t i = 0; i < scene.size(); ++i) {
-      const auto& nodes = scene[i].model->tree.nodes;
-      world[i] = nodes.empty() ? Sphere{scene[i].transform.translate, 0.0f}
-                               : world_sphere(scene[i].transform, nodes[0]);
+      const ModelCullTree& t = cull_tree(static_cast<std::uint32_t>(i));
+      world[i] = t.nodes.empty()
+                     ? Sphere{scene[i].transform.translate, 0.0f}
+                     : world_sphere(scene[i].transform, model_bound(static_cast<std::uint32_t>(i),
+                                                                     t.nodes[0]));
     }
     c.instance_root.assign(scene.size(), UINT32_MAX);
     struct Build {
@@ -186,8 +224,7 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
     for (std::uint32_t n = 0; n < kids.size(); ++n) std::reverse(kids[n].begin(), kids[n].end());
     // Each instance's model nodes, below its BVH leaf (which is the model's root itself).
     for (const auto& [bvh_leaf, i] : leaf_instance) {
-      const ModelCullTree& t = *states[i]->cull_tree;
-      const auto& nodes = scene[i].model->tree.nodes;
+      const ModelCullTree& t = cull_tree(i);
       if (t.nodes.empty()) continue;
       const std::uint32_t base = static_cast<std::uint32_t>(c.h.nodes.size()) - 1;
       // Local node 0 is the BVH leaf; local k > 0 is base + k.
@@ -202,7 +239,7 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
       for (std::uint32_t k = 0; k < t.nodes.size(); ++k) {
         const ModelCullTree::Node& mn = t.nodes[k];
         CullHierarchy::Node& hn = c.h.nodes[global(k)];
-        const Sphere s = world_sphere(scene[i].transform, nodes[mn.tree_node]);
+        const Sphere s = world_sphere(scene[i].transform, model_bound(i, mn));
         hn.bound = {s.center, s.radius};
         hn.culling_leaves = mn.culling_leaves;
         if (k > 0) hn.parent = global(mn.parent);
@@ -294,8 +331,23 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
       return out;
     }
     InstanceView& iv = view_of(m.instance);
-    const ModelCullTree& t = *states[m.instance]->cull_tree;
+    const ModelCullTree& t = cull_tree(m.instance);
     const ModelCullTree::Node& mn = t.nodes[m.local];
+    if (spt) {
+      // The model's root holds its ranges; the top list is always scanned; a chunk outside
+      // the view is skipped as the plain selection skips it.
+      c.weight[n] = static_cast<float>(mn.points);
+      if (m.local == 0) {
+        out.kind = CullCallbacks::Kind::Interior;
+      } else if (mn.tree_node < kSptTopList && fs.spt_chunk_culling &&
+                 settings.frustum_culling &&
+                 spt_chunk_outside(iv.cam, states[m.instance]->spt->chunks[mn.tree_node].bounds)) {
+        return out;
+      } else {
+        out.kind = CullCallbacks::Kind::Leaf;
+      }
+      return out;
+    }
     const SphereNode& node = scene[m.instance].model->tree.nodes[mn.tree_node];
     const std::uint32_t parent = hn.parent;
     std::uint8_t tests = (m.local == 0 || parent == UINT32_MAX) ? root_tests : tests_out[parent];
@@ -326,6 +378,10 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
   std::vector<std::uint32_t> level, next;
   callbacks.bounds = [&](std::uint32_t n, std::vector<QueryBound>& out) {
     const SceneCull::Meta& m = c.meta[n];
+    if (spt && m.instance != UINT32_MAX) {
+      out.push_back(c.h.nodes[n].bound);
+      return;
+    }
     if (m.instance == UINT32_MAX) {
       // A BVH node: its children's spheres, levels down while they are not much larger in
       // total (an instance's root stands for its model).
@@ -355,7 +411,7 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
     }
     const auto& nodes = scene[m.instance].model->tree.nodes;
     const InstanceTransform& tf = scene[m.instance].transform;
-    const std::uint32_t root = states[m.instance]->cull_tree->nodes[m.local].tree_node;
+    const std::uint32_t root = cull_tree(m.instance).nodes[m.local].tree_node;
     level.assign(1, root);
     for (unsigned depth = 0; depth < os.tight_depth; ++depth) {
       next.clear();
@@ -391,6 +447,7 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
   stream.has_features = features;
   double ms_select = 0, ms_raster = 0;
   std::vector<Counters> task_counters;
+  std::vector<SptSelectionStats> spt_counters;
   std::vector<SoftwareQueries::Rect> rects;
   std::vector<std::uint8_t>& instance_drawn = c.instance_drawn;
   instance_drawn.assign(scene.size(), 0);
@@ -429,28 +486,47 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
     const std::size_t first = stream.chunk_count;
     if (stream.chunks.size() < first + groups.size()) stream.chunks.resize(first + groups.size());
     task_counters.assign(groups.size(), {});
+    spt_counters.assign(groups.size(), {});
     rects.assign(groups.size(), {});
     pool.run(groups.size(), [&](std::size_t g) {
-      thread_local std::vector<SubtreeRoot> roots;
-      roots.clear();
       const std::uint32_t instance = c.meta[order[groups[g].first]].instance;
-      for (std::size_t k = groups[g].first; k < groups[g].second; ++k) {
-        const std::uint32_t n = order[k];
-        roots.push_back({states[instance]->cull_tree->nodes[c.meta[n].local].tree_node,
-                         tests_in[n]});
-      }
       const SceneInstance& inst = scene[instance];
       const InstanceView& iv = views[instance];
       SplatChunk& chunk = stream.chunks[first + g];
-      select_subtrees(inst.model->tree.nodes, roots, iv.v, inst.model->tree.has_colors, chunk,
-                      task_counters[g]);
+      const ModelState& st = *states[instance];
+      if (spt) {
+        chunk.count = 0;
+        for (std::size_t k = groups[g].first; k < groups[g].second; ++k) {
+          const ModelCullTree::Node& mn = st.spt_cull_tree->nodes[c.meta[order[k]].local];
+          const SequentialPointTree& t = *st.spt;
+          if (mn.tree_node == kSptTopList) {
+            select_spt_range(t, 0, t.top_end, spt_top_bounds(t), iv.cam, settings, fs.epsilon_px,
+                             *iv.shader, with_discs, chunk, spt_counters[g]);
+          } else if (mn.tree_node < kSptTopList) {
+            const SptChunk& sc = t.chunks[mn.tree_node];
+            select_spt_range(t, sc.begin, sc.end, sc.bounds, iv.cam, settings, fs.epsilon_px,
+                             *iv.shader, with_discs, chunk, spt_counters[g]);
+          }
+        }
+      } else {
+        thread_local std::vector<SubtreeRoot> roots;
+        roots.clear();
+        for (std::size_t k = groups[g].first; k < groups[g].second; ++k) {
+          const std::uint32_t n = order[k];
+          roots.push_back({st.cull_tree->nodes[c.meta[n].local].tree_node, tests_in[n]});
+        }
+        select_subtrees(inst.model->tree.nodes, roots, iv.v, inst.model->tree.has_colors, chunk,
+                        task_counters[g]);
+      }
       chunk.instance = instance;
+      const bool colored = spt ? st.spt->has_colors : inst.model->tree.has_colors;
       if (!iv.identity) to_world(inst.transform, chunk, with_discs);
       if (features) {
-        attach_features(inst.model->tree.features, iv.identity ? nullptr : &inst.transform,
-                        iv.id_base, chunk);
+        const TreeFeatures* f =
+            spt ? (st.spt_features ? &*st.spt_features : nullptr) : inst.model->tree.features;
+        attach_features(f, iv.identity ? nullptr : &inst.transform, iv.id_base, chunk);
       }
-      if (any_colors && !inst.model->tree.has_colors) {
+      if (any_colors && !colored) {
         chunk.reserve(chunk.count, true, with_discs);
         std::fill(chunk.color.begin(), chunk.color.begin() + chunk.count, base_color);
       }
@@ -479,6 +555,7 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
     });
     SoftwareQueries::Rect dirty{cam.width, cam.height, 0, 0};
     for (std::size_t g = 0; g < groups.size(); ++g) {
+      spt_stats_ += spt_counters[g];
       counters.visited += task_counters[g].visited;
       counters.culled_frustum += task_counters[g].culled_frustum;
       counters.culled_backface += task_counters[g].culled_backface;

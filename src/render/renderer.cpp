@@ -99,7 +99,6 @@ void Renderer::render(std::span<const SceneInstance> scene, const Camera& camera
   const bool occlusion = fs.occlusion.method != OcclusionMethod::None;
   if (occlusion) {
     const char* drop = fs.rasterizer != Rasterizer::Fast ? "--mode quality or reference"
-                       : fs.lod == LodScheme::Spt          ? "--lod spt"
                        : options_.page_all                 ? "--memory and --progressive"
                                                            : nullptr;
     for (const SceneInstance& inst : scene) {
@@ -108,8 +107,8 @@ void Renderer::render(std::span<const SceneInstance> scene, const Camera& camera
     if (drop) {
       throw OptionError(std::string("occlusion culling (--occlusion ") +
                         name(fs.occlusion.method) +
-                        ") works with the fast mode and the QSplat traversal of models held "
-                        "whole so far; drop " + drop + ", or --occlusion");
+                        ") works with the fast mode on models held whole so far; drop " + drop +
+                        ", or --occlusion");
     }
   }
   last_frame_.clear();

@@ -86,6 +86,10 @@ struct InstanceView {
 };
 
 ModelCullTree build_cull_tree(std::span<const SphereNode> nodes, std::uint32_t leaf_points);
+// A Sequential Point Tree's: its root over one leaf per list range (tree_node = kSptTopList for
+// the top list, k for chunk k; the root's is kSptTopList + 1).
+inline constexpr std::uint32_t kSptTopList = UINT32_MAX - 1;
+ModelCullTree build_spt_cull_tree(const SequentialPointTree& spt);
 
 }  // namespace pointillist::render_detail
 
@@ -100,7 +104,8 @@ struct Renderer::ModelState {
   std::optional<TreeFeatures> spt_features;  // the model's features on the SPT's entries
   std::uint64_t frame = 0;  // the last frame that drew the model
   std::uint64_t model_bytes = 0;  // storage bytes of a paged model (open + every page)
-  std::optional<render_detail::ModelCullTree> cull_tree;  // occlusion culling
+  std::optional<render_detail::ModelCullTree> cull_tree;      // occlusion culling (QSplat)
+  std::optional<render_detail::ModelCullTree> spt_cull_tree;  // occlusion culling (SPT)
 };
 
 
@@ -113,6 +118,7 @@ struct Renderer::SceneCull {
   };
   std::vector<std::pair<const RenderModel*, InstanceTransform>> scene;  // what it was built for
   std::uint32_t leaf_points = 0;
+  LodScheme lod = LodScheme::QSplat;
   CullHierarchy h;
   std::vector<Meta> meta;
   std::vector<std::uint32_t> instance_root;  // the node of each instance's model root
@@ -124,8 +130,8 @@ struct Renderer::SceneCull {
   std::vector<float> weight;  // splats a node drawn as a leaf is expected to give
   std::vector<render_detail::InstanceView> views;
 
-  bool matches(std::span<const SceneInstance> s, std::uint32_t leaves) const {
-    if (s.size() != scene.size() || leaves != leaf_points) return false;
+  bool matches(std::span<const SceneInstance> s, std::uint32_t leaves, LodScheme l) const {
+    if (s.size() != scene.size() || leaves != leaf_points || l != lod) return false;
     for (std::size_t i = 0; i < s.size(); ++i) {
       const InstanceTransform& a = s[i].transform;
       const InstanceTransform& b = scene[i].second;

@@ -214,6 +214,33 @@ TEST(OcclusionRender, NothingThatWinsAPixelWithoutCullingIsCulled) {
   }
 }
 
+TEST(OcclusionRender, SptChunksAreCulledWithTheSameImage) {
+  // With --lod spt the culling leaves are the Sequential Point Tree's list ranges (the top list
+  // and the chunks).
+  const TestScene scene(false);
+  constexpr int kFrames = 4;
+  for (SplatShape shape : {SplatShape::Square, SplatShape::Ellipse}) {
+    RenderSettings settings;
+    settings.shape = shape;
+    FrameSettings none;
+    none.lod = LodScheme::Spt;
+    const std::vector<Image> want = render_path(scene, settings, none, 2, kFrames);
+    for (OcclusionMethod m : {OcclusionMethod::StopAndWait, OcclusionMethod::ChcPlusPlus}) {
+      for (unsigned threads : {1u, 2u}) {
+        FrameSettings fs = none;
+        fs.occlusion.method = m;
+        const std::vector<Image> got = render_path(scene, settings, fs, threads, kFrames);
+        for (int k = 0; k < kFrames; ++k) {
+          EXPECT_TRUE(same_bits(got[k], want[k]))
+              << name(m) << " shape " << int(shape) << " threads " << threads << " frame " << k;
+          EXPECT_LT(got[k].splats, want[k].splats) << name(m) << " frame " << k;
+          EXPECT_GT(got[k].occlusion.leaves_culled, 0u);
+        }
+      }
+    }
+  }
+}
+
 TEST(OcclusionRender, CombinationsNotYetSupportedAreRefusedWithAMessage) {
   const TestScene scene(false);
   ThreadPool pool(1);
@@ -228,8 +255,8 @@ TEST(OcclusionRender, CombinationsNotYetSupportedAreRefusedWithAMessage) {
   } catch (const OptionError& e) {
     EXPECT_NE(std::string(e.what()).find("--mode quality"), std::string::npos) << e.what();
   }
+  Renderer paging({.page_all = true});
   fs.rasterizer = Rasterizer::Fast;
-  fs.lod = LodScheme::Spt;
-  EXPECT_THROW(renderer.render(scene.instances, path_camera(0, 2), {}, fs, pool, frame),
+  EXPECT_THROW(paging.render(scene.instances, path_camera(0, 2), {}, fs, pool, frame),
                OptionError);
 }

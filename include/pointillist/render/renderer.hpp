@@ -92,7 +92,7 @@ struct FrameSettings {
   bool features = true;
   // Occlusion culling (occlusion.hpp): with a method other than None, nodes hidden behind what
   // is already drawn are skipped. The image is the same bits as without culling. The fast
-  // rasterizer and the QSplat traversal of models held whole only (for now).
+  // rasterizer on models held whole only (for now).
   OcclusionSettings occlusion;
 };
 
@@ -131,8 +131,7 @@ class Renderer {
   // frame.stats sums the instances. Throws OptionError for combinations that cannot be drawn
   // (the message says what to drop): the reference rasterizer with SPT, with several or
   // transformed instances, or without a mesh; SPT on a paged model; occlusion culling other
-  // than with the fast rasterizer and the QSplat traversal of models held whole; invalid
-  // settings.
+  // than with the fast rasterizer on models held whole; invalid settings.
   void render(std::span<const SceneInstance> scene, const Camera& camera,
               const RenderSettings& settings, const FrameSettings& frame_settings,
               ThreadPool& pool, Frame& frame);

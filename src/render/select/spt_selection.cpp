@@ -17,6 +17,7 @@
 #include "pointillist/render/splat_raster.hpp"
 #include "frame_pass.hpp"
 #include "shading.hpp"
+#include "select/subtree_selection.hpp"
 
 namespace pointillist {
 namespace {
@@ -184,7 +185,87 @@ void run_block(const SequentialPointTree& t, Block b, const ViewConstants& v,
   }
 }
 
+ViewConstants spt_view(const CameraFrame& camera, const RenderSettings& settings,
+                       float epsilon_px) {
+  ViewConstants v;
+  v.eye = camera.eye;
+  v.right = camera.right;
+  v.up = camera.up;
+  v.forward = camera.forward;
+  v.focal_px = camera.focal_px;
+  v.half_w = 0.5f * static_cast<float>(camera.width);
+  v.half_h = 0.5f * static_cast<float>(camera.height);
+  v.width = static_cast<float>(camera.width);
+  v.height = static_cast<float>(camera.height);
+  const float epsilon = epsilon_px / camera.focal_px;  // world error per unit distance
+  v.epsilon2 = epsilon * epsilon;
+  v.facing_limit = settings.backface_culling ? 0.0f : std::numeric_limits<float>::infinity();
+  return v;
+}
+
+// The blocks of list range [begin, end) whose bounding sphere is `bounds`: the prefix that can
+// be drawn from the eye, cut into kBlock entries.
+void range_blocks(const SequentialPointTree& tree, std::uint32_t begin, std::uint32_t end,
+                  const Sphere& bounds, const CameraFrame& camera, float epsilon_px,
+                  std::vector<Block>& blocks) {
+  const float epsilon = epsilon_px / camera.focal_px;
+  const float r_lo = std::max(0.0f, distance(bounds.center, camera.eye) - bounds.radius);
+  const std::uint32_t stop = prefix_end(tree, begin, end, r_lo * epsilon);
+  for (std::uint32_t b = begin; b < stop; b += kBlock) {
+    blocks.push_back({b, std::min(stop, b + kBlock)});
+  }
+}
+
 }  // namespace
+
+namespace render_detail {
+
+Sphere spt_top_bounds(const SequentialPointTree& tree) {
+  return {tree.view_sphere.center,
+          tree.view_sphere.radius + (tree.node_count() ? tree.diameter[0] : 0)};
+}
+
+bool spt_chunk_outside(const CameraFrame& camera, const Sphere& bounds) {
+  return sphere_outside(camera, bounds);
+}
+
+void select_spt_range(const SequentialPointTree& tree, std::uint32_t begin, std::uint32_t end,
+                      const Sphere& bounds, const CameraFrame& camera,
+                      const RenderSettings& settings, float epsilon_px, const Shader& shader,
+                      bool with_discs, SplatChunk& out, SptSelectionStats& stats) {
+  const auto v = spt_view(camera, settings, epsilon_px);
+  thread_local std::vector<Block> blocks;
+  blocks.clear();
+  range_blocks(tree, begin, end, bounds, camera, epsilon_px, blocks);
+  const std::size_t first = out.count;
+  thread_local SplatChunk part;
+  for (const Block& b : blocks) {
+    BlockCounters counters;
+    run_block(tree, b, v, shader, tree.has_colors, with_discs, part, counters);
+    stats.entries_scanned += counters.scanned;
+    stats.culled_frustum += counters.frustum;
+    stats.culled_backface += counters.backface;
+    // Appended to `out` in list order.
+    out.reserve(out.count + part.count, tree.has_colors, with_discs);
+    const std::size_t o = out.count, n = part.count;
+    std::copy_n(part.x_px.begin(), n, out.x_px.begin() + o);
+    std::copy_n(part.y_px.begin(), n, out.y_px.begin() + o);
+    std::copy_n(part.depth.begin(), n, out.depth.begin() + o);
+    std::copy_n(part.size_px.begin(), n, out.size_px.begin() + o);
+    std::copy_n(part.shaded.begin(), n, out.shaded.begin() + o);
+    std::copy_n(part.normal.begin(), n, out.normal.begin() + o);
+    std::copy_n(part.node.begin(), n, out.node.begin() + o);
+    if (tree.has_colors) std::copy_n(part.color.begin(), n, out.color.begin() + o);
+    if (with_discs) {
+      std::copy_n(part.center.begin(), n, out.center.begin() + o);
+      std::copy_n(part.radius.begin(), n, out.radius.begin() + o);
+    }
+    out.count = o + n;
+  }
+  stats.splats += out.count - first;
+}
+
+}  // namespace render_detail
 
 void select_splats_spt(const SequentialPointTree& tree, const CameraFrame& camera,
                        const RenderSettings& settings, const SptRenderOptions& options,
@@ -202,30 +283,15 @@ void select_splats_spt(const SequentialPointTree& tree, const CameraFrame& camer
   if (tree.node_count() == 0) return;
 
   const render_detail::Shader shader(settings, camera);
-  ViewConstants v;
-  v.eye = camera.eye;
-  v.right = camera.right;
-  v.up = camera.up;
-  v.forward = camera.forward;
-  v.focal_px = camera.focal_px;
-  v.half_w = 0.5f * static_cast<float>(camera.width);
-  v.half_h = 0.5f * static_cast<float>(camera.height);
-  v.width = static_cast<float>(camera.width);
-  v.height = static_cast<float>(camera.height);
-  const float epsilon = options.epsilon_px / camera.focal_px;  // world error per unit distance
-  v.epsilon2 = epsilon * epsilon;
-  v.facing_limit = settings.backface_culling ? 0.0f : std::numeric_limits<float>::infinity();
+  const ViewConstants v = spt_view(camera, settings, options.epsilon_px);
 
   // The ranges to scan and their prefixes, cut into blocks.
   std::vector<Block> blocks;
   auto add_range = [&](std::uint32_t begin, std::uint32_t end, const Sphere& bounds) {
-    const float r_lo = std::max(0.0f, distance(bounds.center, camera.eye) - bounds.radius);
-    const std::uint32_t stop = prefix_end(tree, begin, end, r_lo * epsilon);
-    for (std::uint32_t b = begin; b < stop; b += kBlock) blocks.push_back({b, std::min(stop, b + kBlock)});
+    range_blocks(tree, begin, end, bounds, camera, options.epsilon_px, blocks);
   };
   // The top list's sphere: the first chunk's bounds do not cover it; use the whole model's.
-  const Sphere model_sphere{tree.view_sphere.center,
-                            tree.view_sphere.radius + (tree.node_count() ? tree.diameter[0] : 0)};
+  const Sphere model_sphere = render_detail::spt_top_bounds(tree);
   if (tree.top_end > 0) add_range(0, tree.top_end, model_sphere);
   for (const SptChunk& c : tree.chunks) {
     if (options.chunk_culling && settings.frustum_culling && sphere_outside(camera, c.bounds)) {

@@ -1,13 +1,17 @@
-// Selection of one subtree of a hierarchy held in memory (occlusion culling draws the culling
-// leaves it finds visible one by one). Internal to render.
+// Selection of parts of a model (occlusion culling draws the culling leaves it finds visible,
+// group by group): subtrees of a hierarchy held in memory, list ranges of a Sequential Point
+// Tree. Internal to render.
 #pragma once
 
 #include <cstdint>
 #include <span>
 
+#include "pointillist/lod/sequential_point_tree.hpp"
 #include "pointillist/lod/sphere_tree.hpp"
+#include "pointillist/render/spt_render.hpp"
 #include "pointillist/render/splat_stream.hpp"
 #include "select/traversal_common.hpp"
+#include "shading.hpp"
 
 namespace pointillist::render_detail {
 
@@ -24,5 +28,16 @@ struct SubtreeRoot {
 void select_subtrees(std::span<const SphereNode> nodes, std::span<const SubtreeRoot> roots,
                      const ViewConstants& v, bool with_colors, SplatChunk& chunk,
                      Counters& counters);
+
+// Sequential Point Trees (spt_selection.cpp): the sphere holding every splat of the top list,
+// whether a chunk's bounds are outside the view (the selection's chunk culling), and the
+// selection of list range [begin, end) with bounding sphere `bounds` as select_splats_spt
+// selects it, appended to `out` (its buffers grown as needed). Adds to `stats`.
+Sphere spt_top_bounds(const SequentialPointTree& tree);
+bool spt_chunk_outside(const CameraFrame& camera, const Sphere& bounds);
+void select_spt_range(const SequentialPointTree& tree, std::uint32_t begin, std::uint32_t end,
+                      const Sphere& bounds, const CameraFrame& camera,
+                      const RenderSettings& settings, float epsilon_px, const Shader& shader,
+                      bool with_discs, SplatChunk& out, SptSelectionStats& stats);
 
 }  // namespace pointillist::render_detail
