@@ -1,0 +1,97 @@
+// `pointillist render --occlusion`: on a generated wall scene, every method writes the frames of
+// --occlusion none bit for bit while culling the statues behind the wall (read from --stats);
+// options that cannot apply are named; combinations not supported are refused with a message.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "cli/cli_run.hpp"
+#include "testing/testing.hpp"
+
+using pointillist::testing::run_cli;
+using pointillist::testing::write_text_file;
+using ::testing::HasSubstr;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), {}};
+}
+
+std::string frame_file(const std::string& dir, int index) {
+  char name[32];
+  std::snprintf(name, sizeof name, "frame_%05d.png", index);
+  return (fs::path(dir) / name).string();
+}
+
+}  // namespace
+
+TEST(OcclusionCli, EveryMethodWritesTheFramesOfNoCullingAndCullsTheHiddenStatues) {
+  pointillist::testing::TempDir dir;
+  auto r = run_cli("generate --scene wall --spacing-scale 8 --points 400 --quiet -o " +
+                   dir.file("wall.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  // Three frames: two in front of the wall, one past its end (statues come into view).
+  write_text_file(dir.file("p.path"),
+                  "fov 30\n0 2 30  0 2 0\n4 2 30  4 2 0\n36 2 30  36 2 0\n");
+  const std::string common = "render " + dir.file("wall.json") + " --path " + dir.file("p.path") +
+                             " --size 480x270 --quiet ";
+  r = run_cli(common + "-o " + dir.file("none.png") + " --frames-out " + dir.file("none") +
+              " --depth " + dir.file("none_depth.png") + " --stats " + dir.file("none.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto plain = nlohmann::json::parse(bytes(dir.file("none.json")));
+  for (const char* method : {"stop-and-wait", "chc", "chc++"}) {
+    const std::string out = dir.file(method);
+    r = run_cli(common + "--occlusion " + method + " -o " + out + ".png --frames-out " + out +
+                " --depth " + out + "_depth.png --stats " + out + ".json");
+    ASSERT_EQ(r.exit_code, 0) << method << "\n" << r.output;
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_EQ(bytes(frame_file(out, k)), bytes(frame_file(dir.file("none"), k)))
+          << method << " frame " << k;
+    }
+    EXPECT_EQ(bytes(out + "_depth.png"), bytes(dir.file("none_depth.png"))) << method;
+    const auto stats = nlohmann::json::parse(bytes(out + ".json"));
+    ASSERT_TRUE(stats.contains("occlusion")) << method;
+    EXPECT_EQ(stats["occlusion"]["method"], method);
+    // In front of the wall, statues are culled and fewer splats drawn; past its end they are
+    // seen.
+    for (int k = 0; k < 2; ++k) {
+      EXPECT_GT(stats["frames"][k]["occlusion"]["leaves_culled"].get<int>(), 0) << method;
+      EXPECT_LT(stats["frames"][k]["splats"].get<std::uint64_t>(),
+                plain["frames"][k]["splats"].get<std::uint64_t>())
+          << method << " frame " << k;
+    }
+    EXPECT_GT(stats["frames"][2]["occlusion"]["instances_drawn"].get<int>(), 1) << method;
+  }
+}
+
+TEST(OcclusionCli, OptionsThatCannotApplyAreNamed) {
+  pointillist::testing::TempDir dir;
+  auto r = run_cli("generate --scene row --points 200 --quiet -o " + dir.file("row.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string common = "render " + dir.file("row.json") + " --size 64x48 -o " +
+                             dir.file("x.png") + " ";
+  r = run_cli(common + "--query-latency 2 --chc-off random");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("--query-latency is ignored: it applies with --occlusion"));
+  EXPECT_THAT(r.output, HasSubstr("--chc-off is ignored: it applies with --occlusion"));
+  r = run_cli(common + "--occlusion chc --chc-batch 10");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("--chc-batch is ignored: it applies with --occlusion chc++"));
+  r = run_cli(common + "--occlusion chc++ --mode quality");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("drop --mode quality or reference, or --occlusion"));
+  r = run_cli(common + "--occlusion chc++ --memory 1M");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("--memory and --progressive"));
+  r = run_cli(common + "--occlusion sometimes");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+}
