@@ -137,6 +137,13 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
   const CameraFrame cam = make_camera_frame(camera);
   size_frame(frame, cam);
   OcclusionStats ostats;
+  if (scene.empty()) {  // nothing to draw: the background
+    frame.splats.chunk_count = 0;
+    begin_splats(cam, settings, pool, frame.scratch, frame.depth);
+    finish_splats(cam, pool, frame.scratch, frame.color);
+    fill_stats(frame, {}, cam, pool.thread_count(), start, start, Clock::now());
+    return;
+  }
 
   const bool spt = fs.lod == LodScheme::Spt;
   // The models' cull trees and the scene's hierarchy (rebuilt when the scene changes).

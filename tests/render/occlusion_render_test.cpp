@@ -241,6 +241,23 @@ TEST(OcclusionRender, SptChunksAreCulledWithTheSameImage) {
   }
 }
 
+TEST(OcclusionRender, AnEmptySceneIsTheBackground) {
+  ThreadPool pool(2);
+  Renderer renderer;
+  Frame frame;
+  FrameSettings fs;
+  fs.occlusion.method = OcclusionMethod::ChcPlusPlus;
+  RenderSettings settings;
+  settings.background = {10, 20, 30};
+  renderer.render({}, path_camera(0, 2), settings, fs, pool, frame);
+  ASSERT_EQ(frame.color.size(), 160u * 120u);
+  for (std::size_t p = 0; p < frame.color.size(); ++p) {
+    ASSERT_EQ(frame.color[p], (Rgb8{10, 20, 30}));
+    ASSERT_EQ(frame.depth[p], std::numeric_limits<float>::infinity());
+  }
+  EXPECT_EQ(frame.stats.splats, 0u);
+}
+
 TEST(OcclusionRender, CombinationsNotYetSupportedAreRefusedWithAMessage) {
   const TestScene scene(false);
   ThreadPool pool(1);
