@@ -102,6 +102,8 @@ ModelCullTree build_spt_cull_tree(const SequentialPointTree& spt) {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+// Culling-hierarchy nodes of a scene at most (about 1 GB of hierarchy and per-frame state).
+constexpr std::uint64_t kMaxCullNodes = std::uint64_t{1} << 24;
 
 // The smallest sphere around `a` and `b` (a sphere holding both).
 Sphere enclose(const Sphere& a, const Sphere& b) {
@@ -172,6 +174,16 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
     return mn.tree_node >= kSptTopList ? spt_top_bounds(t) : t.chunks[mn.tree_node].bounds;
   };
   if (!cull_ || !cull_->matches(scene, os.leaf_points, fs.lod)) {
+    // The hierarchy holds every instance's cull tree: bound its size before building it.
+    std::uint64_t total = 2 * scene.size();
+    for (std::uint32_t i = 0; i < scene.size(); ++i) total += cull_tree(i).nodes.size();
+    if (total > kMaxCullNodes) {
+      throw OptionError("occlusion culling would need a hierarchy of " + std::to_string(total) +
+                        " nodes over " + std::to_string(scene.size()) +
+                        " instances (at most " + std::to_string(kMaxCullNodes) +
+                        "); give a larger --cull-leaf (now " + std::to_string(os.leaf_points) +
+                        " points)");
+    }
     cull_ = std::make_unique<SceneCull>();
     SceneCull& c = *cull_;
     c.leaf_points = os.leaf_points;

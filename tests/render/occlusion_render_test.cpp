@@ -272,6 +272,19 @@ TEST(OcclusionRender, CombinationsNotYetSupportedAreRefusedWithAMessage) {
   } catch (const OptionError& e) {
     EXPECT_NE(std::string(e.what()).find("--mode quality"), std::string::npos) << e.what();
   }
+  // A hierarchy too large for the scene (culling leaves of one point: 4,000 instances of a 4,500-node tree).
+  {
+    FrameSettings tiny;
+    tiny.occlusion.method = OcclusionMethod::Chc;
+    tiny.occlusion.leaf_points = 1;
+    std::vector<SceneInstance> many(4000, scene.instances[1]);
+    try {
+      renderer.render(many, path_camera(0, 2), {}, tiny, pool, frame);
+      FAIL() << "a hierarchy of millions of nodes was built";
+    } catch (const OptionError& e) {
+      EXPECT_NE(std::string(e.what()).find("--cull-leaf"), std::string::npos) << e.what();
+    }
+  }
   Renderer paging({.page_all = true});
   fs.rasterizer = Rasterizer::Fast;
   EXPECT_THROW(paging.render(scene.instances, path_camera(0, 2), {}, fs, pool, frame),
