@@ -242,7 +242,9 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
     // Children lists of the BVH nodes (in split order: lower half first).
     for (std::uint32_t n = 0; n < kids.size(); ++n) std::reverse(kids[n].begin(), kids[n].end());
     // Each instance's model nodes, below its BVH leaf (which is the model's root itself).
-    for (const auto& [bvh_leaf, i] : leaf_instance) {
+    for (const auto& leaf : leaf_instance) {
+      // Named copies: lambdas below use them (clang 14 cannot capture structured bindings).
+      const std::uint32_t bvh_leaf = leaf.first, i = leaf.second;
       const ModelCullTree& t = cull_tree(i);
       if (t.nodes.empty()) continue;
       const std::uint32_t base = static_cast<std::uint32_t>(c.h.nodes.size()) - 1;
