@@ -198,13 +198,7 @@ SelectionStats Renderer::select(std::span<const SceneInstance> scene, const Came
           render_detail::attach_features(f, t, id_base, chunk);
         }
       }
-      if (any_colors && !colors) {
-        // A model without colours beside coloured ones: its base colour, as the others carry.
-        const Rgb8 base{to_byte(settings.base_color.x), to_byte(settings.base_color.y),
-                        to_byte(settings.base_color.z)};
-        chunk.reserve(chunk.count, true, with_discs);
-        std::fill(chunk.color.begin(), chunk.color.begin() + chunk.count, base);
-      }
+      if (any_colors && !colors) fill_base_color(chunk, settings, with_discs);
     }
     if (model_f) id_base += model_f->surface_count;
     if (i > 0) {
@@ -220,14 +214,8 @@ SelectionStats Renderer::select(std::span<const SceneInstance> scene, const Came
   }
   stream.has_colors = any_colors;
   stream.has_features = features;
-  if (fs.splat_scale != 1.0f) {
-    for (std::size_t c = 0; c < stream.chunk_count; ++c) {
-      SplatChunk& chunk = stream.chunks[c];
-      for (std::size_t i = 0; i < chunk.count; ++i) chunk.size_px[i] *= fs.splat_scale;
-      if (with_discs) {
-        for (std::size_t i = 0; i < chunk.count; ++i) chunk.radius[i] *= fs.splat_scale;
-      }
-    }
+  for (std::size_t c = 0; c < stream.chunk_count; ++c) {
+    scale_splats(stream.chunks[c], fs.splat_scale, with_discs);
   }
   return total;
 }

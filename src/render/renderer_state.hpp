@@ -61,6 +61,24 @@ inline void add(SelectionStats& a, const SelectionStats& b) {
 }
 
 
+// A chunk of a model without colours drawn beside coloured ones: its splats take the settings'
+// base colour, as the others carry theirs.
+inline void fill_base_color(SplatChunk& chunk, const RenderSettings& settings, bool with_discs) {
+  const Rgb8 base{to_byte(settings.base_color.x), to_byte(settings.base_color.y),
+                  to_byte(settings.base_color.z)};
+  chunk.reserve(chunk.count, true, with_discs);
+  std::fill(chunk.color.begin(), chunk.color.begin() + chunk.count, base);
+}
+
+// Every splat of the chunk drawn `scale` times its size (FrameSettings::splat_scale).
+inline void scale_splats(SplatChunk& chunk, float scale, bool with_discs) {
+  if (scale == 1.0f) return;
+  for (std::size_t i = 0; i < chunk.count; ++i) chunk.size_px[i] *= scale;
+  if (with_discs) {
+    for (std::size_t i = 0; i < chunk.count; ++i) chunk.radius[i] *= scale;
+  }
+}
+
 // A model's hierarchy cut for occlusion culling: nodes down to subtrees of at most `leaf_points`
 // points (the culling leaves), in depth-first order, each with its children.
 struct ModelCullTree {

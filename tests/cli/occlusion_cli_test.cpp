@@ -86,12 +86,13 @@ TEST(OcclusionCli, OptionsThatCannotApplyAreNamed) {
   r = run_cli(common + "--occlusion chc --chc-batch 10");
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_THAT(r.output, HasSubstr("--chc-batch is ignored: it applies with --occlusion chc++"));
-  r = run_cli(common + "--occlusion chc++ --mode quality");
-  EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_THAT(r.output, HasSubstr("drop --mode quality or reference, or --occlusion"));
-  r = run_cli(common + "--occlusion chc++ --memory 1M");
-  EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_THAT(r.output, HasSubstr("--memory and --progressive"));
+  for (const auto& [args, message] :
+       {std::pair{"--mode quality", "drop --mode quality or reference, or --occlusion"},
+        std::pair{"--memory 1M", "--memory and --progressive"}}) {
+    r = run_cli(common + "--occlusion chc++ " + args);
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_THAT(r.output, HasSubstr(message));
+  }
   r = run_cli(common + "--occlusion sometimes");
   EXPECT_EQ(r.exit_code, 2) << r.output;
 }
