@@ -7,6 +7,8 @@ packages=(
   build-essential cmake pkg-config git
   libnanoflann-dev libeigen3-dev libcli11-dev libspng-dev zlib1g-dev
   nlohmann-json3-dev
+  # pointillist view: SDL 2 for the window; Xvfb (and xauth for xvfb-run) to test it headless
+  libsdl2-dev xvfb xauth
   jq
   libgtest-dev libgmock-dev googletest libbenchmark-dev
   # make fuzz: clang 14, its libFuzzer and sanitizer runtimes (libclang-rt-14-dev), and

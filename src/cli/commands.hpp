@@ -33,6 +33,7 @@ Command add_info_command(CLI::App& app);
 Command add_demo_command(CLI::App& app);
 Command add_generate_command(CLI::App& app);
 Command add_compare_command(CLI::App& app);
+Command add_view_command(CLI::App& app);
 
 struct ConvertCommandOptions {
   std::vector<std::string> inputs;

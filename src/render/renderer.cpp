@@ -251,6 +251,13 @@ bool Renderer::complete() const {
   return true;
 }
 
+bool Renderer::loading() const {
+  for (const ModelState* s : last_frame_) {
+    if (s->paged && s->paged->loading()) return true;
+  }
+  return false;
+}
+
 bool Renderer::paging() const {
   for (const ModelState* s : last_frame_) {
     if (s->paged) return true;

@@ -82,6 +82,8 @@ class PageCache {
   // True when the last frame requested nothing and no page is on its way: what is resident is
   // all that view needs.
   bool complete() const { return stats_.pages_requested == 0 && in_flight_count_ == 0; }
+  // True while pages handed to the loader have not been taken in by a begin_frame().
+  bool loading() const { return in_flight_count_ > 0; }
   const PageCacheStats& stats() const { return stats_; }
   const PageSource& source() const { return source_; }
   std::uint64_t memory_cap() const { return cap_; }

@@ -68,6 +68,7 @@ class PagedRenderer {
   }
   void wait_for_loader() { cache_.wait_for_loader(); }
   bool complete() const { return cache_.complete(); }
+  bool loading() const { return cache_.loading(); }
   const PagedRenderStats& stats() const { return cache_.stats(); }
   const PageCache& cache() const { return cache_; }
   // Counts and boxes of the model (PageSource::summary), for the camera.

@@ -145,6 +145,8 @@ class Renderer {
   void wait_for_loader();
   // True when no paged model is waiting for a page the last frame needed.
   bool complete() const;
+  // True while the loader thread has pages on their way (taken in by the next frame).
+  bool loading() const;
   bool paging() const;  // some model of the last frame is drawn page by page
   // Whether rendering `scene` draws some model page by page.
   bool pages_any(std::span<const SceneInstance> scene) const;

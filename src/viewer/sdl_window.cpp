@@ -1,0 +1,150 @@
+#include "pointillist/viewer/sdl_window.hpp"
+
+#include <SDL.h>
+
+#include <string>
+
+#include "pointillist/core/error.hpp"
+
+namespace pointillist {
+namespace {
+
+std::string key_name(SDL_Keycode k) {
+  if (k >= SDLK_a && k <= SDLK_z) return std::string(1, static_cast<char>('a' + (k - SDLK_a)));
+  if (k >= SDLK_0 && k <= SDLK_9) return std::string(1, static_cast<char>('0' + (k - SDLK_0)));
+  if (k >= SDLK_KP_1 && k <= SDLK_KP_9) {
+    return std::string(1, static_cast<char>('1' + (k - SDLK_KP_1)));
+  }
+  if (k == SDLK_KP_0) return "0";
+  if (k == SDLK_PLUS || k == SDLK_EQUALS || k == SDLK_KP_PLUS) return "plus";
+  if (k == SDLK_MINUS || k == SDLK_KP_MINUS) return "minus";
+  if (k == SDLK_ESCAPE) return "escape";
+  if (k >= SDLK_F1 && k <= SDLK_F12) {
+    std::string name = "f";
+    name += std::to_string(1 + (k - SDLK_F1));
+    return name;
+  }
+  return "";
+}
+
+class SdlWindow final : public Window {
+ public:
+  SdlWindow(const std::string& title, int width, int height) {
+    if (SDL_Init(SDL_INIT_VIDEO) != 0) {
+      std::string message = "cannot open a window (";
+      message += SDL_GetError();
+      message += "); the viewer needs a display: run it in a desktop session, or headless under "
+                 "xvfb-run; `pointillist render` draws images without one";
+      throw IoError(message);
+    }
+    // With no display SDL falls back to drivers that show nothing: refuse them unless asked for
+    // by name (SDL_VIDEODRIVER=offscreen runs the viewer with no window at all).
+    const std::string driver = SDL_GetCurrentVideoDriver() ? SDL_GetCurrentVideoDriver() : "";
+    if ((driver == "offscreen" || driver == "dummy") && !SDL_getenv("SDL_VIDEODRIVER")) {
+      SDL_Quit();
+      throw IoError("cannot open a window (no display found: DISPLAY and WAYLAND_DISPLAY are "
+                    "not set); the viewer needs a display: run it in a desktop session, or "
+                    "headless under xvfb-run; `pointillist render` draws images without one");
+    }
+    window_ = SDL_CreateWindow(title.c_str(), SDL_WINDOWPOS_UNDEFINED, SDL_WINDOWPOS_UNDEFINED,
+                               width, height, SDL_WINDOW_RESIZABLE);
+    if (!window_) {
+      const std::string error = SDL_GetError();
+      SDL_Quit();
+      throw IoError("cannot open a window of " + std::to_string(width) + "x" +
+                    std::to_string(height) + " (" + error + "); try a smaller --size");
+    }
+  }
+  ~SdlWindow() override {
+    SDL_DestroyWindow(window_);
+    SDL_Quit();
+  }
+
+  void present(const Frame& frame) override {
+    SDL_Surface* target = SDL_GetWindowSurface(window_);
+    if (!target || frame.width <= 0 || frame.height <= 0) return;
+    SDL_Surface* image = SDL_CreateRGBSurfaceWithFormatFrom(
+        const_cast<Rgb8*>(frame.color.data()), frame.width, frame.height, 24, 3 * frame.width,
+        SDL_PIXELFORMAT_RGB24);
+    if (!image) return;
+    SDL_BlitSurface(image, nullptr, target, nullptr);
+    SDL_FreeSurface(image);
+    SDL_UpdateWindowSurface(window_);
+  }
+
+  bool poll(InputEvent& out) override {
+    SDL_Event e;
+    while (SDL_PollEvent(&e)) {
+      if (translate(e, out)) return true;
+    }
+    return false;
+  }
+
+  void wait(int ms) override { SDL_WaitEventTimeout(nullptr, ms); }
+
+  void set_title(const std::string& title) override { SDL_SetWindowTitle(window_, title.c_str()); }
+
+  void resize(int width, int height) override { SDL_SetWindowSize(window_, width, height); }
+
+ private:
+  static bool translate(const SDL_Event& e, InputEvent& out) {
+    using T = InputEvent::Type;
+    switch (e.type) {
+      case SDL_QUIT:
+        out = {.type = T::Quit};
+        return true;
+      case SDL_WINDOWEVENT:
+        if (e.window.event == SDL_WINDOWEVENT_SIZE_CHANGED) {
+          out = {.type = T::Resize, .width = e.window.data1, .height = e.window.data2};
+          return true;
+        }
+        if (e.window.event == SDL_WINDOWEVENT_CLOSE) {
+          out = {.type = T::Quit};
+          return true;
+        }
+        return false;
+      case SDL_KEYDOWN: {
+        const std::string k = key_name(e.key.keysym.sym);
+        if (k.empty()) return false;
+        out = {.type = T::Key, .key = k};
+        return true;
+      }
+      case SDL_MOUSEBUTTONDOWN:
+      case SDL_MOUSEBUTTONUP:
+        if (e.button.button < 1 || e.button.button > 3) return false;
+        out = {.type = e.type == SDL_MOUSEBUTTONDOWN ? T::Press : T::Release,
+               .button = e.button.button,
+               .clicks = e.button.clicks,
+               .x = static_cast<float>(e.button.x),
+               .y = static_cast<float>(e.button.y)};
+        return true;
+      case SDL_MOUSEMOTION:
+        out = {.type = T::Motion,
+               .x = static_cast<float>(e.motion.x),
+               .y = static_cast<float>(e.motion.y)};
+        return true;
+      case SDL_MOUSEWHEEL: {
+        int x = 0, y = 0;
+        SDL_GetMouseState(&x, &y);
+        const float clicks = e.wheel.preciseY != 0 ? e.wheel.preciseY : float(e.wheel.y);
+        out = {.type = T::Wheel,
+               .x = static_cast<float>(x),
+               .y = static_cast<float>(y),
+               .wheel = e.wheel.direction == SDL_MOUSEWHEEL_FLIPPED ? -clicks : clicks};
+        return true;
+      }
+      default:
+        return false;
+    }
+  }
+
+  SDL_Window* window_ = nullptr;
+};
+
+}  // namespace
+
+std::unique_ptr<Window> open_sdl_window(const std::string& title, int width, int height) {
+  return std::make_unique<SdlWindow>(title, width, height);
+}
+
+}  // namespace pointillist

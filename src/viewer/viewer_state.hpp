@@ -1,0 +1,73 @@
+// The viewer's state between frames: input turned into camera moves and toggles, and the phase
+// that decides each frame's detail (moving: the frame-time controller; refine: towards full
+// detail; loading: full detail while pages stream in; settled: nothing to draw). Internal to
+// the viewer module.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "pointillist/render/frame_control.hpp"
+#include "pointillist/viewer/viewer.hpp"
+
+namespace pointillist {
+
+class ViewerState {
+ public:
+  ViewerState(const ViewerOptions& options, Navigator& navigator);
+
+  // Applies one input event (at now_ms); `frame` is the frame on screen (its depth buffer picks
+  // points under the cursor).
+  void handle(const InputEvent& e, double now_ms, const Frame& frame);
+  // The detail of the next frame, or nothing when the view is settled.
+  std::optional<float> next_detail(const Renderer& renderer);
+  // After a frame: its time (render and present) and the pages handed to the loader after it.
+  void frame_done(double frame_ms, const Renderer& renderer, std::size_t pages_handed);
+  // The last toggle could not be drawn: undo it and show why.
+  void refuse(const std::string& message, double now_ms);
+
+  const RenderSettings& settings() const { return settings_; }
+  const FrameSettings& frame_settings() const { return frame_; }
+  bool quit() const { return quit_; }
+  bool settled() const { return phase_ == Phase::Settled; }
+  const char* phase_name() const;
+  // When the first input event the next frame answers to arrived (ms), or -1.
+  double input_time() const { return input_ms_; }
+  bool take_screenshot_request() { return std::exchange(screenshot_, false); }
+  bool help_requested() { return std::exchange(help_, false); }
+  std::string title(const Renderer& renderer, double now_ms,
+                    const ViewerFrame* last = nullptr) const;
+
+ private:
+  enum class Phase { Moving, Refine, Loading, Settled };
+  void changed(double now_ms);
+  void key(const std::string& name, double now_ms);
+  void full_detail_reached(const Renderer& renderer, std::size_t pages_handed);
+
+  const ViewerOptions& options_;
+  Navigator& nav_;
+  RenderSettings settings_;
+  FrameSettings frame_;
+  RenderSettings undo_settings_;
+  FrameSettings undo_frame_;
+  float finest_;
+  FrameTimeController control_;
+  Phase phase_ = Phase::Moving;
+  bool moved_ = true;  // something changed since the last frame
+  float last_detail_ = 0;
+  std::vector<float> refine_;
+  std::size_t refine_index_ = 0;
+  std::size_t last_handed_ = 0;
+  std::size_t frames_ = 0;  // pages handed to the loader after the last frame
+  int buttons_ = 0;  // bit b-1 for button b held
+  float last_x_ = 0, last_y_ = 0;
+  double input_ms_ = -1;
+  bool quit_ = false, screenshot_ = false, help_ = false;
+  std::string message_;
+  double message_until_ = 0;
+  std::vector<double> recent_ms_;  // the last frames' times, for the fps shown
+};
+
+}  // namespace pointillist
