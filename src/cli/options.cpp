@@ -147,6 +147,32 @@ void parse_camera_options(const CameraText& text, ViewOptions& view) {
   if (!text.up.empty()) view.up = parse_vec3(text.up, "--up");
 }
 
+void add_edl_and_two_sided(CLI::App* app, RenderSettings& settings,
+                           std::vector<std::string>& edl_text) {
+  app->add_option("--edl", edl_text,
+                  "Eye-dome lighting [STRENGTH, default 1]: darken each pixel by how far its "
+                  "neighbours stand in front of it (depth-only shading that shows the shape of "
+                  "scans without normals; combine with --unlit for depth shading alone)")
+      ->expected(0, 1)
+      ->group(kGroupLook);
+  app->add_flag("--two-sided", settings.two_sided,
+                "Two-sided lighting: no backface culling, surfaces seen from behind lit as "
+                "from the front (partial scans seen from behind)")
+      ->group(kGroupLook);
+}
+
+float parse_edl(const std::vector<std::string>& edl_text) {
+  if (edl_text.empty() || edl_text.front().empty()) return 1.0f;
+  const std::string& t = edl_text.front();
+  char* end = nullptr;
+  const float v = std::strtof(t.c_str(), &end);
+  if (end != t.c_str() + t.size() || t.empty() || !(v > 0.0f) || !(v <= 100.0f)) {
+    throw OptionError("--edl " + t + ": give a strength between 0 and 100 (exclusive of 0; 1 is "
+                      "the usual strength), or --edl alone");
+  }
+  return v;
+}
+
 void add_columns(CLI::App* app, std::string& columns) {
   app->add_option("--columns", columns,
                   "Text inputs (.xyz .pts .csv .txt): what each column holds, e.g. "

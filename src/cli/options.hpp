@@ -14,6 +14,7 @@
 #include "commands.hpp"
 #include "pointillist/core/math.hpp"
 #include "pointillist/prep/prepare.hpp"
+#include "pointillist/render/settings.hpp"
 
 namespace pointillist::cli {
 
@@ -73,6 +74,12 @@ struct CameraText {
 };
 void add_camera_options(CLI::App* app, ViewOptions& view, CameraText& text);
 void parse_camera_options(const CameraText& text, ViewOptions& view);
+
+// --edl [STRENGTH] (into `edl_text`; parse_edl reads it once given) and --two-sided, for render
+// and view.
+void add_edl_and_two_sided(CLI::App* app, RenderSettings& settings,
+                           std::vector<std::string>& edl_text);
+float parse_edl(const std::vector<std::string>& edl_text);
 
 void add_columns(CLI::App* app, std::string& columns);
 void add_threads(CLI::App* app, unsigned& threads);

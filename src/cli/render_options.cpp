@@ -16,6 +16,7 @@ struct RenderText {
   CameraText camera;
   std::string background = "0,0,0", path, memory, read_per_frame;
   bool unlit = false;
+  std::vector<std::string> edl;  // --edl [STRENGTH]
   bool no_chunk_culling = false;
   bool features = false, no_features = false;
   FeatureOptions feature;
@@ -50,6 +51,7 @@ void add_look(CLI::App* cmd, RenderOptions& o, RenderText& t) {
                 "Show each splat's own colour, unshaded (ambient 1, no diffuse or specular): "
                 "the face colours of generate --scene T*, for compare --labels")
       ->group(kGroupLook);
+  add_edl_and_two_sided(cmd, o.settings, t.edl);
   add_enum<Reconstruction>(cmd, "--reconstruction", o.frame.quality.reconstruction,
                            {{"zrange", Reconstruction::ZRange},
                             {"zthreshold", Reconstruction::ZThreshold}},
@@ -297,6 +299,7 @@ Command add_render_command(CLI::App& app) {
             }
             parse_camera_options(t->camera, o->view);
             o->settings.background = parse_rgb8(t->background, "--background");
+            if (cmd->count("--edl") > 0) o->settings.edl_strength = parse_edl(t->edl);
             if (t->unlit) {
               o->settings.ambient = 1.0f;
               o->settings.diffuse = 0.0f;

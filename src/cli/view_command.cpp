@@ -24,6 +24,7 @@ struct ViewCommandOptions {
   RenderSettings settings;
   FrameSettings frame;
   std::string background = "0,0,0", memory, events, log_frames, screenshots = ".";
+  std::vector<std::string> edl;
   double fps = 30;
   unsigned refine = 8;
   bool features = false, no_features = false;
@@ -54,6 +55,7 @@ std::vector<std::string> render_words(const CLI::App& cmd, const ViewCommandOpti
 int run_view(const CLI::App& cmd, ViewCommandOptions& o) {
   parse_camera_options(o.camera, o.view);
   o.settings.background = parse_rgb8(o.background, "--background");
+  if (cmd.count("--edl") > 0) o.settings.edl_strength = parse_edl(o.edl);
   if (o.features && o.no_features) {
     throw OptionError("--features and --no-features contradict each other; give one");
   }
@@ -148,6 +150,7 @@ Command add_view_command(CLI::App& app) {
       ->group(kGroupLook);
   cmd->add_option("--background", o->background, "Background color R,G,B (0-255)")
       ->group(kGroupLook);
+  add_edl_and_two_sided(cmd, o->settings, o->edl);
   cmd->add_flag("--features", o->features,
                 "Find the sharp features of scans and draw them (stored ones are drawn anyway)")
       ->group(kGroupLook);

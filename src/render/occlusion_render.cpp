@@ -234,7 +234,7 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
   }
   const std::uint8_t root_tests =
       static_cast<std::uint8_t>((settings.frustum_culling ? kTestFrustum : 0) |
-                                (settings.backface_culling ? kTestBackface : 0));
+                                (settings.culls_backfaces() ? kTestBackface : 0));
   const auto view_of = [&](std::uint32_t i) -> InstanceView& {
     InstanceView& iv = views[i];
     if (!iv.ready) {

@@ -11,6 +11,7 @@
 #include "renderer_state.hpp"
 #include "select/stream_features.hpp"
 #include "pointillist/core/error.hpp"
+#include "pointillist/render/eye_dome.hpp"
 #include "pointillist/render/mesh_reference.hpp"
 #include "pointillist/render/paged.hpp"
 #include "pointillist/render/selection.hpp"
@@ -116,18 +117,17 @@ void Renderer::render(std::span<const SceneInstance> scene, const Camera& camera
   ++frame_number_;
   if (occlusion) {
     render_occluded(scene, camera, settings, fs, pool, frame);
-    return;
-  }
-  if (fs.rasterizer == Rasterizer::Reference) {
+  } else if (fs.rasterizer == Rasterizer::Reference) {
     render_mesh_reference(*scene[0].model->mesh, camera, settings, frame);
-    return;
+  } else {
+    const bool quality = fs.rasterizer == Rasterizer::Quality;
+    render_detail::frame_pass(camera, settings, quality ? &fs.quality : nullptr,
+                              &quality_scratch_, pool, frame,
+                              [&](const CameraFrame& world, SplatStream& stream) {
+                                return select(scene, camera, world, settings, fs, pool, stream);
+                              });
   }
-  const bool quality = fs.rasterizer == Rasterizer::Quality;
-  render_detail::frame_pass(camera, settings, quality ? &fs.quality : nullptr,
-                            &quality_scratch_, pool, frame,
-                            [&](const CameraFrame& world, SplatStream& stream) {
-                              return select(scene, camera, world, settings, fs, pool, stream);
-                            });
+  if (settings.edl_strength != 0.0f) apply_eye_dome_lighting(frame, settings.edl_strength, pool);
 }
 
 // Selection, instance after instance; the first instance selects straight into the frame's

@@ -53,6 +53,7 @@ class Shader {
     diffuse_ = s.diffuse;
     specular_ = s.specular;
     base_ = s.base_color;
+    two_sided_ = s.two_sided;
     table_ = power_table(s.shininess);
     power_ = table_->data();
   }
@@ -70,6 +71,7 @@ class Shader {
 
   // n: unit normal, v: unit vector to the eye, both in world space; base: linear 0..1.
   Rgb8 shade(Vec3f n, Vec3f v, Vec3f base) const {
+    if (two_sided_ && dot(n, v) < 0.0f) n = -n;  // seen from behind: lit as its front
     const float ndl = dot(n, light_);
     const float k = ambient_ + diffuse_ * std::max(0.0f, ndl);
     // h is zero only when the light is exactly behind the surface (then n·l ≤ 0: no highlight);
@@ -83,8 +85,14 @@ class Shader {
 
   // shade() for four surfaces at once (components of n, v and base as lanes). Writes
   // round(255·c) per channel into r, g, b.
-  void shade4(const Float4 n[3], const Float4 v[3], const Float4 base[3], Int4 out[3]) const {
+  void shade4(const Float4 n_in[3], const Float4 v[3], const Float4 base[3], Int4 out[3]) const {
     const Float4 zero = splat4(0.0f), one = splat4(1.0f);
+    Float4 n[3] = {n_in[0], n_in[1], n_in[2]};
+    if (two_sided_) {  // seen from behind: lit as its front
+      const Float4 ndv = n[0] * v[0] + n[1] * v[1] + n[2] * v[2];
+      const Float4 sign = select4(ndv < zero, splat4(-1.0f), one);
+      for (Float4& c : n) c = c * sign;
+    }
     const Float4 ndl = n[0] * light_.x + n[1] * light_.y + n[2] * light_.z;
     const Float4 k = ambient_ + diffuse_ * max4(zero, ndl);
     const Float4 hx = v[0] + light_.x, hy = v[1] + light_.y, hz = v[2] + light_.z;
@@ -105,6 +113,7 @@ class Shader {
  private:
   Vec3f light_, base_;
   float ambient_ = 0, diffuse_ = 0, specular_ = 0;
+  bool two_sided_ = false;
   using PowerTable = std::array<float, kTableIntervals + 2>;
   // t^shininess at the table's points, computed once per shininess (a scene of thousands of
   // instances makes a Shader per instance and frame).

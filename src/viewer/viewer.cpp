@@ -87,6 +87,8 @@ std::string render_command_line(std::span<const std::string> base, const Camera&
     add("--threshold", number_text(s.threshold_px));
   }
   if (f.splat_scale != 1.0f) add("--radius-scale", number_text(f.splat_scale));
+  if (s.edl_strength > 0) add("--edl", number_text(s.edl_strength));
+  if (s.two_sided) add("--two-sided", "");
   if (!f.features) add("--no-features", "");
   if (f.occlusion.method != OcclusionMethod::None) add("--occlusion", name(f.occlusion.method));
   add("-o", output);
@@ -104,6 +106,7 @@ std::string viewer_help() {
          "keys:  1-6 front, back, left, right, top, bottom views; 0 or r reset the view\n"
          "       m fast / quality mode; k splat kernel (square, circle, ellipse)\n"
          "       l QSplat / Sequential Point Tree; plus / minus splat size\n"
+         "       e eye-dome lighting on / off; t two-sided lighting on / off\n"
          "       f sharp features on / off; c occlusion culling (none / chc++)\n"
          "       s screenshot and its render command; h this help; q or Escape quit\n";
 }

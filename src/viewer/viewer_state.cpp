@@ -136,6 +136,11 @@ void ViewerState::key(const std::string& k, double now_ms) {
       frame_.splat_scale = std::min(100.0f, frame_.splat_scale * kSplatScaleStep);
     } else if (k == "minus") {
       frame_.splat_scale = std::max(0.01f, frame_.splat_scale / kSplatScaleStep);
+    } else if (k == "e") {
+      const float strength = options_.settings.edl_strength > 0 ? options_.settings.edl_strength : 1;
+      settings_.edl_strength = settings_.edl_strength > 0 ? 0.0f : strength;
+    } else if (k == "t") {
+      settings_.two_sided = !settings_.two_sided;
     } else if (k == "f") {
       frame_.features = !frame_.features;
     } else if (k == "c") {
@@ -254,6 +259,8 @@ std::string ViewerState::title(const Renderer& renderer, double now_ms,
     std::snprintf(s, sizeof s, " size x%.2f", double(frame_.splat_scale));
     t += s;
   }
+  if (settings_.edl_strength > 0) t += " edl";
+  if (settings_.two_sided) t += " two-sided";
   if (frame_.occlusion.method != OcclusionMethod::None) t += " culling";
   if (!frame_.features) t += " no-features";
   t += dot;

@@ -43,6 +43,15 @@ struct RenderSettings {
   float diffuse = 0.85f;
   float specular = 0.25f;   // Blinn-Phong, white
   float shininess = 32.0f;  // Blinn-Phong exponent, >= 0
+  // Two-sided lighting: nothing is culled for facing away (no backface culling of subtrees or
+  // splats), and a surface seen from behind is lit as if its normal faced the eye (partial scans
+  // seen from behind, clouds with unoriented normals).
+  bool two_sided = false;
+  // Eye-dome lighting after rasterization (eye_dome.hpp): 0 = off; 1 is Potree's default.
+  float edl_strength = 0.0f;
+
+  // Whether subtrees and splats facing away are skipped.
+  bool culls_backfaces() const { return backface_culling && !two_sided; }
 };
 
 }  // namespace pointillist

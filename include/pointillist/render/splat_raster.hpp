@@ -25,6 +25,7 @@ struct RasterScratch {
   std::vector<Chunk> chunks;
   std::vector<Buffer<std::uint32_t>> band_colors;  // one packed-color band per thread
   Buffer<std::uint32_t> image;   // per pixel: packed colour, drawing in several batches
+  Buffer<float> log_depth;       // eye-dome lighting: log2 of each pixel's depth
   std::uint64_t clipped_fragments = 0;  // the last frame's (RenderStats::clipped_fragments)
 };
 

@@ -219,7 +219,7 @@ SelectionStats PagedRenderer::select(const CameraFrame& cam, const RenderSetting
   Selection selection{
       v,
       static_cast<std::uint8_t>((settings.frustum_culling ? kTestFrustum : 0) |
-                                (settings.backface_culling ? kTestBackface : 0)),
+                                (settings.culls_backfaces() ? kTestBackface : 0)),
       with_colors, expected_splats(summary_.leaf_count, cam), stream, {}};
   if (!pages.empty() && pages[0]) {
     if (pages[0]->is_packed()) {

@@ -116,7 +116,7 @@ void select_splats(const SphereTreeView& tree, const CameraFrame& camera,
 
   const std::uint8_t tests =
       static_cast<std::uint8_t>((settings.frustum_culling ? kTestFrustum : 0) |
-                                (settings.backface_culling ? kTestBackface : 0));
+                                (settings.culls_backfaces() ? kTestBackface : 0));
   const Sphere root_sphere{tree.nodes[0].center, tree.nodes[0].radius};
   std::vector<TaskState<FlatAccess>> tasks;
   Counters top;

@@ -199,7 +199,7 @@ ViewConstants spt_view(const CameraFrame& camera, const RenderSettings& settings
   v.height = static_cast<float>(camera.height);
   const float epsilon = epsilon_px / camera.focal_px;  // world error per unit distance
   v.epsilon2 = epsilon * epsilon;
-  v.facing_limit = settings.backface_culling ? 0.0f : std::numeric_limits<float>::infinity();
+  v.facing_limit = settings.culls_backfaces() ? 0.0f : std::numeric_limits<float>::infinity();
   return v;
 }
 

@@ -76,6 +76,7 @@ struct ViewConstants {
   float threshold_px;
   std::array<Plane, 4> planes;
   bool with_discs;  // finish_chunk writes the discs (SplatStream::with_discs)
+  bool cull_facing;  // splats facing away are dropped (not with two-sided lighting)
 };
 
 enum class Decision { Cull, Draw, Refine };
@@ -144,7 +145,7 @@ class Emitter {
       ++counters.culled_frustum;
       return;
     }
-    if (check_facing && n.cone_sin < 1.0f && dot(d, n.normal) > 0) {
+    if (check_facing && v.cull_facing && n.cone_sin < 1.0f && dot(d, n.normal) > 0) {
       ++counters.culled_backface;
       return;
     }
@@ -264,6 +265,7 @@ inline ViewConstants make_view_constants(const Shader& shader, const CameraFrame
   v.threshold_px = settings.threshold_px;
   v.planes = camera.planes;
   v.with_discs = with_discs;
+  v.cull_facing = !settings.two_sided;
   return v;
 }
 
