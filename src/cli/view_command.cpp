@@ -1,6 +1,7 @@
 // `pointillist view`: opens the models (or a scene file) as `render` does and shows them in a
 // window (viewer module): the camera follows the mouse at a held frame rate, the view refines when
 // it stops, keys toggle the modes, `s` writes a screenshot and prints its `render` command.
+#include <chrono>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -53,6 +54,7 @@ std::vector<std::string> render_words(const CLI::App& cmd, const ViewCommandOpti
 }
 
 int run_view(const CLI::App& cmd, ViewCommandOptions& o) {
+  const auto start = std::chrono::steady_clock::now();
   parse_camera_options(o.camera, o.view);
   o.settings.background = parse_rgb8(o.background, "--background");
   if (cmd.count("--edl") > 0) o.settings.edl_strength = parse_edl(o.edl);
@@ -113,6 +115,7 @@ int run_view(const CLI::App& cmd, ViewCommandOptions& o) {
   v.scripted = !o.events.empty();
   v.log_frames = o.log_frames;
   v.quiet = o.quiet;
+  v.start = start;
   const std::unique_ptr<Window> window =
       open_sdl_window("Pointillist \xe2\x80\x94 " + v.name, o.view.width, o.view.height);
   run_viewer(renderer, scene.instances(), navigator, *window, pool, v, stdout);

@@ -116,7 +116,7 @@ ViewerResult run_viewer(Renderer& renderer, std::span<const SceneInstance> scene
                         const ViewerOptions& o, std::FILE* out) {
   ViewerState st(o, navigator);
   ViewerResult result;
-  const Clock::time_point start = Clock::now();
+  const Clock::time_point start = o.start;
   const auto now_ms = [&] {
     return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
   };

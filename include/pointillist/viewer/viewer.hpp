@@ -6,6 +6,7 @@
 // (sdl_window.hpp), a recording fake in tests.
 #pragma once
 
+#include <chrono>
 #include <cstdio>
 #include <memory>
 #include <span>
@@ -48,11 +49,14 @@ struct ViewerOptions {
   bool scripted = false;
   std::string log_frames;  // a CSV line per frame there (--log-frames), or empty
   bool quiet = false;      // print no help and no screenshot lines
+  // Where the frames' times count from (ViewerFrame::t_ms): the program's start, so the first
+  // frame's time includes opening the models and the window.
+  std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
 };
 
 // What one frame of the viewer was (also a line of --log-frames).
 struct ViewerFrame {
-  double t_ms = 0;          // when it was shown, since the viewer started
+  double t_ms = 0;          // when it was shown, since ViewerOptions::start
   const char* phase = "";   // "moving", "refine" or "loading"
   float detail = 0;         // QSplat threshold or SPT epsilon, pixels
   double render_ms = 0;     // Renderer::render
