@@ -49,6 +49,7 @@ struct ViewOptions {
   float azimuth_deg = 0, elevation_deg = 0;
   float distance = 0;  // 0 = automatic
   float fov_deg = 30;
+  float ortho_height = 0;  // > 0: orthographic, this many world units from top to bottom
   std::optional<Vec3f> eye, target, up;
 };
 

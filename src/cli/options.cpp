@@ -130,6 +130,11 @@ void add_camera_options(CLI::App* app, ViewOptions& view, CameraText& text) {
   app->add_option("--fov", view.fov_deg, "Vertical field of view, degrees")
       ->default_val(30.0f)
       ->group(kGroupCamera);
+  app->add_option("--ortho", view.ortho_height,
+                  "Orthographic camera showing HEIGHT world units from the image's top to its "
+                  "bottom (parallel rays: no perspective; --view 0,90 is a plan view)")
+      ->check(CLI::PositiveNumber)
+      ->group(kGroupCamera);
   app->add_option("--eye", text.eye, "Explicit eye X,Y,Z (with --target)")->group(kGroupCamera);
   app->add_option("--target", text.target, "Explicit target X,Y,Z (with --eye)")
       ->group(kGroupCamera);

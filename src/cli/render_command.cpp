@@ -35,15 +35,18 @@ Camera make_camera(const ViewOptions& v, const Sphere& view_sphere, Vec3f model_
     c.fov_deg = v.fov_deg;
     c.width = v.width;
     c.height = v.height;
+    c.ortho_height = v.ortho_height;
     return c;
   }
-  return orbit_camera(view_sphere, {.azimuth_deg = v.azimuth_deg,
-                                    .elevation_deg = v.elevation_deg,
-                                    .distance = v.distance,
-                                    .fov_deg = v.fov_deg,
-                                    .width = v.width,
-                                    .height = v.height,
-                                    .up = v.up.value_or(model_up)});
+  Camera c = orbit_camera(view_sphere, {.azimuth_deg = v.azimuth_deg,
+                                        .elevation_deg = v.elevation_deg,
+                                        .distance = v.distance,
+                                        .fov_deg = v.fov_deg,
+                                        .width = v.width,
+                                        .height = v.height,
+                                        .up = v.up.value_or(model_up)});
+  c.ortho_height = v.ortho_height;
+  return c;
 }
 
 void write_text(const std::string& where, const std::string& json) {

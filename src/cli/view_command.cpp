@@ -35,6 +35,9 @@ struct ViewCommandOptions {
   bool quiet = false;
 };
 
+// .ptl files larger than this are drawn page by page (about 5 million points).
+constexpr std::uintmax_t kPagedViewBytes = 32u << 20;
+
 // The options given to `view` that `render` needs as they are to draw the same image.
 const char* const kPassedToRender[] = {"--background", "--memory", "--features", "--normals",
                                        "--k", "--drop-outliers", "--outlier-ratio", "--columns"};
@@ -83,14 +86,22 @@ int run_view(const CLI::App& cmd, ViewCommandOptions& o) {
   open.prepare = o.prepare;
   open.columns = o.columns;
   open.paging = memory_cap > 0 ? Paging::Always : Paging::Auto;
-  open.frames = 1000;  // a viewer draws many frames: decoded whole unless too large for memory
+  // A large .ptl is drawn page by page: its first frame comes at once (0.46 s for a 20 M-point
+  // file against 12.7 s to decode it whole) and frames are as fast. Smaller ones are decoded
+  // whole (in under a second), so that SPT and occlusion culling can be switched on.
+  bool large = false;
+  for (const std::string& in : o.inputs) {
+    large = large || (is_model_file(in) && std::filesystem::file_size(in, ec) > kPagedViewBytes);
+  }
+  open.frames = large ? 1 : 1000;
   open.frame_pixels = std::uint64_t(o.view.width) * std::uint64_t(o.view.height);
   if (o.features) {
     open.features = FeatureOptions{};
     open.paging = Paging::Never;
   }
   open.stored_features = o.frame.features;
-  if (o.frame.occlusion.method != OcclusionMethod::None && memory_cap == 0) {
+  if ((o.frame.occlusion.method != OcclusionMethod::None || o.frame.lod == LodScheme::Spt) &&
+      memory_cap == 0) {
     open.paging = Paging::Never;
   }
   const Scene scene = o.inputs.size() == 1 && is_scene_file(o.inputs[0])

@@ -8,10 +8,10 @@
 namespace pointillist {
 
 Camera orbit_camera(const Sphere& view_sphere, const OrbitOptions& o) {
-  if (!(std::abs(o.elevation_deg) < 89.999f)) {
+  if (!(std::abs(o.elevation_deg) <= 90.0f)) {
     throw OptionError("view elevation " + std::to_string(o.elevation_deg) +
-                      "° is at or beyond a pole; use a value strictly between -90 and 90, or "
-                      "give --eye/--target/--up");
+                      "° is beyond a pole; use a value between -90 and 90, or give "
+                      "--eye/--target/--up");
   }
   if (!(o.fov_deg > 0.0f && o.fov_deg < 180.0f)) {
     throw OptionError("field of view " + std::to_string(o.fov_deg) +
@@ -43,7 +43,11 @@ Camera orbit_camera(const Sphere& view_sphere, const OrbitOptions& o) {
   Camera cam;
   cam.eye = view_sphere.center + dir * (d * radius);
   cam.target = view_sphere.center;
-  cam.up = up;
+  // Near a pole the up axis is (nearly) the view direction: the camera's up is then the direction
+  // of increasing elevation (at 90°, a plan view with -Z' up in the image for azimuth 0).
+  cam.up = std::abs(o.elevation_deg) < 89.99f
+               ? up
+               : up * std::cos(el) - (x_axis * std::sin(az) + z_axis * std::cos(az)) * std::sin(el);
   cam.fov_deg = o.fov_deg;
   cam.width = o.width;
   cam.height = o.height;
@@ -55,7 +59,11 @@ CameraFrame make_camera_frame(const Camera& c) {
     throw OptionError("image size " + std::to_string(c.width) + "x" + std::to_string(c.height) +
                       " is invalid; both sides must be positive");
   }
-  if (!(c.fov_deg > 0.0f && c.fov_deg < 180.0f)) {
+  if (!(c.ortho_height >= 0.0f) || !std::isfinite(c.ortho_height)) {
+    throw OptionError("orthographic view height " + std::to_string(c.ortho_height) +
+                      " is invalid; give a positive height in world units (or 0 for perspective)");
+  }
+  if (c.ortho_height == 0.0f && !(c.fov_deg > 0.0f && c.fov_deg < 180.0f)) {
     throw OptionError("field of view " + std::to_string(c.fov_deg) +
                       "° is out of range; use a value between 0 and 180 (exclusive)");
   }
@@ -74,6 +82,17 @@ CameraFrame make_camera_frame(const Camera& c) {
   f.up = cross(f.right, f.forward);
   f.width = c.width;
   f.height = c.height;
+  if (c.ortho_height > 0.0f) {
+    // Parallel side planes at half the view's width and height from the eye's axis.
+    f.ortho = true;
+    f.focal_px = static_cast<float>(c.height) / c.ortho_height;
+    const float half_h = 0.5f * c.ortho_height;
+    const float half_w = 0.5f * static_cast<float>(c.width) / f.focal_px;
+    const auto side = [&](Vec3f n, float half) { return Plane{n, half - dot(n, f.eye)}; };
+    f.planes = {side(f.right, half_w), side(-f.right, half_w), side(f.up, half_h),
+                side(-f.up, half_h)};
+    return f;
+  }
   const float tan_half_v = std::tan(deg_to_rad(c.fov_deg) * 0.5f);
   f.focal_px = (static_cast<float>(c.height) * 0.5f) / tan_half_v;
   const float tan_half_h = static_cast<float>(c.width) * 0.5f / f.focal_px;

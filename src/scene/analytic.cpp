@@ -259,7 +259,7 @@ RayCastImage ray_cast_image(const AnalyticScene& scene, const Camera& camera) {
   for (int y = 0; y < f.height; ++y) {
     for (int x = 0; x < f.width; ++x) {
       const Vec3f dir = pixel_ray(f, x, y);
-      if (auto hit = ray_cast(scene, f.eye, dir)) {
+      if (auto hit = ray_cast(scene, pixel_ray_origin(f, x, y), dir)) {
         const std::size_t i = std::size_t(y) * f.width + x;
         img.covered[i] = 1;
         img.depth[i] = hit->t * dot(dir, f.forward);

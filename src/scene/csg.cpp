@@ -449,7 +449,7 @@ CsgImage ray_cast_csg_image(const CsgScene& scene, const Camera& camera) {
   for (int y = 0; y < f.height; ++y) {
     for (int x = 0; x < f.width; ++x) {
       const Vec3f dir = pixel_ray(f, x, y);
-      if (auto hit = ray_cast_csg(scene, f.eye, dir)) {
+      if (auto hit = ray_cast_csg(scene, pixel_ray_origin(f, x, y), dir)) {
         const std::size_t i = static_cast<std::size_t>(y) * f.width + x;
         img.label[i] = hit->label;
         img.depth[i] = hit->t * dot(dir, f.forward);

@@ -36,6 +36,7 @@ void Navigator::set_from_camera(const Camera& c) {
   elevation_deg_ = rad_to_deg(std::asin(std::clamp(dot(d, up_), -1.0f, 1.0f)));
   azimuth_deg_ = rad_to_deg(std::atan2(dot(d, x_axis_), dot(d, z_axis_)));
   fov_deg_ = c.fov_deg;
+  ortho_height_ = c.ortho_height;
   width_ = c.width;
   height_ = c.height;
 }
@@ -56,7 +57,14 @@ Camera Navigator::camera() const {
   c.fov_deg = fov_deg_;
   c.width = width_;
   c.height = height_;
+  c.ortho_height = ortho_height_;
   return c;
+}
+
+void Navigator::toggle_ortho() {
+  ortho_height_ = ortho_height_ > 0
+                      ? 0.0f
+                      : 2.0f * distance_ * std::tan(0.5f * deg_to_rad(fov_deg_));
 }
 
 void Navigator::orbit(float dx_px, float dy_px) {
@@ -67,7 +75,7 @@ void Navigator::orbit(float dx_px, float dy_px) {
 
 void Navigator::pan(float dx_px, float dy_px) {
   const CameraFrame f = make_camera_frame(camera());
-  const float world_per_px = distance_ / f.focal_px;
+  const float world_per_px = (f.ortho ? 1.0f : distance_) / f.focal_px;
   pivot_ -= (f.right * dx_px - f.up * dy_px) * world_per_px;
 }
 
@@ -75,6 +83,7 @@ Vec3f Navigator::point_under(float x_px, float y_px, float depth) const {
   const CameraFrame f = make_camera_frame(camera());
   const float sx = (x_px - 0.5f * static_cast<float>(width_)) / f.focal_px;
   const float sy = (0.5f * static_cast<float>(height_) - y_px) / f.focal_px;
+  if (f.ortho) return f.eye + f.right * sx + f.up * sy + f.forward * depth;
   return f.eye + (f.forward + f.right * sx + f.up * sy) * depth;
 }
 
@@ -83,6 +92,15 @@ void Navigator::zoom(float clicks, float x_px, float y_px, std::optional<float> 
   const Vec3f p = point_under(x_px, y_px, z);
   float s = std::pow(kZoomPerClick, clicks);
   const float closest = sphere_.radius * 1e-6f;
+  if (ortho_height_ > 0) {
+    // Parallel rays: shrink the view about p's ray (p's lateral place stays under the cursor).
+    if (ortho_height_ * s < closest) s = closest / ortho_height_;
+    const Vec3f forward = -direction();
+    const Vec3f lateral = (pivot_ - p) - forward * dot(pivot_ - p, forward);
+    pivot_ = pivot_ - lateral + lateral * s;
+    ortho_height_ *= s;
+    return;
+  }
   if (distance_ * s < closest) s = closest / distance_;
   // Scaling the camera about p keeps the ray through p, so p stays under the cursor.
   pivot_ = p + (pivot_ - p) * s;

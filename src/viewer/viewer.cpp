@@ -78,6 +78,7 @@ std::string render_command_line(std::span<const std::string> base, const Camera&
   add("--target", vec3_text(c.target));
   add("--up", vec3_text(c.up));
   add("--fov", number_text(c.fov_deg));
+  if (c.ortho_height > 0) add("--ortho", number_text(c.ortho_height));
   if (f.rasterizer != Rasterizer::Fast) add("--mode", name(f.rasterizer));
   if (s.shape != SplatShape::Circle) add("--splat", name(s.shape));
   if (f.lod == LodScheme::Spt) {
@@ -107,6 +108,7 @@ std::string viewer_help() {
          "       m fast / quality mode; k splat kernel (square, circle, ellipse)\n"
          "       l QSplat / Sequential Point Tree; plus / minus splat size\n"
          "       e eye-dome lighting on / off; t two-sided lighting on / off\n"
+         "       o orthographic / perspective camera\n"
          "       f sharp features on / off; c occlusion culling (none / chc++)\n"
          "       s screenshot and its render command; h this help; q or Escape quit\n";
 }
@@ -201,9 +203,8 @@ ViewerResult run_viewer(Renderer& renderer, std::span<const SceneInstance> scene
     try {
       renderer.render(scene, navigator.camera(), s, f, pool, frame);
     } catch (const OptionError& error) {
-      if (!have_frame) throw;
-      st.refuse(error.what(), now_ms());
-      if (out) std::fprintf(stderr, "pointillist view: %s\n", error.what());
+      if (!st.refuse(error.what(), now_ms())) throw;
+      std::fprintf(stderr, "pointillist view: %s\n", error.what());
       continue;
     }
     const double t1 = now_ms();

@@ -117,9 +117,17 @@ void ViewerState::key(const std::string& k, double now_ms) {
     nav_.axis_view(static_cast<AxisView>(k[0] - '1'));
   } else if (k == "0" || k == "r") {
     nav_.reset();
+  } else if (k == "o") {
+    undo_settings_ = settings_;
+    undo_frame_ = frame_;
+    undo_ortho_ = nav_.ortho();
+    toggled_ = true;
+    nav_.toggle_ortho();
   } else {
     undo_settings_ = settings_;
     undo_frame_ = frame_;
+    undo_ortho_ = nav_.ortho();
+    toggled_ = true;
     if (k == "m") {
       frame_.rasterizer =
           frame_.rasterizer == Rasterizer::Fast ? Rasterizer::Quality : Rasterizer::Fast;
@@ -154,9 +162,12 @@ void ViewerState::key(const std::string& k, double now_ms) {
   changed(now_ms);
 }
 
-void ViewerState::refuse(const std::string& message, double now_ms) {
+bool ViewerState::refuse(const std::string& message, double now_ms) {
+  if (!toggled_) return false;
+  toggled_ = false;
   settings_ = undo_settings_;
   frame_ = undo_frame_;
+  if (nav_.ortho() != undo_ortho_) nav_.toggle_ortho();
   finest_ = initial_detail(options_.settings, options_.frame);
   if (frame_.lod != options_.frame.lod) {
     finest_ = frame_.lod == LodScheme::Spt ? options_.frame.epsilon_px
@@ -165,6 +176,7 @@ void ViewerState::refuse(const std::string& message, double now_ms) {
   message_ = "refused: " + message;
   message_until_ = now_ms + 5000;
   changed(now_ms);
+  return true;
 }
 
 std::optional<float> ViewerState::next_detail(const Renderer& renderer) {
@@ -202,6 +214,7 @@ void ViewerState::full_detail_reached(const Renderer& renderer, std::size_t page
 
 void ViewerState::frame_done(double frame_ms, const Renderer& renderer, std::size_t pages_handed) {
   input_ms_ = -1;
+  toggled_ = false;  // drawn: nothing to undo
   last_handed_ = pages_handed;
   recent_ms_.push_back(frame_ms);
   if (recent_ms_.size() > kFpsFrames) recent_ms_.erase(recent_ms_.begin());
@@ -261,6 +274,7 @@ std::string ViewerState::title(const Renderer& renderer, double now_ms,
   }
   if (settings_.edl_strength > 0) t += " edl";
   if (settings_.two_sided) t += " two-sided";
+  if (nav_.ortho()) t += " ortho";
   if (frame_.occlusion.method != OcclusionMethod::None) t += " culling";
   if (!frame_.features) t += " no-features";
   t += dot;

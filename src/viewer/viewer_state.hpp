@@ -25,8 +25,9 @@ class ViewerState {
   std::optional<float> next_detail(const Renderer& renderer);
   // After a frame: its time (render and present) and the pages handed to the loader after it.
   void frame_done(double frame_ms, const Renderer& renderer, std::size_t pages_handed);
-  // The last toggle could not be drawn: undo it and show why.
-  void refuse(const std::string& message, double now_ms);
+  // The frame could not be drawn: undo the toggle since the last frame and show why; false when
+  // there was no toggle to undo (the models cannot be drawn at all).
+  bool refuse(const std::string& message, double now_ms);
 
   const RenderSettings& settings() const { return settings_; }
   const FrameSettings& frame_settings() const { return frame_; }
@@ -52,6 +53,8 @@ class ViewerState {
   FrameSettings frame_;
   RenderSettings undo_settings_;
   FrameSettings undo_frame_;
+  bool undo_ortho_ = false;
+  bool toggled_ = false;  // a toggle since the last frame drawn
   float finest_;
   FrameTimeController control_;
   Phase phase_ = Phase::Moving;

@@ -123,7 +123,7 @@ TEST(Cli, MissingInputAndBadOptionsFailCleanly) {
   pointillist::testing::TempDir dir;
   const auto in = dir.file("in.ply");
   ASSERT_EQ(run("generate --points 100 -o " + in).exit_code, 0);
-  const Result r = run("render " + in + " -o " + dir.file("x.png") + " --view 10,90");
+  const Result r = run("render " + in + " -o " + dir.file("x.png") + " --view 10,91");
   EXPECT_NE(r.exit_code, 0);
   EXPECT_THAT(r.output, HasSubstr("elevation"));
   const Result s = run("render " + in + " -o " + dir.file("x.png") + " --size 12by4");

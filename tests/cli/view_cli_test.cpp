@@ -76,15 +76,17 @@ TEST(ViewCli, ScreenshotsEqualThePrintedRenderCommandAndDragsTurnTheModel) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   r = run_cli("convert " + dir.file("demo.ply") + " -o " + dir.file("demo.ptl") + " --quiet");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const std::string a = dir.file("a.png"), b = dir.file("b.png"), c = dir.file("c.png");
+  const std::string a = dir.file("a.png"), b = dir.file("b.png"), c = dir.file("c.png"),
+                    d = dir.file("d.png");
   write_text_file(dir.file("s.events"),
                   "settle\nscreenshot " + a + "\ndrag left 300 240 380 240 8\nsettle\n"
                   "screenshot " + b + "\nkey m\nkey k\nwheel 200 200 2\nsettle\nscreenshot " +
-                      c + "\nquit\n");
+                      c + "\nkey m\nkey o\nkey e\nkey t\nwheel 320 240 1\nsettle\nscreenshot " + d +
+                      "\nquit\n");
   r = run_shell(viewer(dir.file("demo.ptl") + " --size 640x480 --events " + dir.file("s.events") +
                        " --log-frames " + dir.file("frames.csv")));
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  for (const std::string& shot : {a, b, c}) {
+  for (const std::string& shot : {a, b, c, d}) {
     std::string command = printed_command(r.output, shot);
     ASSERT_FALSE(command.empty()) << r.output;
     ASSERT_EQ(command.rfind("pointillist render ", 0), 0u) << command;
@@ -95,6 +97,8 @@ TEST(ViewCli, ScreenshotsEqualThePrintedRenderCommandAndDragsTurnTheModel) {
     EXPECT_EQ(bytes(shot), bytes(out)) << shot << " differs from " << command;
   }
   EXPECT_THAT(printed_command(r.output, c), HasSubstr("--mode quality --splat ellipse"));
+  EXPECT_THAT(printed_command(r.output, d), HasSubstr("--ortho "));
+  EXPECT_THAT(printed_command(r.output, d), HasSubstr("--splat ellipse --edl 1 --two-sided"));
   // Dragging right turns the model right: the eye moves to the camera's left.
   const std::string ca = printed_command(r.output, a), cb = printed_command(r.output, b);
   const Vec3f eye_a = option_vec3(ca, "--eye"), target = option_vec3(ca, "--target");
@@ -116,6 +120,15 @@ TEST(ViewCli, BadModelAndMissingDisplayEndWithAMessage) {
                 std::string(POINTILLIST_CLI_PATH) + " view " + dir.file("s.ply") + " --quiet");
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_THAT(r.output, HasSubstr("the viewer needs a display"));
+  r = run_cli("render " + dir.file("s.ply") + " --ortho -2 -o " + dir.file("x.png"));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("--ortho"));
+  r = run_cli("render " + dir.file("s.ply") + " --ortho 2 --mode quality -o " + dir.file("x.png"));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("drop --mode quality, or --ortho"));
+  r = run_cli("render " + dir.file("s.ply") + " --ortho 2.5 --view 0,90 --edl -q -o " +
+              dir.file("plan.png"));
+  EXPECT_EQ(r.exit_code, 0) << r.output;
   r = run_cli("view " + dir.file("s.ply") + " --events " + dir.file("s.ply"));
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_THAT(r.output, HasSubstr("s.ply:1: unknown event"));

@@ -55,7 +55,16 @@ TEST(Camera, OrbitPlacesTheEyeAsTheArchitectureSays) {
   EXPECT_NEAR(c.eye.z, 3, 1e-5f);
   const Camera d = orbit_camera(vs, {.fov_deg = 30});
   EXPECT_NEAR(length(d.eye - vs.center), 2.0f * 1.05f / std::sin(deg_to_rad(15)), 1e-4f);
-  EXPECT_THROW(orbit_camera(vs, {.elevation_deg = 90}), OptionError);
+  EXPECT_THROW(orbit_camera(vs, {.elevation_deg = 90.5f}), OptionError);
+  // The poles are plan views: the eye straight above (below) the centre, -Z' up in the image.
+  const Camera top = orbit_camera(vs, {.elevation_deg = 90, .distance = 3});
+  EXPECT_NEAR(top.eye.x, 1, 1e-5f);
+  EXPECT_NEAR(top.eye.y, 2 + 6, 1e-5f);
+  EXPECT_NEAR(top.eye.z, 3, 1e-5f);
+  const CameraFrame f = make_camera_frame(top);
+  EXPECT_NEAR(f.up.z, -1, 1e-5f);
+  EXPECT_NEAR(f.right.x, 1, 1e-5f);
+  EXPECT_NO_THROW(make_camera_frame(orbit_camera(vs, {.azimuth_deg = 30, .elevation_deg = -90})));
 }
 
 TEST(Camera, OrbitAroundAZUpAxisKeepsZUpAndMeasuresElevationFromTheXYPlane) {

@@ -147,3 +147,36 @@ TEST(Navigator, PickedPointBecomesThePivotWithTheEyeInPlace) {
   EXPECT_NEAR(at.x, 400, 1e-2);
   EXPECT_NEAR(at.y, 300, 1e-2);
 }
+
+TEST(Navigator, OrthographicZoomAndPanKeepThePointUnderTheCursor) {
+  Navigator nav = front_navigator();
+  nav.toggle_ortho();
+  ASSERT_TRUE(nav.ortho());
+  // The same scale at the pivot: its plane's points stay where they were.
+  const Camera persp_home = orbit_camera(kSphere, {.width = 800, .height = 600});
+  const Vec3f on_pivot_plane = kSphere.center + Vec3f{0.5f, -0.3f, 0};
+  const Pixel before_toggle = project(persp_home, on_pivot_plane);
+  const auto ortho_project = [](const Camera& c, Vec3f p) {
+    const CameraFrame f = make_camera_frame(c);
+    EXPECT_TRUE(f.ortho);
+    const Vec3f d = p - f.eye;
+    return Pixel{400 + f.focal_px * dot(d, f.right), 300 - f.focal_px * dot(d, f.up)};
+  };
+  const Pixel after_toggle = ortho_project(nav.camera(), on_pivot_plane);
+  EXPECT_NEAR(after_toggle.x, before_toggle.x, 1e-2);
+  EXPECT_NEAR(after_toggle.y, before_toggle.y, 1e-2);
+  const float height = nav.camera().ortho_height;
+  const Vec3f p = kSphere.center + Vec3f{0.7f, 0.4f, 0.2f};
+  const Pixel at = ortho_project(nav.camera(), p);
+  nav.zoom(3, at.x, at.y, 1.0f);
+  const Pixel zoomed = ortho_project(nav.camera(), p);
+  EXPECT_NEAR(zoomed.x, at.x, 2e-3);
+  EXPECT_NEAR(zoomed.y, at.y, 2e-3);
+  EXPECT_NEAR(nav.camera().ortho_height, height * 0.512f, 1e-5);
+  nav.pan(-30, 12);
+  const Pixel panned = ortho_project(nav.camera(), p);
+  EXPECT_NEAR(panned.x, at.x - 30, 1e-2);
+  EXPECT_NEAR(panned.y, at.y + 12, 1e-2);
+  nav.toggle_ortho();
+  EXPECT_FALSE(nav.ortho());
+}

@@ -13,9 +13,12 @@ struct Camera {
   Vec3f eye{0, 0, 1};
   Vec3f target{0, 0, 0};
   Vec3f up{0, 1, 0};
-  float fov_deg = 30.0f;  // vertical field of view
+  float fov_deg = 30.0f;  // vertical field of view (perspective)
   int width = 1024;       // image size in pixels
   int height = 768;
+  // > 0: an orthographic camera showing this height of the world (world units) from top to
+  // bottom of the image, along parallel rays; fov_deg is then unused. 0: perspective.
+  float ortho_height = 0.0f;
 };
 
 // An orbit around a model's view sphere (centre c, radius R = largest distance from c to a
@@ -34,8 +37,9 @@ struct OrbitOptions {
   Vec3f up = {0.0f, 1.0f, 0.0f};
 };
 
-// Throws OptionError when the elevation is ±90° (the up vector is then undefined), `up` is zero
-// or not finite, or the size/fov/distance is out of range.
+// Elevations of ±90° are plan views from above (below): the camera's up is then the direction of
+// increasing elevation (−Z' for azimuth 0). Throws OptionError when the elevation is beyond ±90°,
+// `up` is zero or not finite, or the size/fov/distance is out of range.
 Camera orbit_camera(const Sphere& view_sphere, const OrbitOptions& options);
 
 // A plane n·p + d = 0 with unit normal n; signed distance n·p + d, positive inside.
@@ -53,23 +57,42 @@ struct CameraFrame {
   Vec3f right;    // +x on screen
   Vec3f up;       // +y on screen (rows go down, so pixel y decreases along it)
   Vec3f forward;  // viewing direction (= -Z of the camera); depth = dot(p - eye, forward)
-  float focal_px = 1;  // f = (H/2) / tan(fov/2)
+  // Perspective: f = (H/2) / tan(fov/2), a point at eye-space (x, y, z) is at pixel
+  // (W/2 + f·x/z, H/2 − f·y/z). Orthographic: f = H / ortho_height (pixels per world unit), and
+  // the pixel is (W/2 + f·x, H/2 − f·y).
+  float focal_px = 1;
+  bool ortho = false;
   int width = 1, height = 1;
   std::array<Plane, 4> planes;  // left, right, bottom, top; normals point into the frustum
 
   // Depth (eye-space distance along the view direction; positive in front).
   float depth(Vec3f p) const { return dot(p - eye, forward); }
+  // What eye-space x and y are multiplied by, with focal_px, to give pixels at depth z: 1/z in
+  // perspective, 1 orthographic.
+  float projection(float z) const { return ortho ? 1.0f : 1.0f / z; }
+  // Unit vector from p towards the eye (the viewing rays' reverse).
+  Vec3f to_eye(Vec3f p) const { return ortho ? -forward : normalized(eye - p); }
 };
 
-// Unit direction (world) of the ray from the eye through the centre of pixel (x, y).
+// Unit direction (world) of the ray through the centre of pixel (x, y): from the eye in
+// perspective; along the view direction, from pixel_ray_origin, orthographic.
 inline Vec3f pixel_ray(const CameraFrame& f, int x, int y) {
+  if (f.ortho) return f.forward;
   const float sx = (static_cast<float>(x) + 0.5f - static_cast<float>(f.width) * 0.5f) / f.focal_px;
   const float sy = (static_cast<float>(f.height) * 0.5f - (static_cast<float>(y) + 0.5f)) / f.focal_px;
   return normalized(f.forward + f.right * sx + f.up * sy);
 }
+// Where the ray of pixel (x, y) starts: the eye in perspective, the pixel's place on the plane
+// through the eye orthographic.
+inline Vec3f pixel_ray_origin(const CameraFrame& f, int x, int y) {
+  if (!f.ortho) return f.eye;
+  const float sx = (static_cast<float>(x) + 0.5f - static_cast<float>(f.width) * 0.5f) / f.focal_px;
+  const float sy = (static_cast<float>(f.height) * 0.5f - (static_cast<float>(y) + 0.5f)) / f.focal_px;
+  return f.eye + f.right * sx + f.up * sy;
+}
 
 // Throws OptionError when eye == target, up is parallel to the view direction, fov is not in
-// (0, 180) or the size is not positive.
+// (0, 180) (perspective), ortho_height is negative or not finite, or the size is not positive.
 CameraFrame make_camera_frame(const Camera& camera);
 
 }  // namespace pointillist

@@ -46,11 +46,16 @@ class Navigator {
   // Wheel: `clicks` > 0 zooms in. The point under the cursor at (x, y) stays under the cursor:
   // at `depth` (its depth along the view direction, from the depth buffer) when given, else at
   // the pivot's depth. The camera never comes closer than a millionth of the view radius.
+  // Orthographic: the view height shrinks instead, about the point under the cursor.
   void zoom(float clicks, float x_px, float y_px, std::optional<float> depth = std::nullopt);
   // Makes the point seen at pixel (x, y) at `depth` the pivot; the eye stays where it is.
   void pick_pivot(float x_px, float y_px, float depth);
   void axis_view(AxisView view);
   void reset();
+  // Switches between perspective and an orthographic camera that shows the pivot's plane at
+  // the same scale (height 2·distance·tan(fov/2)).
+  void toggle_ortho();
+  bool ortho() const { return ortho_height_ > 0; }
   void resize(int width, int height);
 
  private:
@@ -63,6 +68,7 @@ class Navigator {
   Vec3f pivot_{0, 0, 0};
   float distance_ = 1, azimuth_deg_ = 0, elevation_deg_ = 0;
   float fov_deg_ = 30;
+  float ortho_height_ = 0;  // > 0: orthographic (Camera::ortho_height)
   int width_ = 1, height_ = 1;
 };
 

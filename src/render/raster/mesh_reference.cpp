@@ -22,6 +22,8 @@ struct EyeVertex {
   Vec3f color;   // linear 0..1
 };
 
+// Perspective: 1/z and the attributes over z interpolate linearly on the screen. Orthographic:
+// z and the attributes themselves do (inv_z then holds z, and "over z" means over 1).
 struct ScreenVertex {
   double x, y;    // pixels
   double inv_z;
@@ -52,6 +54,10 @@ struct Raster {
   Frame& frame;
 
   ScreenVertex project(const EyeVertex& v) const {
+    if (cam.ortho) {
+      return {0.5 * cam.width + cam.focal_px * double(v.p.x),
+              0.5 * cam.height - cam.focal_px * double(v.p.y), double(v.p.z), v.normal, v.color};
+    }
     const double inv_z = 1.0 / static_cast<double>(v.p.z);
     const float fz = static_cast<float>(inv_z);
     return {0.5 * cam.width + cam.focal_px * v.p.x * inv_z,
@@ -96,17 +102,21 @@ struct Raster {
         if (!inside) continue;
         const double wa = e_bc / area, wb = e_ca / area, wc = e_ab / area;
         const double inv_z = wa * a.inv_z + wb * b.inv_z + wc * c.inv_z;
-        const float z = static_cast<float>(1.0 / inv_z);
+        const float z = static_cast<float>(cam.ortho ? inv_z : 1.0 / inv_z);
+        const float attribute_scale = cam.ortho ? 1.0f : z;
         const std::size_t idx = static_cast<std::size_t>(j) * cam.width + i;
         if (!(z < frame.depth[idx])) continue;
         const float fa = static_cast<float>(wa), fb = static_cast<float>(wb),
                     fc = static_cast<float>(wc);
-        const Vec3f n =
-            (a.normal_over_z * fa + b.normal_over_z * fb + c.normal_over_z * fc) * z;
-        const Vec3f base = (a.color_over_z * fa + b.color_over_z * fb + c.color_over_z * fc) * z;
+        const Vec3f n = (a.normal_over_z * fa + b.normal_over_z * fb + c.normal_over_z * fc) *
+                        attribute_scale;
+        const Vec3f base = (a.color_over_z * fa + b.color_over_z * fb + c.color_over_z * fc) *
+                           attribute_scale;
         // Direction to the eye from the surface point seen through the pixel centre.
-        const Vec3f ray = cam.forward + cam.right * ((static_cast<float>(px) - half_w) / cam.focal_px) -
-                          cam.up * ((static_cast<float>(py) - half_h) / cam.focal_px);
+        const Vec3f ray =
+            cam.ortho ? cam.forward
+                      : cam.forward + cam.right * ((static_cast<float>(px) - half_w) / cam.focal_px) -
+                            cam.up * ((static_cast<float>(py) - half_h) / cam.focal_px);
         frame.depth[idx] = z;
         frame.color[idx] = shader.shade(normalized(n, -ray), -ray / length(ray), base);
       }

@@ -51,8 +51,10 @@ inline void prepare_ellipses(const SplatChunk& chunk, const CameraFrame& cam, Ra
   for (std::size_t i = 0; i < n; ++i) {
     const Vec3f nw = chunk.normal[i];
     const Vec3f ne{dot(nw, right), dot(nw, up), dot(nw, back)};
-    // Unit vector to the eye in eye space: −(x_e/z, y_e/z, −1), normalized.
-    const float a = (chunk.x_px[i] - half_w) * inv_f, b = (chunk.y_px[i] - half_h) * inv_f;
+    // Unit vector to the eye in eye space: −(x_e/z, y_e/z, −1), normalized; (0, 0, 1) for
+    // parallel rays.
+    const float a = cam.ortho ? 0.0f : (chunk.x_px[i] - half_w) * inv_f;
+    const float b = cam.ortho ? 0.0f : (chunk.y_px[i] - half_h) * inv_f;
     const float inv_len = 1.0f / std::sqrt(a * a + b * b + 1.0f);
     ellipse_parameters(ne, Vec3f{-a * inv_len, b * inv_len, inv_len},
                        &out.ellipse[kEllipseStride * i]);

@@ -99,6 +99,7 @@ struct NoClip {
 struct PixelClip {
   float cx, cy, cz, nx, ny, nz, nc;  // centre and normal, eye coordinates; n·c
   float half_w, half_h, inv_f;
+  bool ortho;  // parallel rays along +z from (a, b, 0)
   const float* planes;
   std::uint32_t count;
   ClipMode mode;
@@ -109,6 +110,14 @@ struct PixelClip {
   Int4 operator()(Float4 px, float py) const {
     const Float4 a = (px - half_w) * inv_f;
     const float b = (half_h - py) * inv_f;
+    if (ortho) {  // the pixel's ray meets the splat's plane at depth (n·c − nx·a − ny·b) / nz
+      const Float4 z = (nc - nx * a - ny * b) / nz;
+      const Int4 valid = (z > splat4(0.0f)) & (z < splat4(std::numeric_limits<float>::infinity())) &
+                         (z > splat4(-std::numeric_limits<float>::infinity()));
+      return render_detail::clip_discard4(planes, count, mode, select4(valid, a, splat4(cx)),
+                                          select4(valid, splat4(b), splat4(cy)),
+                                          select4(valid, z, splat4(cz)));
+    }
     const Float4 t = nc / (nx * a + (ny * b + nz));
     const Int4 valid = (t > splat4(0.0f)) & (t < splat4(std::numeric_limits<float>::infinity()));
     return render_detail::clip_discard4(planes, count, mode, select4(valid, t * a, splat4(cx)),
@@ -361,7 +370,7 @@ inline void draw_one(const Target& t, const SplatChunk& s, const RasterScratch::
       const Vec3f ce{dot(d, cam.right), dot(d, cam.up), dot(d, cam.forward)};
       const Vec3f ne{dot(n, cam.right), dot(n, cam.up), dot(n, cam.forward)};
       const PixelClip clip{ce.x, ce.y, ce.z, ne.x, ne.y, ne.z, dot(ne, ce),
-                           0.5f * t.width_f, 0.5f * t.height_f, 1.0f / cam.focal_px,
+                           0.5f * t.width_f, 0.5f * t.height_f, 1.0f / cam.focal_px, cam.ortho,
                            sc.planes.data() + 4 * static_cast<std::size_t>(s.clip_first[i]),
                            clip_count(code), clip_mode(code), t.clipped};
       draw_shape<kShape>(t, s, sc, i, clip);

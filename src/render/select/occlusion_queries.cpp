@@ -120,6 +120,11 @@ bool bound_may_be_visible(const DepthPyramid& pyramid, const CameraFrame& camera
   const double den = cz * cz - rf * rf;
   const double f = camera.focal_px;
   const auto range = [&](double c, double& lo, double& hi) {
+    if (camera.ortho) {  // parallel rays: the sphere's shadow on the image is c ± r
+      lo = c - rf;
+      hi = c + rf;
+      return;
+    }
     const double s = rf * std::sqrt(std::max(0.0, c * c + den));
     lo = (c * cz - s) / den;
     hi = (c * cz + s) / den;

@@ -92,7 +92,8 @@ void walk_subtree(const Access& access, const typename Access::Item& start,
         if constexpr (Access::kPaged) {
           if (!c.resident) {
             emit(n, access.page(p), access.index(p), d, z, true);
-            out.requests.push_back({c.page, access.page(p), z > 0 ? n.radius / z : 0.0f});
+            out.requests.push_back(
+                {c.page, access.page(p), z > 0 ? n.radius * (v.ortho ? 1.0f : 1.0f / z) : 0.0f});
             break;
           }
           if (c.page != access.page(p)) out.touched.push_back(c.page);

@@ -33,8 +33,9 @@ struct Block {
 struct ViewConstants {
   Vec3f eye, right, up, forward;
   float focal_px, half_w, half_h, width, height;
-  float epsilon2;      // (epsilon_px / f)²: compared with error² / r²
+  float epsilon2;      // (epsilon_px / f)²: compared with error² / r² (orthographic: r = 1)
   float facing_limit;  // 0 with backface culling (drop (c − eye)·n > 0), else +infinity
+  bool ortho;          // orthographic: parallel rays along forward
 };
 
 // Entry i of [begin, end) is selected (mask 1) iff error² ≤ r²ε² < parent_error² and it faces the
@@ -55,6 +56,16 @@ void select_mask(const SequentialPointTree& t, std::uint32_t begin, std::uint32_
   const float ex = v.eye.x, ey = v.eye.y, ez = v.eye.z, eps2 = v.epsilon2;
   const float facing_limit = v.facing_limit;
   const std::uint32_t n = end - begin;
+  if (v.ortho) {
+    // Every entry is seen at the same scale and from the same direction.
+    const float fx = v.forward.x, fy = v.forward.y, fz = v.forward.z;
+    for (std::uint32_t i = 0; i < n; ++i) {
+      const float facing = fx * nx[i] + fy * ny[i] + fz * nz[i];
+      const int in = (err[i] * err[i] <= eps2) & (eps2 < perr[i] * perr[i]);
+      mask[i] = static_cast<std::uint8_t>(in + (in & (facing > facing_limit)));
+    }
+    return;
+  }
   for (std::uint32_t i = 0; i < n; ++i) {
     const float dx = cx[i] - ex, dy = cy[i] - ey, dz = cz[i] - ez;
     const float re2 = (dx * dx + dy * dy + dz * dz) * eps2;
@@ -125,7 +136,7 @@ void run_block(const SequentialPointTree& t, Block b, const ViewConstants& v,
       const Float4 dy = Float4{cy[idx[0]], cy[idx[1]], cy[idx[2]], cy[idx[3]]} - v.eye.y;
       const Float4 dz = Float4{cz[idx[0]], cz[idx[1]], cz[idx[2]], cz[idx[3]]} - v.eye.z;
       const Float4 z = dx * v.forward.x + dy * v.forward.y + dz * v.forward.z;
-      const Float4 inv_z = 1.0f / render_detail::max4(splat4(1e-30f), z);
+      const Float4 inv_z = v.ortho ? splat4(1.0f) : 1.0f / render_detail::max4(splat4(1e-30f), z);
       const Float4 x = v.half_w + v.focal_px * (dx * v.right.x + dy * v.right.y + dz * v.right.z) * inv_z;
       const Float4 y = v.half_h - v.focal_px * (dx * v.up.x + dy * v.up.y + dz * v.up.z) * inv_z;
       const Float4 diameter{t.diameter[idx[0]], t.diameter[idx[1]], t.diameter[idx[2]],
@@ -143,9 +154,12 @@ void run_block(const SequentialPointTree& t, Block b, const ViewConstants& v,
       // Shading (as the QSplat traversal's finish_chunk): normal, unit vector to the eye, base.
       const Float4 inv_len = 1.0f / render_detail::sqrt4(
           render_detail::max4(splat4(1e-30f), dx * dx + dy * dy + dz * dz));
-      to_eye[0] = -dx * inv_len;
-      to_eye[1] = -dy * inv_len;
-      to_eye[2] = -dz * inv_len;
+      for (int c = 0; c < 3; ++c) to_eye[c] = splat4(-v.forward[c]);
+      if (!v.ortho) {
+        to_eye[0] = -dx * inv_len;
+        to_eye[1] = -dy * inv_len;
+        to_eye[2] = -dz * inv_len;
+      }
       if (with_colors) {
         constexpr float kScale = 1.0f / 255.0f;
         const Rgb8* col = t.colors.data();
@@ -199,6 +213,7 @@ ViewConstants spt_view(const CameraFrame& camera, const RenderSettings& settings
   v.height = static_cast<float>(camera.height);
   const float epsilon = epsilon_px / camera.focal_px;  // world error per unit distance
   v.epsilon2 = epsilon * epsilon;
+  v.ortho = camera.ortho;
   v.facing_limit = settings.culls_backfaces() ? 0.0f : std::numeric_limits<float>::infinity();
   return v;
 }
@@ -209,7 +224,9 @@ void range_blocks(const SequentialPointTree& tree, std::uint32_t begin, std::uin
                   const Sphere& bounds, const CameraFrame& camera, float epsilon_px,
                   std::vector<Block>& blocks) {
   const float epsilon = epsilon_px / camera.focal_px;
-  const float r_lo = std::max(0.0f, distance(bounds.center, camera.eye) - bounds.radius);
+  // Orthographic: every entry is seen at distance 1 (ε is then in world units).
+  const float r_lo = camera.ortho ? 1.0f
+                                  : std::max(0.0f, distance(bounds.center, camera.eye) - bounds.radius);
   const std::uint32_t stop = prefix_end(tree, begin, end, r_lo * epsilon);
   for (std::uint32_t b = begin; b < stop; b += kBlock) {
     blocks.push_back({b, std::min(stop, b + kBlock)});

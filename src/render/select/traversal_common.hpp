@@ -47,7 +47,7 @@ inline std::uint64_t expected_splats(std::uint64_t leaves, const CameraFrame& ca
   if (bound) {
     const float z = dot(bound->center - camera.eye, camera.forward) - bound->radius;
     if (z > 0) {
-      const double rho = double(bound->radius) * camera.focal_px / z;  // pixels, at least
+      const double rho = double(bound->radius) * camera.focal_px * camera.projection(z);  // px
       const double t = std::max(0.25, double(threshold_px));
       const double covered = 4.0 * 3.14159265 * (rho + 1) * (rho + 1) / (t * t);
       if (covered < double(expected)) expected = static_cast<std::uint64_t>(covered) + 1;
@@ -72,8 +72,9 @@ struct ViewConstants {
   Vec3f base_color;
   Vec3f eye, right, up, forward;
   float focal_px, half_w, half_h;
-  float size_per_radius;  // 2·f: projected diameter = r · size_per_radius / z
+  float size_per_radius;  // 2·f: projected diameter = r · size_per_radius / z (orthographic: · 1)
   float threshold_px;
+  bool ortho;             // orthographic camera (CameraFrame::ortho)
   std::array<Plane, 4> planes;
   bool with_discs;  // finish_chunk writes the discs (SplatStream::with_discs)
   bool cull_facing;  // splats facing away are dropped (not with two-sided lighting)
@@ -105,7 +106,16 @@ inline Decision visit(const SphereNode& n, const ViewConstants& v, std::uint8_t&
     }
     if (inside) tests &= static_cast<std::uint8_t>(~kTestFrustum);
   }
-  if ((tests & kTestBackface) && n.cone_sin < 1.0f) {
+  if ((tests & kTestBackface) && n.cone_sin < 1.0f && v.ortho) {
+    // Parallel rays: every normal of the cone faces away when n·forward > sin(cone), every one
+    // faces the eye when −n·forward > sin(cone).
+    const float k = -dot(v.forward, n.normal);
+    if (k < -n.cone_sin) {
+      ++counters.culled_backface;
+      return Decision::Cull;
+    }
+    if (k > n.cone_sin) tests &= static_cast<std::uint8_t>(~kTestBackface);
+  } else if ((tests & kTestBackface) && n.cone_sin < 1.0f) {
     const float k = -dot(d, n.normal);
     // Only a sphere entirely on one side of its normal's plane can pass either test.
     if (k + r < 0.0f || k - r > 0.0f) {
@@ -117,7 +127,8 @@ inline Decision visit(const SphereNode& n, const ViewConstants& v, std::uint8_t&
       if (k - r > bound) tests &= static_cast<std::uint8_t>(~kTestBackface);
     }
   }
-  if (n.child_count == 0 || (z > 0 && r * v.size_per_radius <= v.threshold_px * z)) {
+  if (n.child_count == 0 ||
+      (z > 0 && r * v.size_per_radius <= v.threshold_px * (v.ortho ? 1.0f : z))) {
     return Decision::Draw;
   }
   return Decision::Refine;
@@ -145,11 +156,12 @@ class Emitter {
       ++counters.culled_frustum;
       return;
     }
-    if (check_facing && v.cull_facing && n.cone_sin < 1.0f && dot(d, n.normal) > 0) {
+    if (check_facing && v.cull_facing && n.cone_sin < 1.0f &&
+        dot(v.ortho ? v.forward : d, n.normal) > 0) {
       ++counters.culled_backface;
       return;
     }
-    const float inv_z = 1.0f / z;
+    const float inv_z = v.ortho ? 1.0f : 1.0f / z;
     const float x = v.half_w + v.focal_px * dot(d, v.right) * inv_z;
     const float y = v.half_h - v.focal_px * dot(d, v.up) * inv_z;
     const float size = n.radius * v.size_per_radius * inv_z;
@@ -221,9 +233,13 @@ void finish_chunk(const NodeAt& node_at, const ViewConstants& v, bool with_color
       to_eye[c] = v.eye[c] - Float4{n[0]->center[c], n[1]->center[c], n[2]->center[c],
                                     n[3]->center[c]};
     }
-    const Float4 inv_len = 1.0f / render_detail::sqrt4(
-        to_eye[0] * to_eye[0] + to_eye[1] * to_eye[1] + to_eye[2] * to_eye[2]);
-    for (Float4& t : to_eye) t *= inv_len;
+    if (v.ortho) {
+      for (int c = 0; c < 3; ++c) to_eye[c] = splat4(-v.forward[c]);
+    } else {
+      const Float4 inv_len = 1.0f / render_detail::sqrt4(
+          to_eye[0] * to_eye[0] + to_eye[1] * to_eye[1] + to_eye[2] * to_eye[2]);
+      for (Float4& t : to_eye) t *= inv_len;
+    }
     if (with_colors) {
       constexpr float kScale = 1.0f / 255.0f;
       base[0] = Float4{float(n[0]->color.r), float(n[1]->color.r), float(n[2]->color.r),
@@ -266,6 +282,7 @@ inline ViewConstants make_view_constants(const Shader& shader, const CameraFrame
   v.planes = camera.planes;
   v.with_discs = with_discs;
   v.cull_facing = !settings.two_sided;
+  v.ortho = camera.ortho;
   return v;
 }
 
