@@ -8,11 +8,11 @@
 #     frames whose frame_ms is within ±20% of the target 1000/fps ms, or at full detail,
 #     detail_px <= 1, and faster than the target), median and p90 of frame_ms, mean detail_px;
 #     then the refine frames after the last moving frame and the time from it to the last frame.
-#     The dragon, the big model held whole, and the big model paged (--memory).
+#     The dragon, the big model held whole (--whole), and the big model paged (--memory).
 #  2. Launch: script `settle` then `quit`. Time from the program's start to the first frame
 #     (frame 0's t_ms: opening the model and the window included) and to full detail (the last
 #     frame's t_ms), for the big model paged (--memory 2G, pages streamed on the loader thread)
-#     and held whole; frames drawn, pages loaded and peak resident memory.
+#     and held whole (--whole); frames drawn, pages loaded and peak resident memory.
 #  3. Input-to-frame latency: mean and p95 of latency_ms over the moving frames that answered an
 #     input event (latency_ms >= 0) of the orbit runs.
 #
@@ -186,10 +186,10 @@ launch_row() {
 }
 
 view orbit-dragon orbit.events "$dragon"
-view orbit-big orbit.events "$big"
+view orbit-big orbit.events "$big" --whole
 view orbit-big-paged orbit.events "$big" --memory "$memory"
 view launch-big-paged launch.events "$big" --memory "$memory"
-view launch-big-whole launch.events "$big"
+view launch-big-whole launch.events "$big" --whole
 
 echo "## pointillist view at $size, target $(awk -v t="$target" 'BEGIN { printf "%.1f", t }') ms per frame (--fps $fps)"
 echo

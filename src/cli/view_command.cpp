@@ -29,6 +29,7 @@ struct ViewCommandOptions {
   double fps = 30;
   unsigned refine = 8;
   bool features = false, no_features = false;
+  bool whole = false;  // --whole: decode every .ptl whole
   PrepareOptions prepare;
   std::string columns;
   unsigned threads = 0;
@@ -93,7 +94,8 @@ int run_view(const CLI::App& cmd, ViewCommandOptions& o) {
   for (const std::string& in : o.inputs) {
     large = large || (is_model_file(in) && std::filesystem::file_size(in, ec) > kPagedViewBytes);
   }
-  open.frames = large ? 1 : 1000;
+  open.frames = large && !o.whole ? 1 : 1000;
+  if (o.whole && memory_cap == 0) open.paging = Paging::Never;
   open.frame_pixels = std::uint64_t(o.view.width) * std::uint64_t(o.view.height);
   if (o.features) {
     open.features = FeatureOptions{};
@@ -199,6 +201,10 @@ Command add_view_command(CLI::App& app) {
                             "Occlusion culling to start with (key c switches); models held whole",
                             "none")
       ->group(kGroupDetail);
+  cmd->add_flag("--whole", o->whole,
+                 "Decode every model whole, also .ptl files over 32 MiB (viewed page by page "
+                 "otherwise): slower to open, and SPT and occlusion culling can be switched on")
+      ->group(kGroupPaging);
   cmd->add_option("--memory", o->memory,
                   "Draw page by page keeping at most this much of the models in memory (e.g. "
                   "512M); pages stream in on a loader thread while frames keep coming")
