@@ -76,13 +76,7 @@ void Renderer::render(std::span<const SceneInstance> scene, const Camera& camera
                         "a transform");
     }
   }
-  if (fs.rasterizer == Rasterizer::Quality) {
-    validate_quality_settings(fs.quality);
-    if (camera.ortho_height > 0.0f) {
-      throw OptionError("--ortho draws with the fast and reference modes so far; drop --mode "
-                        "quality, or --ortho");
-    }
-  }
+  if (fs.rasterizer == Rasterizer::Quality) validate_quality_settings(fs.quality);
   if (!(fs.splat_scale > 0.0f) || !std::isfinite(fs.splat_scale)) {
     throw OptionError("splat scale " + std::to_string(fs.splat_scale) +
                       " is invalid; give a positive number (1 draws splats at their size)");

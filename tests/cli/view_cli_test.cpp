@@ -81,7 +81,7 @@ TEST(ViewCli, ScreenshotsEqualThePrintedRenderCommandAndDragsTurnTheModel) {
   write_text_file(dir.file("s.events"),
                   "settle\nscreenshot " + a + "\ndrag left 300 240 380 240 8\nsettle\n"
                   "screenshot " + b + "\nkey m\nkey k\nwheel 200 200 2\nsettle\nscreenshot " +
-                      c + "\nkey m\nkey o\nkey e\nkey t\nwheel 320 240 1\nsettle\nscreenshot " + d +
+                      c + "\nkey o\nkey e\nkey t\nwheel 320 240 1\nsettle\nscreenshot " + d +
                       "\nquit\n");
   r = run_shell(viewer(dir.file("demo.ptl") + " --size 640x480 --events " + dir.file("s.events") +
                        " --log-frames " + dir.file("frames.csv")));
@@ -98,7 +98,8 @@ TEST(ViewCli, ScreenshotsEqualThePrintedRenderCommandAndDragsTurnTheModel) {
   }
   EXPECT_THAT(printed_command(r.output, c), HasSubstr("--mode quality --splat ellipse"));
   EXPECT_THAT(printed_command(r.output, d), HasSubstr("--ortho "));
-  EXPECT_THAT(printed_command(r.output, d), HasSubstr("--splat ellipse --edl 1 --two-sided"));
+  EXPECT_THAT(printed_command(r.output, d),
+              HasSubstr("--mode quality --splat ellipse --edl 1 --two-sided"));
   // Dragging right turns the model right: the eye moves to the camera's left.
   const std::string ca = printed_command(r.output, a), cb = printed_command(r.output, b);
   const Vec3f eye_a = option_vec3(ca, "--eye"), target = option_vec3(ca, "--target");
@@ -123,9 +124,6 @@ TEST(ViewCli, BadModelAndMissingDisplayEndWithAMessage) {
   r = run_cli("render " + dir.file("s.ply") + " --ortho -2 -o " + dir.file("x.png"));
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_THAT(r.output, HasSubstr("--ortho"));
-  r = run_cli("render " + dir.file("s.ply") + " --ortho 2 --mode quality -o " + dir.file("x.png"));
-  EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_THAT(r.output, HasSubstr("drop --mode quality, or --ortho"));
   r = run_cli("render " + dir.file("s.ply") + " --ortho 2.5 --view 0,90 --edl -q -o " +
               dir.file("plan.png"));
   EXPECT_EQ(r.exit_code, 0) << r.output;

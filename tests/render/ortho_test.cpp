@@ -1,8 +1,8 @@
 // The orthographic camera (Camera::ortho_height) against exact expectations: a cube face seen
 // head-on is the exact square of its side over the view height (the ray-cast reference too),
 // whatever the eye's distance; every kernel, both level-of-detail schemes and the mesh reference
-// draw it; a plan view from the pole works; occlusion culling gives the same bits; quality mode
-// is refused with a message.
+// draw it, in fast and quality mode; a plan view from the pole works; occlusion culling gives the
+// same bits.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -148,7 +148,22 @@ TEST(Ortho, PlanViewFromThePoleSeesTheTopFace) {
   EXPECT_NEAR(f.depth[100 * kSize + 100], 10 * std::sqrt(3.0f) - 1, 0.05f);
 }
 
-TEST(Ortho, OcclusionCullingGivesTheSameBitsAndQualityModeIsRefused) {
+TEST(Ortho, QualityModeDrawsTheSquareWhateverTheDistance) {
+  Cube cube;
+  FrameSettings quality;
+  quality.rasterizer = Rasterizer::Quality;
+  for (float eye_z : {3.0f, 300.0f}) {
+    const Frame frame = cube.draw(head_on(eye_z), {}, quality);
+    const SquareCount n = count(frame, 2);
+    EXPECT_EQ(n.inside, 100 * 100) << eye_z;
+    EXPECT_EQ(n.far_outside, 0) << eye_z;
+    EXPECT_NEAR(frame.depth[100 * kSize + 100], eye_z - 1, 0.02f + 1e-4f * eye_z);
+    // Lit head-on by the headlight along parallel rays: one colour over the face's interior.
+    EXPECT_EQ(frame.color[70 * kSize + 70], frame.color[130 * kSize + 120]) << eye_z;
+  }
+}
+
+TEST(Ortho, OcclusionCullingGivesTheSameBits) {
   Cube cube;
   Camera c = orbit_camera({{0, 0, 0}, std::sqrt(3.0f)},
                           {.azimuth_deg = 20, .elevation_deg = 15, .distance = 10,
@@ -159,9 +174,6 @@ TEST(Ortho, OcclusionCullingGivesTheSameBitsAndQualityModeIsRefused) {
   culled.occlusion.leaf_points = 256;
   const Frame a = cube.draw(c), b = cube.draw(c, {}, culled);
   for (std::size_t i = 0; i < a.color.size(); ++i) ASSERT_EQ(a.color[i], b.color[i]) << i;
-  FrameSettings quality;
-  quality.rasterizer = Rasterizer::Quality;
-  EXPECT_THROW(cube.draw(c, {}, quality), OptionError);
   c.ortho_height = -1;
   EXPECT_THROW(make_camera_frame(c), OptionError);
 }

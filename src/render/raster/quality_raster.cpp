@@ -65,6 +65,7 @@ inline bool any4(Int4 m) { return (m[0] | m[1] | m[2] | m[3]) != 0; }
 // Per-frame constants of the pixel kernel.
 struct View {
   float half_w, half_h, inv_f;
+  bool ortho;  // parallel rays along +z from (a, b, 0); else rays t·(a, b, 1) from the eye
   float inv_rho2;  // 1 / lowpass_radius_px²
   float kernel_k;  // 1 / (2σ²), σ in radii
 };
@@ -105,14 +106,14 @@ struct Band {
 // Lanes whose fragment the splat's clip planes discard (features.hpp): the point P where the
 // pixel's ray meets the splat's plane, pulled back to the disc's rim for a fragment of the
 // low-pass alone (u > 1), the centre when the ray misses the plane.
-inline Int4 clipped_lanes(const float* s, const float* planes, Float4 t, Float4 a, float b,
-                          Float4 u, Int4 valid) {
+inline Int4 clipped_lanes(const float* s, const float* planes, Float4 t, Float4 px_ray,
+                          Float4 py_ray, Float4 u, Int4 valid) {
   const auto code = static_cast<std::uint8_t>(float_to_bits(s[kClipCode]));
   const Float4 one = splat4(1.0f);
   const Float4 pull = select4(u > one, 1.0f / render_detail::sqrt4(select4(u > one, u, one)), one);
   const float cx = s[kCx], cy = s[kCy], cz = s[kCz];
-  const Float4 px = select4(valid, cx + (t * a - cx) * pull, splat4(cx));
-  const Float4 py = select4(valid, cy + (t * b - cy) * pull, splat4(cy));
+  const Float4 px = select4(valid, cx + (px_ray - cx) * pull, splat4(cx));
+  const Float4 py = select4(valid, cy + (py_ray - cy) * pull, splat4(cy));
   const Float4 pz = select4(valid, cz + (t - cz) * pull, splat4(cz));
   return render_detail::clip_discard4(
       planes + 4 * static_cast<std::size_t>(float_to_bits(s[kClipFirst])), clip_count(code),
@@ -148,9 +149,19 @@ void draw_splat(const float* s, const float* planes, const View& v, const Band& 
       const float pcy = static_cast<float>(j) + 0.5f;
       const float b = (v.half_h - pcy) * v.inv_f;
       const float dy = pcy - s[kSy];
-      const Float4 t = nc / (na + ny * b);
+      // Where the pixel's ray meets the splat's plane: (X, Y, t) in eye space, t the depth.
+      Float4 t, X, Y;
+      if (v.ortho) {
+        t = (nc - nx * a - ny * b) / nz;
+        X = a;
+        Y = splat4(b);
+      } else {
+        t = nc / (na + ny * b);
+        X = t * a;
+        Y = t * b;
+      }
       const Int4 valid = (t > zero) & (t < inf);
-      const Float4 ex = t * a - cx, ey = t * b - cy, ez = t - cz;
+      const Float4 ex = X - cx, ey = Y - cy, ez = t - cz;
       const Float4 u = (ex * ex + ey * ey + ez * ez) * inv_r2;
       const Float4 sd = (dx2 + dy * dy) * v.inv_rho2;
       const Float4 m = select4(valid, min4(sd, u), sd);
@@ -158,7 +169,7 @@ void draw_splat(const float* s, const float* planes, const View& v, const Band& 
       if (!any4(cover)) continue;
       if constexpr (kFeat != kNoFeatures) {
         if (float_to_bits(s[kClipCode]) & 31u) {
-          const Int4 cut = cover & clipped_lanes(s, planes, t, a, b, u, valid);
+          const Int4 cut = cover & clipped_lanes(s, planes, t, X, Y, u, valid);
           // Counted once a frame: in the first pass of the opaque or the layered rule.
           if (kFeat == kFindFront || (kFeat == kClipOnly && !kAccumulate)) {
             *band.clipped += render_detail::lane_count(cut);
@@ -292,10 +303,16 @@ class BandShader {
         // View vector (world space) along each pixel's ray, toward the eye.
         const Float4 a = (static_cast<float>(i_first) + lane + 0.5f - v_.half_w) * v_.inv_f;
         Float4 view[3];
-        for (int c = 0; c < 3; ++c) view[c] = -(a * cam_.right[c] + b * cam_.up[c] + cam_.forward[c]);
-        const Float4 inv_view = 1.0f / render_detail::sqrt4(
-            view[0] * view[0] + view[1] * view[1] + view[2] * view[2]);
-        for (Float4& c : view) c *= inv_view;
+        if (v_.ortho) {
+          for (int c = 0; c < 3; ++c) view[c] = splat4(-cam_.forward[c]);
+        } else {
+          for (int c = 0; c < 3; ++c) {
+            view[c] = -(a * cam_.right[c] + b * cam_.up[c] + cam_.forward[c]);
+          }
+          const Float4 inv_view = 1.0f / render_detail::sqrt4(
+              view[0] * view[0] + view[1] * view[1] + view[2] * view[2]);
+          for (Float4& c : view) c *= inv_view;
+        }
         Float4 base[3], normal[3];
         const Float4 safe_w = select4(has, w, splat4(1.0f));
         for (int c = 0; c < 3; ++c) {
@@ -460,6 +477,7 @@ void rasterize_quality(const SplatStream& stream, const CameraFrame& camera, con
   v.half_w = 0.5f * static_cast<float>(camera.width);
   v.half_h = 0.5f * static_cast<float>(camera.height);
   v.inv_f = 1.0f / camera.focal_px;
+  v.ortho = camera.ortho;
   v.inv_rho2 = 1.0f / (quality.lowpass_radius_px * quality.lowpass_radius_px);
   v.kernel_k = 0.5f / (quality.kernel_sigma * quality.kernel_sigma);
   const BandShader band_shader(shader, camera, v, settings.background,

@@ -106,7 +106,9 @@ void prepare_chunk(const SplatChunk& chunk, const SetupConstants& k, bool featur
     }
     // Pixel box: the sphere's projection (pixel x = W/2 + f·slope_x, y = H/2 − f·slope_y),
     // united with the low-pass disc around the projected centre.
-    const Range sx = tangent_slopes(c.x, c.z, r), sy = tangent_slopes(c.y, c.z, r);
+    // Orthographic: the sphere's shadow is c ± r in eye-space units.
+    const Range sx = cam.ortho ? Range{c.x - r, c.x + r} : tangent_slopes(c.x, c.z, r);
+    const Range sy = cam.ortho ? Range{c.y - r, c.y + r} : tangent_slopes(c.y, c.z, r);
     const float x_lo = half_w + f * sx.lo, x_hi = half_w + f * sx.hi;
     const float y_lo = half_h - f * sy.hi, y_hi = half_h - f * sy.lo;
     const float slack_x = kBoxSlackPx + kBoxSlackRel * (x_hi - x_lo);
