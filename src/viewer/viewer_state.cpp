@@ -197,7 +197,11 @@ std::optional<float> ViewerState::next_detail(const Renderer& renderer) {
     case Phase::Refine:
       return last_detail_ = refine_[refine_index_];
     case Phase::Loading:
-      return last_detail_ = finest_;
+      // While pages are on their way, frames at the held frame rate's detail show them arriving
+      // (full-detail frames of a large model would keep input waiting); once the loader is idle,
+      // one frame at full detail, which may ask for more.
+      loading_budget_ = renderer.loading();
+      return last_detail_ = loading_budget_ ? std::max(control_.parameter(), finest_) : finest_;
     case Phase::Settled:
       break;
   }
@@ -228,7 +232,11 @@ void ViewerState::frame_done(double frame_ms, const Renderer& renderer, std::siz
       if (++refine_index_ >= refine_.size()) full_detail_reached(renderer, pages_handed);
       break;
     case Phase::Loading:
-      full_detail_reached(renderer, pages_handed);
+      if (loading_budget_) {
+        control_.report(frame_ms);
+      } else {
+        full_detail_reached(renderer, pages_handed);
+      }
       break;
     case Phase::Settled:
       break;

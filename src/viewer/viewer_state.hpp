@@ -63,7 +63,8 @@ class ViewerState {
   std::vector<float> refine_;
   std::size_t refine_index_ = 0;
   std::size_t last_handed_ = 0;
-  std::size_t frames_ = 0;  // pages handed to the loader after the last frame
+  std::size_t frames_ = 0;
+  bool loading_budget_ = false;  // the loading frame drawn at the held frame rate's detail  // pages handed to the loader after the last frame
   int buttons_ = 0;  // bit b-1 for button b held
   float last_x_ = 0, last_y_ = 0;
   double input_ms_ = -1;
