@@ -7,8 +7,9 @@ packages=(
   build-essential cmake pkg-config git
   libnanoflann-dev libeigen3-dev libcli11-dev libspng-dev zlib1g-dev
   nlohmann-json3-dev
-  # pointillist view: SDL 2 for the window; Xvfb (and xauth for xvfb-run) to test it headless
-  libsdl2-dev xvfb xauth
+  # pointillist view: SDL 2 for the window, SDL_ttf and DejaVu for its help overlay; Xvfb (and
+  # xauth for xvfb-run) to test it headless
+  libsdl2-dev libsdl2-ttf-dev fonts-dejavu-core xvfb xauth
   jq
   libgtest-dev libgmock-dev googletest libbenchmark-dev
   # make fuzz: clang 14, its libFuzzer and sanitizer runtimes (libclang-rt-14-dev), and

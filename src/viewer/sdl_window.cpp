@@ -1,8 +1,11 @@
 #include "pointillist/viewer/sdl_window.hpp"
 
 #include <SDL.h>
+#include <SDL_ttf.h>
 
+#include <algorithm>
 #include <string>
+#include <vector>
 
 #include "pointillist/core/error.hpp"
 
@@ -26,6 +29,12 @@ std::string key_name(SDL_Keycode k) {
   }
   return "";
 }
+
+// Fonts tried for the overlay (Debian's fonts-dejavu-core), first found wins.
+constexpr const char* kOverlayFonts[] = {"/usr/share/fonts/truetype/dejavu/DejaVuSansMono.ttf",
+                                         "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf"};
+constexpr int kOverlayPoints = 15;
+constexpr int kOverlayPad = 10;
 
 class SdlWindow final : public Window {
  public:
@@ -56,8 +65,43 @@ class SdlWindow final : public Window {
     }
   }
   ~SdlWindow() override {
+    if (overlay_) SDL_FreeSurface(overlay_);
+    if (font_) TTF_CloseFont(font_);
+    if (ttf_) TTF_Quit();
     SDL_DestroyWindow(window_);
     SDL_Quit();
+  }
+
+  bool set_overlay(const std::vector<std::string>& lines) override {
+    if (overlay_) SDL_FreeSurface(overlay_);
+    overlay_ = nullptr;
+    if (!open_font()) return false;
+    if (lines.empty()) return true;
+    // The lines over a translucent dark box, composed once.
+    std::vector<SDL_Surface*> rendered;
+    int w = 0, h = 0;
+    for (const std::string& line : lines) {
+      SDL_Surface* r = TTF_RenderUTF8_Blended(font_, line.empty() ? " " : line.c_str(),
+                                              SDL_Color{235, 235, 235, 255});
+      if (!r) continue;
+      rendered.push_back(r);
+      w = std::max(w, r->w);
+      h += r->h;
+    }
+    overlay_ = SDL_CreateRGBSurfaceWithFormat(0, w + 2 * kOverlayPad, h + 2 * kOverlayPad, 32,
+                                              SDL_PIXELFORMAT_ARGB8888);
+    if (overlay_) {
+      SDL_FillRect(overlay_, nullptr, SDL_MapRGBA(overlay_->format, 0, 0, 0, 185));
+      SDL_Rect at{kOverlayPad, kOverlayPad, 0, 0};
+      for (SDL_Surface* r : rendered) {
+        SDL_SetSurfaceBlendMode(r, SDL_BLENDMODE_BLEND);
+        SDL_BlitSurface(r, nullptr, overlay_, &at);
+        at.y += r->h;
+      }
+      SDL_SetSurfaceBlendMode(overlay_, SDL_BLENDMODE_BLEND);
+    }
+    for (SDL_Surface* r : rendered) SDL_FreeSurface(r);
+    return overlay_ != nullptr;
   }
 
   void present(const Frame& frame) override {
@@ -69,6 +113,10 @@ class SdlWindow final : public Window {
     if (!image) return;
     SDL_BlitSurface(image, nullptr, target, nullptr);
     SDL_FreeSurface(image);
+    if (overlay_) {
+      SDL_Rect at{12, 12, 0, 0};
+      SDL_BlitSurface(overlay_, nullptr, target, &at);
+    }
     SDL_UpdateWindowSurface(window_);
   }
 
@@ -138,7 +186,22 @@ class SdlWindow final : public Window {
     }
   }
 
+  bool open_font() {
+    if (font_) return true;
+    if (!ttf_) {
+      if (TTF_Init() != 0) return false;
+      ttf_ = true;
+    }
+    for (const char* path : kOverlayFonts) {
+      if ((font_ = TTF_OpenFont(path, kOverlayPoints))) return true;
+    }
+    return false;
+  }
+
   SDL_Window* window_ = nullptr;
+  bool ttf_ = false;
+  TTF_Font* font_ = nullptr;
+  SDL_Surface* overlay_ = nullptr;  // the help, drawn over every frame presented
 };
 
 }  // namespace

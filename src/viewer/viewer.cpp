@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <optional>
+#include <sstream>
 
 #include "pointillist/core/error.hpp"
 #include "pointillist/io/png.hpp"
@@ -132,6 +133,7 @@ ViewerResult run_viewer(Renderer& renderer, std::span<const SceneInstance> scene
   if (!o.quiet) std::fprintf(out, "%s", viewer_help().c_str());
   Frame frame;
   bool have_frame = false;
+  bool help_shown = false;
   double title_at = -1e9;
   std::size_t title_frames = 0;  // frames drawn when the title was last set
   std::size_t script_step = 0, script_event = 0;
@@ -184,7 +186,21 @@ ViewerResult run_viewer(Renderer& renderer, std::span<const SceneInstance> scene
     }
     if (st.quit()) break;
     if (st.take_screenshot_request()) screenshot("");
-    if (st.help_requested() && !o.quiet) std::fprintf(out, "%s", viewer_help().c_str());
+    if (st.help_requested()) {
+      // Over the frame where the window draws text, else in the terminal.
+      help_shown = !help_shown;
+      std::vector<std::string> lines;
+      if (help_shown) {
+        lines.push_back("Pointillist keys (h hides this)");
+        std::istringstream help(viewer_help());
+        for (std::string line; std::getline(help, line);) lines.push_back(line);
+      }
+      if (window.set_overlay(lines)) {
+        if (have_frame) window.present(frame);
+      } else if (help_shown && !o.quiet) {
+        std::fprintf(out, "%s", viewer_help().c_str());
+      }
+    }
     const std::optional<float> detail = st.next_detail(renderer);
     if (!detail) {
       if (now_ms() - title_at > 250 || title_frames != result.frames.size()) {

@@ -109,8 +109,6 @@ void ViewerState::key(const std::string& k, double now_ms) {
   }
   if (k == "h") {
     help_ = true;
-    message_ = "help printed in the terminal";
-    message_until_ = now_ms + 3000;
     return;
   }
   if (k.size() == 1 && k[0] >= '1' && k[0] <= '6') {

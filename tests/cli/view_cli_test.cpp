@@ -79,7 +79,7 @@ TEST(ViewCli, ScreenshotsEqualThePrintedRenderCommandAndDragsTurnTheModel) {
   const std::string a = dir.file("a.png"), b = dir.file("b.png"), c = dir.file("c.png"),
                     d = dir.file("d.png");
   write_text_file(dir.file("s.events"),
-                  "settle\nscreenshot " + a + "\ndrag left 300 240 380 240 8\nsettle\n"
+                  "settle\nkey h\nscreenshot " + a + "\nkey h\ndrag left 300 240 380 240 8\nsettle\n"
                   "screenshot " + b + "\nkey m\nkey k\nwheel 200 200 2\nsettle\nscreenshot " +
                       c + "\nkey o\nkey e\nkey t\nwheel 320 240 1\nsettle\nscreenshot " + d +
                       "\nquit\n");

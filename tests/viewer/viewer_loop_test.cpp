@@ -45,6 +45,11 @@ class RecordingWindow final : public Window {
   void resize(int w, int h) override {
     pending.push_back({.type = InputEvent::Type::Resize, .width = w, .height = h});
   }
+  bool set_overlay(const std::vector<std::string>& lines) override {
+    overlays.push_back(lines);
+    return true;
+  }
+  std::vector<std::vector<std::string>> overlays;
   std::deque<InputEvent> pending;
   std::vector<std::string> titles;
   int presented = 0;
@@ -179,6 +184,33 @@ TEST(ViewerLoop, PagedModelSettlesWithItsPagesAndRefusesWhatPagesCannotDraw) {
   const std::vector<SceneInstance> whole_scene{{.model = &decoded.renderable()}};
   const Frame whole = fresh_render(whole_scene, nav.camera(), o, fx.pool);
   EXPECT_TRUE(std::equal(p.pixels.begin(), p.pixels.end(), whole.color.begin()));
+}
+
+TEST(ViewerLoop, HelpKeyShowsAndHidesTheOverlayWithoutChangingTheFrame) {
+  Fixture fx;
+  pointillist::testing::TempDir dir;
+  Navigator nav(fx.home, fx.tree.view_sphere, {0, 1, 0});
+  ViewerOptions o;
+  o.quiet = true;
+  o.scripted = true;
+  o.script = script(dir.path().string(), "settle\nscreenshot " + dir.file("a.png") +
+                                             "\nkey h\nscreenshot " + dir.file("b.png") +
+                                             "\nkey h\n");
+  Renderer renderer;
+  RecordingWindow window;
+  const ViewerResult r = run_viewer(renderer, fx.scene, nav, window, fx.pool, o, stdout);
+  ASSERT_EQ(window.overlays.size(), 2u);
+  bool names_orbit = false;
+  for (const std::string& line : window.overlays[0]) {
+    names_orbit = names_orbit || line.find("left drag orbits") != std::string::npos;
+  }
+  EXPECT_TRUE(names_orbit);
+  EXPECT_TRUE(window.overlays[1].empty());
+  // The overlay is the window's: the frame (and its screenshot) is unchanged, and no frame was
+  // drawn for it.
+  const ImageRgb8 a = read_png_rgb8(dir.file("a.png")), b = read_png_rgb8(dir.file("b.png"));
+  EXPECT_TRUE(std::equal(a.pixels.begin(), a.pixels.end(), b.pixels.begin()));
+  EXPECT_EQ(r.screenshots.size(), 2u);
 }
 
 TEST(ViewerLoop, ClosingTheWindowOrQuitKeysEndTheLoop) {

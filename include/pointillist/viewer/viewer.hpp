@@ -32,6 +32,12 @@ class Window {
   virtual void set_title(const std::string& title) = 0;
   // Resizes the window (a script's `resize`); the window reports it back as a Resize event.
   virtual void resize(int width, int height) = 0;
+  // Lines of text drawn over every frame presented from now on (none: empty). Never part of the
+  // frame (screenshots are the frame). False when this window cannot draw text.
+  virtual bool set_overlay(const std::vector<std::string>& lines) {
+    (void)lines;
+    return false;
+  }
 };
 
 struct ViewerOptions {
