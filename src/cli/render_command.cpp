@@ -215,7 +215,11 @@ int run_render(const RenderOptions& o) {
   }
   if (o.quiet || o.stats_output == "-") return 0;
   std::string names;
-  for (std::size_t i = 0; i < o.inputs.size(); ++i) names += (i ? ", " : "") + o.inputs[i];
+  for (std::size_t i = 0; i < o.inputs.size() && i < 3; ++i) {
+    if (i) names += ", ";
+    names += o.inputs[i];
+  }
+  if (o.inputs.size() > 3) names += " and " + std::to_string(o.inputs.size() - 3) + " more";
   if (sequence) {
     double total = 0;
     for (const SequenceFrame& r : frames) total += r.stats.ms_total;

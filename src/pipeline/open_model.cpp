@@ -133,6 +133,17 @@ Model Model::open_file(const std::string& path, const OpenModelOptions& options,
     return model;
   }
   const std::string paths[] = {path};
+  return from_scans(paths, options, pool, progress);
+}
+
+Model Model::from_scans(std::span<const std::string> paths, const OpenModelOptions& options,
+                        ThreadPool& pool, Progress& progress) {
+  Model model;
+  model.path_ = paths.front();
+  for (const std::string& p : paths) {
+    std::error_code ec;
+    model.file_size_ += std::filesystem::file_size(p, ec);
+  }
   PointSet points = merge_inputs(paths, pool, progress, {.columns = options.columns});
   model.kind_ = ModelKind::Scan;
   model.scan_input_ = {.points = points.size(),
@@ -150,7 +161,24 @@ Model Model::open_file(const std::string& path, const OpenModelOptions& options,
 
 Model open_model(const std::string& path, const OpenModelOptions& options, ThreadPool& pool,
                  Progress& progress) {
-  Model model = Model::open_file(path, options, pool, progress);
+  return Model::finish(Model::open_file(path, options, pool, progress), options, pool, progress);
+}
+
+Model open_scans(std::span<const std::string> paths, const OpenModelOptions& options,
+                 ThreadPool& pool, Progress& progress) {
+  if (paths.empty()) throw OptionError("no scan to open; give at least one input file");
+  for (const std::string& p : paths) {
+    if (!std::filesystem::exists(p)) throw IoError(p + ": no such file; check the path");
+  }
+  Model model = Model::from_scans(paths, options, pool, progress);
+  if (paths.size() > 1) {
+    model.path_ += " (+" + std::to_string(paths.size() - 1) + " more)";
+  }
+  return Model::finish(std::move(model), options, pool, progress);
+}
+
+Model Model::finish(Model model, const OpenModelOptions& options, ThreadPool& pool,
+                    Progress& progress) {
   if (options.features && !model.paged()) {
     const bool quantized = model.kind_ == ModelKind::PtlV2 || model.kind_ == ModelKind::Qsplat;
     const FeatureOptions fo =
@@ -167,7 +195,7 @@ Model open_model(const std::string& path, const OpenModelOptions& options, Threa
                   .mesh = options.keep_source && model.kind_ == ModelKind::Scan
                               ? model.source_.get()
                               : nullptr,
-                  .name = path});
+                  .name = model.path_});
   return model;
 }
 

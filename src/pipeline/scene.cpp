@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -153,7 +154,23 @@ Scene scene_of_models(std::span<const std::string> paths, const OpenModelOptions
                       ThreadPool& pool, Progress& progress) {
   ModelCache cache(options, pool, progress);
   Scene scene;
-  for (const std::string& p : paths) scene.add(cache.get(p));
+  // Scans are merged into one model (as convert merges them): tiles of one survey then share
+  // their normals and radii across borders, and a tile too small to prepare on its own is
+  // prepared with its neighbours. Models are added one instance each, in order.
+  std::vector<std::string> scans;
+  std::set<std::string> seen;
+  for (const std::string& p : paths) {
+    if (!is_model_file(p) && seen.insert(canonical_key(p)).second) scans.push_back(p);
+  }
+  bool scans_added = scans.size() < 2;
+  for (const std::string& p : paths) {
+    if (is_model_file(p) || scans.size() < 2) {
+      scene.add(cache.get(p));
+    } else if (!scans_added) {
+      scene.add(std::make_shared<const Model>(open_scans(scans, options, pool, progress)));
+      scans_added = true;
+    }
+  }
   return scene;
 }
 

@@ -14,9 +14,9 @@ struct CliResult {
   std::string output;  // stdout and stderr together
 };
 
-// Runs `pointillist ARGS` (POINTILLIST_CLI_PATH, set by tests/CMakeLists.txt) through the shell.
-inline CliResult run_cli(const std::string& args) {
-  const std::string cmd = std::string(POINTILLIST_CLI_PATH) + " " + args + " 2>&1";
+// Runs a shell command line, stdout and stderr together.
+inline CliResult run_shell(const std::string& command) {
+  const std::string cmd = command + " 2>&1";
   CliResult r;
   FILE* pipe = ::popen(cmd.c_str(), "r");
   if (!pipe) return r;
@@ -25,6 +25,11 @@ inline CliResult run_cli(const std::string& args) {
   const int status = ::pclose(pipe);
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
+}
+
+// Runs `pointillist ARGS` (POINTILLIST_CLI_PATH, set by tests/CMakeLists.txt) through the shell.
+inline CliResult run_cli(const std::string& args) {
+  return run_shell(std::string(POINTILLIST_CLI_PATH) + " " + args);
 }
 
 inline void write_text_file(const std::string& path, const std::string& text) {

@@ -141,6 +141,43 @@ TEST(InputsCli, ConvertMergesSeveralTextFiles) {
   EXPECT_NEAR(box[4], 3.9, 1e-5);
 }
 
+TEST(InputsCli, RenderMergesSeveralScansIntoOneModelAsConvertDoes) {
+  TempDir dir;
+  // A 40 × 40 grid split into a large tile and a tile of one point, which alone is too small
+  // to estimate a normal: merged, it is prepared with its neighbours.
+  std::string a, b;
+  for (int j = 0; j < 40; ++j) {
+    for (int i = 0; i < 40; ++i) {
+      char line[64];
+      std::snprintf(line, sizeof line, "%g %g 0\n", i * 0.1, j * 0.1);
+      (i == 39 && j == 39 ? b : a) += line;
+    }
+  }
+  write_text_file(dir.file("a.xyz"), a);
+  write_text_file(dir.file("b.xyz"), b);
+  const std::string both = dir.file("a.xyz") + " " + dir.file("b.xyz");
+  // Two-sided: the plane's PCA normals may face either way.
+  const CliResult r = run_cli("render " + both + " " + dir.file("a.xyz") + " -q --two-sided --size 64x64 -o " +
+                              dir.file("x.png") + " --stats " + dir.file("s.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream in(dir.file("s.json"));
+  const std::string stats{std::istreambuf_iterator<char>(in), {}};
+  // One model (a.xyz named twice is read once), the first file's name and the count of others.
+  EXPECT_THAT(stats, HasSubstr("a.xyz (+1 more)"));
+  EXPECT_EQ(stats.find("b.xyz"), std::string::npos) << stats;
+  // The image of the points convert prepares from the same two files (written as PLY with
+  // their normals and radii, read back as one scan).
+  ASSERT_EQ(run_cli("convert " + both + " -q -o " + dir.file("m.ply")).exit_code, 0);
+  const CliResult one = run_cli("render " + dir.file("m.ply") +
+                                " -q --two-sided --size 64x64 -o " + dir.file("y.png"));
+  ASSERT_EQ(one.exit_code, 0) << one.output;
+  const ImageRgb8 x = read_png_rgb8(dir.file("x.png")), y = read_png_rgb8(dir.file("y.png"));
+  int drawn = 0;
+  for (const Rgb8& p : x.pixels) drawn += !(p == Rgb8{0, 0, 0});
+  EXPECT_GT(drawn, 1000);
+  EXPECT_TRUE(x.pixels == y.pixels);
+}
+
 TEST(InputsCli, DropOutliersRemovesStraysAboveAGridAndKeepsTheGrid) {
   TempDir dir;
   // A 60 × 60 grid in z = 0 (spacing 0.1) and 4 strays 1 to 2.5 above it, far apart.

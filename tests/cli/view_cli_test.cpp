@@ -20,21 +20,11 @@
 using pointillist::Vec3f;
 using pointillist::testing::CliResult;
 using pointillist::testing::run_cli;
+using pointillist::testing::run_shell;
 using pointillist::testing::write_text_file;
 using ::testing::HasSubstr;
 
 namespace {
-
-CliResult run_shell(const std::string& cmd) {
-  CliResult r;
-  FILE* pipe = ::popen((cmd + " 2>&1").c_str(), "r");
-  if (!pipe) return r;
-  char buf[4096];
-  while (std::size_t n = std::fread(buf, 1, sizeof buf, pipe)) r.output.append(buf, n);
-  const int status = ::pclose(pipe);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
 
 bool have_xvfb() { return std::system("command -v xvfb-run >/dev/null 2>&1") == 0; }
 

@@ -76,6 +76,15 @@ struct Fixture {
                                                 .width = 320, .height = 240});
 };
 
+// Quiet options that play `text` as the script (written into `dir`).
+ViewerOptions scripted(const pointillist::testing::TempDir& dir, const std::string& text) {
+  ViewerOptions o;
+  o.quiet = true;
+  o.scripted = true;
+  o.script = script(dir.path().string(), text);
+  return o;
+}
+
 Frame fresh_render(std::span<const SceneInstance> scene, const Camera& c, const ViewerOptions& o,
                    ThreadPool& pool, Renderer* renderer = nullptr) {
   Renderer own;
@@ -90,13 +99,10 @@ TEST(ViewerLoop, SettledViewIsTheHeadlessRenderOfItsCamera) {
   Fixture fx;
   pointillist::testing::TempDir dir;
   Navigator nav(fx.home, fx.tree.view_sphere, {0, 1, 0});
-  ViewerOptions o;
-  o.quiet = true;
-  o.scripted = true;
-  o.script = script(dir.path().string(),
-                    "drag left 100 100 160 120 4\nwheel 160 120 2\nsettle\nscreenshot " +
-                        dir.file("a.png") + "\nkey k\nkey m\nsettle\nscreenshot " +
-                        dir.file("b.png") + "\n");
+  ViewerOptions o = scripted(
+      dir, "drag left 100 100 160 120 4\nwheel 160 120 2\nsettle\nscreenshot " +
+               dir.file("a.png") + "\nkey k\nkey m\nsettle\nscreenshot " + dir.file("b.png") +
+               "\n");
   Renderer renderer;
   RecordingWindow window;
   const ViewerResult r = run_viewer(renderer, fx.scene, nav, window, fx.pool, o, stdout);
@@ -122,14 +128,11 @@ TEST(ViewerLoop, AfterTheCameraStopsFramesRefineToFullDetailThenStop) {
   Fixture fx;
   pointillist::testing::TempDir dir;
   Navigator nav(fx.home, fx.tree.view_sphere, {0, 1, 0});
-  ViewerOptions o;
-  o.quiet = true;
-  o.scripted = true;
+  ViewerOptions o = scripted(dir, "drag left 50 50 150 50 6\nsettle\nwait 60\n");
   o.refine_frames = 5;
   // A target no frame can meet: every moving frame is coarser than full detail.
   o.fps = 100000;
   o.settings.threshold_px = 1.5f;
-  o.script = script(dir.path().string(), "drag left 50 50 150 50 6\nsettle\nwait 60\n");
   Renderer renderer;
   RecordingWindow window;
   const ViewerResult r = run_viewer(renderer, fx.scene, nav, window, fx.pool, o, stdout);
@@ -158,12 +161,9 @@ TEST(ViewerLoop, PagedModelSettlesWithItsPagesAndRefusesWhatPagesCannotDraw) {
   ASSERT_TRUE(model.paged());
   const std::vector<SceneInstance> scene{{.model = &model.renderable()}};
   Navigator nav(fx.home, fx.tree.view_sphere, {0, 1, 0});
-  ViewerOptions o;
-  o.quiet = true;
-  o.scripted = true;
   // SPT and occlusion culling are not drawn from pages: refused, undone, the viewer goes on.
-  o.script = script(dir.path().string(), "settle\nkey l\nsettle\nkey c\nsettle\nscreenshot " +
-                                             dir.file("p.png") + "\n");
+  ViewerOptions o = scripted(
+      dir, "settle\nkey l\nsettle\nkey c\nsettle\nscreenshot " + dir.file("p.png") + "\n");
   Renderer renderer({.page_all = true, .memory_cap = 1u << 20});
   RecordingWindow window;
   const ViewerResult r = run_viewer(renderer, scene, nav, window, fx.pool, o, stdout);
@@ -190,12 +190,8 @@ TEST(ViewerLoop, HelpKeyShowsAndHidesTheOverlayWithoutChangingTheFrame) {
   Fixture fx;
   pointillist::testing::TempDir dir;
   Navigator nav(fx.home, fx.tree.view_sphere, {0, 1, 0});
-  ViewerOptions o;
-  o.quiet = true;
-  o.scripted = true;
-  o.script = script(dir.path().string(), "settle\nscreenshot " + dir.file("a.png") +
-                                             "\nkey h\nscreenshot " + dir.file("b.png") +
-                                             "\nkey h\n");
+  ViewerOptions o = scripted(dir, "settle\nscreenshot " + dir.file("a.png") +
+                                      "\nkey h\nscreenshot " + dir.file("b.png") + "\nkey h\n");
   Renderer renderer;
   RecordingWindow window;
   const ViewerResult r = run_viewer(renderer, fx.scene, nav, window, fx.pool, o, stdout);

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 
 #include "pointillist/core/point_set.hpp"
@@ -104,7 +105,13 @@ class Model {
 
  private:
   friend Model open_model(const std::string&, const OpenModelOptions&, ThreadPool&, Progress&);
+  friend Model open_scans(std::span<const std::string>, const OpenModelOptions&, ThreadPool&,
+                          Progress&);
   static Model open_file(const std::string&, const OpenModelOptions&, ThreadPool&, Progress&);
+  static Model from_scans(std::span<const std::string>, const OpenModelOptions&, ThreadPool&,
+                          Progress&);
+  // Sharp features and the renderable, once the hierarchy is there.
+  static Model finish(Model model, const OpenModelOptions&, ThreadPool&, Progress&);
   std::string path_;
   ModelKind kind_ = ModelKind::Scan;
   std::unique_ptr<PtlFile> v1_;
@@ -126,6 +133,13 @@ class Model {
 // in memory. Throws IoError for a missing file, and what the readers and builders throw.
 Model open_model(const std::string& path, const OpenModelOptions& options, ThreadPool& pool,
                  Progress& progress);
+
+// Several scans read as one (merge_inputs: tiles of one survey line up, normals and radii near a
+// tile's border see its neighbours), prepared and built into one hierarchy in memory. The
+// model's path is the first file's, followed by " (+N more)". Throws IoError for a missing file
+// and what the readers and builders throw.
+Model open_scans(std::span<const std::string> paths, const OpenModelOptions& options,
+                 ThreadPool& pool, Progress& progress);
 
 // True when `path` is a splat model (.ptl or .qs) rather than a scan.
 bool is_model_file(const std::string& path);

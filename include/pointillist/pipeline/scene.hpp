@@ -46,7 +46,9 @@ class Scene {
   std::vector<SceneInstance> instances_;
 };
 
-// One untransformed instance of each path's model (each opened once, even when named twice).
+// One untransformed instance of each path's model (each opened once, even when named twice);
+// several scans (inputs that are not .ptl or .qs models) are merged into one model (open_scans),
+// placed where the first of them is listed.
 Scene scene_of_models(std::span<const std::string> paths, const OpenModelOptions& options,
                       ThreadPool& pool, Progress& progress);
 
