@@ -11,6 +11,7 @@
 
 #include "commands.hpp"
 #include "terminal_progress.hpp"
+#include "util.hpp"
 #include "pointillist/core/atomic_file.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/io/camera_path.hpp"
@@ -214,12 +215,7 @@ int run_render(const RenderOptions& o) {
                                    .finest = finest}));
   }
   if (o.quiet || o.stats_output == "-") return 0;
-  std::string names;
-  for (std::size_t i = 0; i < o.inputs.size() && i < 3; ++i) {
-    if (i) names += ", ";
-    names += o.inputs[i];
-  }
-  if (o.inputs.size() > 3) names += " and " + std::to_string(o.inputs.size() - 3) + " more";
+  const std::string names = input_names(o.inputs);
   if (sequence) {
     double total = 0;
     for (const SequenceFrame& r : frames) total += r.stats.ms_total;

@@ -1,6 +1,7 @@
 #include "util.hpp"
 
 #include <cstdio>
+#include <filesystem>
 
 namespace pointillist::cli {
 
@@ -14,6 +15,16 @@ std::string human_bytes(double bytes) {
   char buf[32];
   std::snprintf(buf, sizeof buf, u == 0 ? "%.0f %s" : "%.2f %s", bytes, units[u]);
   return buf;
+}
+
+std::string input_names(std::span<const std::string> inputs, bool file_names) {
+  std::string names;
+  for (std::size_t i = 0; i < inputs.size() && i < 3; ++i) {
+    if (i) names += ", ";
+    names += file_names ? std::filesystem::path(inputs[i]).filename().string() : inputs[i];
+  }
+  if (inputs.size() > 3) names += " and " + std::to_string(inputs.size() - 3) + " more";
+  return names;
 }
 
 }  // namespace pointillist::cli

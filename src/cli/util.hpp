@@ -1,6 +1,7 @@
 // Small helpers shared by the subcommands.
 #pragma once
 
+#include <span>
 #include <string>
 
 #include "pointillist/core/math.hpp"
@@ -9,6 +10,10 @@ namespace pointillist::cli {
 
 // "1.23 MB"-style size.
 std::string human_bytes(double bytes);
+
+// The inputs for a summary line or a window title: the first three (file names only with
+// `file_names`), then "and N more".
+std::string input_names(std::span<const std::string> inputs, bool file_names = false);
 
 // Eight well-separated face colours (spec §4.1), so that any blending of two faces shows:
 // `generate --scene T*` colours face label l with kLabelPalette[l % 8], samples and --reference

@@ -10,6 +10,7 @@
 #include "commands.hpp"
 #include "options.hpp"
 #include "terminal_progress.hpp"
+#include "util.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/pipeline/scene.hpp"
 #include "pointillist/viewer/sdl_window.hpp"
@@ -119,11 +120,7 @@ int run_view(const CLI::App& cmd, ViewCommandOptions& o) {
   v.frame = o.frame;
   v.fps = o.fps;
   v.refine_frames = o.refine;
-  for (std::size_t i = 0; i < o.inputs.size() && i < 3; ++i) {
-    if (i) v.name += ", ";
-    v.name += std::filesystem::path(o.inputs[i]).filename().string();
-  }
-  if (o.inputs.size() > 3) v.name += " and " + std::to_string(o.inputs.size() - 3) + " more";
+  v.name = input_names(o.inputs, /*file_names=*/true);
   v.render_command = render_words(cmd, o);
   v.screenshot_dir = o.screenshots;
   v.script = std::move(script);

@@ -37,10 +37,10 @@ ViewerState::ViewerState(const ViewerOptions& o, Navigator& nav)
       frame_(o.frame),
       undo_settings_(o.settings),
       undo_frame_(o.frame),
-      finest_(initial_detail(o.settings, o.frame)),
-      control_(FrameControlOptions{.target_ms = 1000.0 / o.fps, .finest = finest_,
-                                   .coarsest = std::max(64.0f, finest_)},
-               finest_) {}
+      control_(FrameControlOptions{.target_ms = 1000.0 / o.fps,
+                                   .finest = initial_detail(o.settings, o.frame),
+                                   .coarsest = std::max(64.0f, initial_detail(o.settings, o.frame))},
+               initial_detail(o.settings, o.frame)) {}
 
 void ViewerState::changed(double now_ms) {
   moved_ = true;
@@ -115,49 +115,51 @@ void ViewerState::key(const std::string& k, double now_ms) {
     nav_.axis_view(static_cast<AxisView>(k[0] - '1'));
   } else if (k == "0" || k == "r") {
     nav_.reset();
-  } else if (k == "o") {
-    undo_settings_ = settings_;
-    undo_frame_ = frame_;
-    undo_ortho_ = nav_.ortho();
-    toggled_ = true;
-    nav_.toggle_ortho();
   } else {
-    undo_settings_ = settings_;
-    undo_frame_ = frame_;
-    undo_ortho_ = nav_.ortho();
+    const RenderSettings settings = settings_;
+    const FrameSettings frame = frame_;
+    const bool ortho = nav_.ortho();
+    if (!toggle(k)) return;  // not a key of the viewer
+    undo_settings_ = settings;
+    undo_frame_ = frame;
+    undo_ortho_ = ortho;
     toggled_ = true;
-    if (k == "m") {
-      frame_.rasterizer =
-          frame_.rasterizer == Rasterizer::Fast ? Rasterizer::Quality : Rasterizer::Fast;
-    } else if (k == "k") {
-      settings_.shape = settings_.shape == SplatShape::Square   ? SplatShape::Circle
-                        : settings_.shape == SplatShape::Circle ? SplatShape::Ellipse
-                                                                : SplatShape::Square;
-    } else if (k == "l") {
-      const bool to_spt = frame_.lod == LodScheme::QSplat;
-      frame_.lod = to_spt ? LodScheme::Spt : LodScheme::QSplat;
-      // The full detail of the other scheme: its parameter as the viewer was started with.
-      finest_ = to_spt ? options_.frame.epsilon_px : options_.settings.threshold_px;
-    } else if (k == "plus") {
-      frame_.splat_scale = std::min(100.0f, frame_.splat_scale * kSplatScaleStep);
-    } else if (k == "minus") {
-      frame_.splat_scale = std::max(0.01f, frame_.splat_scale / kSplatScaleStep);
-    } else if (k == "e") {
-      const float strength = options_.settings.edl_strength > 0 ? options_.settings.edl_strength : 1;
-      settings_.edl_strength = settings_.edl_strength > 0 ? 0.0f : strength;
-    } else if (k == "t") {
-      settings_.two_sided = !settings_.two_sided;
-    } else if (k == "f") {
-      frame_.features = !frame_.features;
-    } else if (k == "c") {
-      frame_.occlusion.method = frame_.occlusion.method == OcclusionMethod::None
-                                    ? OcclusionMethod::ChcPlusPlus
-                                    : OcclusionMethod::None;
-    } else {
-      return;  // not a key of the viewer
-    }
   }
   changed(now_ms);
+}
+
+bool ViewerState::toggle(const std::string& k) {
+  if (k == "o") {
+    nav_.toggle_ortho();
+  } else if (k == "m") {
+    frame_.rasterizer =
+        frame_.rasterizer == Rasterizer::Fast ? Rasterizer::Quality : Rasterizer::Fast;
+  } else if (k == "k") {
+    settings_.shape = settings_.shape == SplatShape::Square   ? SplatShape::Circle
+                      : settings_.shape == SplatShape::Circle ? SplatShape::Ellipse
+                                                              : SplatShape::Square;
+  } else if (k == "l") {
+    // Full detail follows (finest()): the other scheme's parameter as the viewer started with.
+    frame_.lod = frame_.lod == LodScheme::QSplat ? LodScheme::Spt : LodScheme::QSplat;
+  } else if (k == "plus") {
+    frame_.splat_scale = std::min(100.0f, frame_.splat_scale * kSplatScaleStep);
+  } else if (k == "minus") {
+    frame_.splat_scale = std::max(0.01f, frame_.splat_scale / kSplatScaleStep);
+  } else if (k == "e") {
+    const float strength = options_.settings.edl_strength > 0 ? options_.settings.edl_strength : 1;
+    settings_.edl_strength = settings_.edl_strength > 0 ? 0.0f : strength;
+  } else if (k == "t") {
+    settings_.two_sided = !settings_.two_sided;
+  } else if (k == "f") {
+    frame_.features = !frame_.features;
+  } else if (k == "c") {
+    frame_.occlusion.method = frame_.occlusion.method == OcclusionMethod::None
+                                  ? OcclusionMethod::ChcPlusPlus
+                                  : OcclusionMethod::None;
+  } else {
+    return false;
+  }
+  return true;
 }
 
 bool ViewerState::refuse(const std::string& message, double now_ms) {
@@ -166,11 +168,6 @@ bool ViewerState::refuse(const std::string& message, double now_ms) {
   settings_ = undo_settings_;
   frame_ = undo_frame_;
   if (nav_.ortho() != undo_ortho_) nav_.toggle_ortho();
-  finest_ = initial_detail(options_.settings, options_.frame);
-  if (frame_.lod != options_.frame.lod) {
-    finest_ = frame_.lod == LodScheme::Spt ? options_.frame.epsilon_px
-                                            : options_.settings.threshold_px;
-  }
   message_ = "refused: " + message;
   message_until_ = now_ms + 5000;
   changed(now_ms);
@@ -179,19 +176,19 @@ bool ViewerState::refuse(const std::string& message, double now_ms) {
 
 std::optional<float> ViewerState::next_detail(const Renderer& renderer) {
   if (phase_ == Phase::Moving && !moved_) {
-    if (last_detail_ <= finest_) {
+    if (last_detail_ <= finest()) {
       // The last moving frame was already at full detail, and nothing moved since.
       full_detail_reached(renderer, last_handed_);
     } else {
       // The camera stopped: refine from the moving detail to full detail.
-      refine_ = refinement_sequence(last_detail_, finest_, options_.refine_frames);
+      refine_ = refinement_sequence(last_detail_, finest(), options_.refine_frames);
       refine_index_ = 0;
       phase_ = Phase::Refine;
     }
   }
   switch (phase_) {
     case Phase::Moving:
-      return last_detail_ = std::max(control_.parameter(), finest_);
+      return last_detail_ = std::max(control_.parameter(), finest());
     case Phase::Refine:
       return last_detail_ = refine_[refine_index_];
     case Phase::Loading:
@@ -199,7 +196,7 @@ std::optional<float> ViewerState::next_detail(const Renderer& renderer) {
       // (full-detail frames of a large model would keep input waiting); once the loader is idle,
       // one frame at full detail, which may ask for more.
       loading_budget_ = renderer.loading();
-      return last_detail_ = loading_budget_ ? std::max(control_.parameter(), finest_) : finest_;
+      return last_detail_ = loading_budget_ ? std::max(control_.parameter(), finest()) : finest();
     case Phase::Settled:
       break;
   }

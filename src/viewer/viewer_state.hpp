@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "pointillist/render/frame_control.hpp"
+#include "pointillist/render/sequence.hpp"
 #include "pointillist/viewer/viewer.hpp"
 
 namespace pointillist {
@@ -45,6 +46,11 @@ class ViewerState {
   enum class Phase { Moving, Refine, Loading, Settled };
   void changed(double now_ms);
   void key(const std::string& name, double now_ms);
+  // Applies a mode key (m, k, l, plus, minus, e, t, o, f, c); false for any other key.
+  bool toggle(const std::string& name);
+  // Full detail of the scheme drawn: the QSplat threshold or SPT epsilon the viewer started with
+  // (the viewer never changes those; frames draw copies with their own detail).
+  float finest() const { return initial_detail(settings_, frame_); }
   void full_detail_reached(const Renderer& renderer, std::size_t pages_handed);
 
   const ViewerOptions& options_;
@@ -55,7 +61,6 @@ class ViewerState {
   FrameSettings undo_frame_;
   bool undo_ortho_ = false;
   bool toggled_ = false;  // a toggle since the last frame drawn
-  float finest_;
   FrameTimeController control_;
   Phase phase_ = Phase::Moving;
   bool moved_ = true;  // something changed since the last frame

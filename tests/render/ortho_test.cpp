@@ -31,6 +31,15 @@ Camera head_on(float eye_z) {
   return c;
 }
 
+// An orthographic orbit camera around the cube's bounding sphere, 10 radii away.
+Camera ortho_orbit(float azimuth_deg, float elevation_deg, float height) {
+  Camera c = orbit_camera({{0, 0, 0}, std::sqrt(3.0f)},
+                          {.azimuth_deg = azimuth_deg, .elevation_deg = elevation_deg,
+                           .distance = 10, .width = kSize, .height = kSize});
+  c.ortho_height = height;
+  return c;
+}
+
 struct Cube {
   ThreadPool pool{2};
   SphereTree tree;
@@ -115,10 +124,7 @@ TEST(Ortho, ParallelEdgesStayParallelFromAnAngle) {
   // same length in an orthographic view (perspective would make the near one longer). Measure
   // the drawn column heights a little inside the left and right silhouette.
   Cube cube;
-  Camera c = orbit_camera({{0, 0, 0}, std::sqrt(3.0f)},
-                          {.azimuth_deg = 30, .elevation_deg = 0, .distance = 10,
-                           .width = kSize, .height = kSize});
-  c.ortho_height = 4;
+  const Camera c = ortho_orbit(30, 0, 4);
   RenderSettings ellipses;  // the top and bottom faces, seen edge-on, add no height
   ellipses.shape = SplatShape::Ellipse;
   const Frame f = cube.draw(c, ellipses);
@@ -139,9 +145,7 @@ TEST(Ortho, ParallelEdgesStayParallelFromAnAngle) {
 
 TEST(Ortho, PlanViewFromThePoleSeesTheTopFace) {
   Cube cube;
-  Camera c = orbit_camera({{0, 0, 0}, std::sqrt(3.0f)},
-                          {.elevation_deg = 90, .distance = 10, .width = kSize, .height = kSize});
-  c.ortho_height = 4;
+  const Camera c = ortho_orbit(0, 90, 4);
   const Frame f = cube.draw(c);
   EXPECT_EQ(count(f, 2).inside, 100 * 100);
   EXPECT_EQ(count(f, 2).far_outside, 0);
@@ -165,10 +169,7 @@ TEST(Ortho, QualityModeDrawsTheSquareWhateverTheDistance) {
 
 TEST(Ortho, OcclusionCullingGivesTheSameBits) {
   Cube cube;
-  Camera c = orbit_camera({{0, 0, 0}, std::sqrt(3.0f)},
-                          {.azimuth_deg = 20, .elevation_deg = 15, .distance = 10,
-                           .width = kSize, .height = kSize});
-  c.ortho_height = 5;
+  Camera c = ortho_orbit(20, 15, 5);
   FrameSettings culled;
   culled.occlusion.method = OcclusionMethod::ChcPlusPlus;
   culled.occlusion.leaf_points = 256;
