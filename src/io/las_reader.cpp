@@ -3,6 +3,7 @@
 // finds the coordinate bounds (for the origin) and the largest color value (for the color
 // scale), a second pass decodes. Both passes run in chunks, in parallel when a pool is given.
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -14,6 +15,8 @@
 #include "pointillist/core/error.hpp"
 #include "pointillist/core/thread_pool.hpp"
 #include "pointillist/io/las.hpp"
+#include "file_window.hpp"
+#include "streams.hpp"
 
 namespace pointillist {
 namespace {
@@ -63,8 +66,13 @@ std::string fixed_text(const char* p, std::size_t size) {
 
 class LasFile {
  public:
-  LasFile(const std::string& path, std::string_view data, bool compressed)
-      : path_(path), data_(data), compressed_(compressed) {}
+  // `data`: the file, or a prefix of it holding the public header (a streamed file) whose
+  // whole size is `file_size`.
+  LasFile(const std::string& path, std::string_view data, bool compressed,
+          std::uint64_t file_size = std::numeric_limits<std::uint64_t>::max())
+      : path_(path), data_(data), compressed_(compressed),
+        file_size_(file_size == std::numeric_limits<std::uint64_t>::max() ? data.size()
+                                                                           : file_size) {}
 
   [[noreturn]] void fail(std::uint64_t offset, const std::string& what) const {
     throw FormatError(path_ + ": byte " + std::to_string(offset) +
@@ -73,7 +81,7 @@ class LasFile {
 
   LasHeader parse_header() const {
     const char* d = data_.data();
-    const std::size_t size = data_.size();
+    const std::uint64_t size = file_size_;
     if (size == 0) fail(0, "file is empty (expected a LAS file starting with 'LASF')");
     if (size < 4 || std::memcmp(d, "LASF", 4) != 0)
       fail(0, "not a LAS file: expected the signature 'LASF', found " +
@@ -94,6 +102,8 @@ class LasFile {
       fail(kHeaderSizeAt, "header size " + std::to_string(header_size) + " is too small for LAS " +
                               std::to_string(h.major) + "." + std::to_string(h.minor) +
                               " (expected at least " + std::to_string(needed) + ")");
+    if (header_size > data_.size() && data_.size() < size)
+      fail(header_size, "the public header is larger than the part of the file read for it");
     if (header_size > size)
       fail(size, "file ends inside the public header (its size field says " +
                      std::to_string(header_size) + " bytes, the file has " + std::to_string(size) +
@@ -163,6 +173,7 @@ class LasFile {
   const std::string& path_;
   std::string_view data_;
   bool compressed_;
+  std::uint64_t file_size_;
 };
 
 // What the first pass finds over a range of records.
@@ -221,6 +232,97 @@ std::uint64_t las_limit(std::string_view prefix) {
   return offset + count * record + (1u << 20);
 }
 
+void scan_records(const char* records, std::size_t count, std::size_t stride, int rgb,
+                  RecordStats& s) {
+  for (std::size_t i = 0; i < count; ++i) {
+    const char* r = records + i * stride;
+    for (int a = 0; a < 3; ++a) {
+      const std::int32_t v = i32(r + 4 * a);
+      s.lo[a] = std::min(s.lo[a], v);
+      s.hi[a] = std::max(s.hi[a], v);
+    }
+    if (rgb >= 0)
+      s.max_color = std::max({s.max_color, u16(r + rgb), u16(r + rgb + 2), u16(r + rgb + 4)});
+  }
+}
+
+// How the records become points, from the first pass's statistics: positions are
+// integer * scale + shift, colours shifted right by color_shift.
+struct LasFrame {
+  double shift[3] = {};
+  std::array<double, 3> origin{};
+  int rgb = -1;  // byte offset of RGB in a record, -1 when colours are not read
+  int color_shift = 0;
+};
+
+// `find_record(axis, value)`: the index of the first record whose coordinate on `axis` is
+// `value` (for the message when a coordinate overflows).
+LasFrame las_frame(const std::string& path, const LasHeader& h, const RecordStats& stats,
+                   bool read_colors, bool shift_origin, bool compressed,
+                   const std::function<std::uint64_t(int, std::int32_t)>& find_record) {
+  // Every decoded coordinate must be finite (a huge scale or offset can overflow): coordinates
+  // are linear in the record's integer, so the axis extremes decide; the message names the
+  // first record that overflows.
+  const auto check_finite = [&](const double (&shift_by)[3]) {
+    for (int a = 0; a < 3; ++a) {
+      for (const std::int32_t v : {stats.lo[a], stats.hi[a]}) {
+        const double w = double(v) * h.scale[a] + shift_by[a];
+        if (std::isfinite(w) && std::fabs(w) <= double(std::numeric_limits<float>::max())) continue;
+        const std::uint64_t i = find_record(a, v);
+        LasFile(path, {}, compressed).fail(h.point_offset + i * h.record_length + 4 * a,
+             "point record " + std::to_string(i) + ": " + std::string(1, "XYZ"[a]) +
+                 " coordinate " + std::to_string(v) + " x scale " + format_double(h.scale[a]) +
+                 " + offset " + format_double(h.offset[a]) +
+                 " is not a finite number a float can hold; the header's scale or offset is "
+                 "wrong (fix them, e.g. with las2las, or re-export the scan)");
+      }
+    }
+  };
+  check_finite(h.offset);
+  LasFrame f;
+  if (shift_origin) {
+    for (int a = 0; a < 3; ++a) {
+      const double s = h.scale[a];
+      const double v0 = stats.lo[a] * s + h.offset[a], v1 = stats.hi[a] * s + h.offset[a];
+      const double lo = std::min(v0, v1), hi = std::max(v0, v1);
+      const double limit = std::ldexp(std::fabs(s), 23);
+      f.origin[a] = axis_origin(lo, hi, limit, power_of_ten_below(std::max(hi - lo, std::fabs(s))));
+    }
+  }
+  for (int a = 0; a < 3; ++a) f.shift[a] = h.offset[a] - f.origin[a];
+  check_finite(f.shift);
+  const int rgb = read_colors ? kRgbOffset[h.format] : -1;
+  f.rgb = rgb >= 0 && stats.max_color > 0 ? rgb : -1;
+  f.color_shift = stats.max_color > 255 ? 8 : 0;
+  return f;
+}
+
+void decode_records(const char* records, std::size_t count, std::size_t stride,
+                    const LasHeader& h, const LasFrame& f, Vec3f* positions, Rgb8* colors) {
+  for (std::size_t i = 0; i < count; ++i) {
+    const char* r = records + i * stride;
+    positions[i] = {static_cast<float>(i32(r) * h.scale[0] + f.shift[0]),
+                    static_cast<float>(i32(r + 4) * h.scale[1] + f.shift[1]),
+                    static_cast<float>(i32(r + 8) * h.scale[2] + f.shift[2])};
+    if (colors) {
+      const int rgb = f.rgb;
+      colors[i] = {static_cast<std::uint8_t>(u16(r + rgb) >> f.color_shift),
+                   static_cast<std::uint8_t>(u16(r + rgb + 2) >> f.color_shift),
+                   static_cast<std::uint8_t>(u16(r + rgb + 4) >> f.color_shift)};
+    }
+  }
+}
+
+std::vector<std::string> las_comments(const LasHeader& h) {
+  std::vector<std::string> comments;
+  comments.push_back("LAS " + std::to_string(h.major) + "." + std::to_string(h.minor) +
+                     ", point format " + std::to_string(h.format) + ", " +
+                     std::to_string(h.record_length) + "-byte records");
+  if (!h.system.empty()) comments.push_back("system identifier: " + h.system);
+  if (!h.software.empty()) comments.push_back("generating software: " + h.software);
+  return comments;
+}
+
 }  // namespace
 
 PointSet read_las(const std::string& path, Progress& progress, const LasReadOptions& options) {
@@ -241,86 +343,134 @@ PointSet read_las(const std::string& path, Progress& progress, const LasReadOpti
   std::vector<RecordStats> chunk_stats((n + kChunk - 1) / kChunk);
   for_chunks(options.pool, n, [&](std::size_t begin, std::size_t end) {
     RecordStats s;
-    for (std::size_t i = begin; i < end; ++i) {
-      const char* r = records + i * stride;
-      for (int a = 0; a < 3; ++a) {
-        const std::int32_t v = i32(r + 4 * a);
-        s.lo[a] = std::min(s.lo[a], v);
-        s.hi[a] = std::max(s.hi[a], v);
-      }
-      if (rgb >= 0)
-        s.max_color = std::max({s.max_color, u16(r + rgb), u16(r + rgb + 2), u16(r + rgb + 4)});
-    }
+    scan_records(records + begin * stride, end - begin, stride, rgb, s);
     chunk_stats[begin / kChunk] = s;
     read_progress.advance((end - begin) * stride);
   });
   RecordStats stats;
   for (const RecordStats& s : chunk_stats) stats.merge(s);
-
-  // Every decoded coordinate must be finite (a huge scale or offset can overflow): coordinates
-  // are linear in the record's integer, so the axis extremes decide; the message names the
-  // first record that overflows.
-  const auto check_finite = [&](const double (&shift_by)[3]) {
-    for (int a = 0; a < 3; ++a) {
-      for (const std::int32_t v : {stats.lo[a], stats.hi[a]}) {
-        const double w = double(v) * h.scale[a] + shift_by[a];
-        if (std::isfinite(w) && std::fabs(w) <= double(std::numeric_limits<float>::max())) continue;
-        std::size_t i = 0;
-        while (i + 1 < n && i32(records + i * stride + 4 * a) != v) ++i;
-        LasFile(path, data, gzip).fail(h.point_offset + i * stride + 4 * a,
-             "point record " + std::to_string(i) + ": " + std::string(1, "XYZ"[a]) +
-                 " coordinate " + std::to_string(v) + " x scale " + format_double(h.scale[a]) +
-                 " + offset " + format_double(h.offset[a]) +
-                 " is not a finite number a float can hold; the header's scale or offset is "
-                 "wrong (fix them, e.g. with las2las, or re-export the scan)");
-      }
-    }
-  };
-  if (n > 0) check_finite(h.offset);
-  std::array<double, 3> origin{};
-  if (options.shift_origin) {
-    for (int a = 0; a < 3; ++a) {
-      const double s = h.scale[a];
-      const double v0 = stats.lo[a] * s + h.offset[a], v1 = stats.hi[a] * s + h.offset[a];
-      const double lo = std::min(v0, v1), hi = std::max(v0, v1);
-      const double limit = std::ldexp(std::fabs(s), 23);
-      origin[a] = axis_origin(lo, hi, limit, power_of_ten_below(std::max(hi - lo, std::fabs(s))));
-    }
-  }
-  const double shift[3] = {h.offset[0] - origin[0], h.offset[1] - origin[1],
-                           h.offset[2] - origin[2]};
-  if (n > 0) check_finite(shift);
-  const bool has_colors = rgb >= 0 && stats.max_color > 0;
-  const int color_shift = stats.max_color > 255 ? 8 : 0;
+  const LasFrame frame =
+      las_frame(path, h, stats, options.read_colors, options.shift_origin, gzip,
+                [&](int axis, std::int32_t v) {
+                  std::size_t i = 0;
+                  while (i + 1 < n && i32(records + i * stride + 4 * axis) != v) ++i;
+                  return std::uint64_t{i};
+                });
 
   PointSet points;
   points.positions.resize(n);
-  if (has_colors) points.colors.resize(n);
+  if (frame.rgb >= 0) points.colors.resize(n);
   Vec3f* positions = points.positions.data();
-  Rgb8* colors = has_colors ? points.colors.data() : nullptr;
+  Rgb8* colors = frame.rgb >= 0 ? points.colors.data() : nullptr;
   for_chunks(options.pool, n, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
-      const char* r = records + i * stride;
-      positions[i] = {static_cast<float>(i32(r) * h.scale[0] + shift[0]),
-                      static_cast<float>(i32(r + 4) * h.scale[1] + shift[1]),
-                      static_cast<float>(i32(r + 8) * h.scale[2] + shift[2])};
-      if (colors)
-        colors[i] = {static_cast<std::uint8_t>(u16(r + rgb) >> color_shift),
-                     static_cast<std::uint8_t>(u16(r + rgb + 2) >> color_shift),
-                     static_cast<std::uint8_t>(u16(r + rgb + 4) >> color_shift)};
-    }
+    decode_records(records + begin * stride, end - begin, stride, h, frame, positions + begin,
+                   colors ? colors + begin : nullptr);
     read_progress.advance((end - begin) * stride);
   });
 
-  points.comments.push_back("LAS " + std::to_string(h.major) + "." + std::to_string(h.minor) +
-                            ", point format " + std::to_string(h.format) + ", " +
-                            std::to_string(h.record_length) + "-byte records");
-  if (!h.system.empty()) points.comments.push_back("system identifier: " + h.system);
-  if (!h.software.empty()) points.comments.push_back("generating software: " + h.software);
-  points.origin = origin;
+  points.comments = las_comments(h);
+  points.origin = frame.origin;
   points.up = {0, 0, 1};  // LAS coordinates are projected: x east, y north, z up
   read_progress.finish();
   return points;
 }
 
+namespace io_detail {
+namespace {
+
+class LasStream final : public PointStream {
+ public:
+  LasStream(std::unique_ptr<FileWindow> file, const LasHeader& header, const LasFrame& frame)
+      : file_(std::move(file)), header_(header), frame_(frame) {}
+
+  std::size_t read(PointSet& batch, std::size_t max) override {
+    const std::size_t stride = header_.record_length;
+    const std::uint64_t n =
+        std::min<std::uint64_t>({max, info_.point_count - next_,
+                                 std::max<std::uint64_t>(1, kStreamWindowBytes / stride)});
+    batch.positions.resize(n);
+    batch.colors.resize(frame_.rgb >= 0 ? n : 0);
+    batch.normals.clear();
+    batch.radii.clear();
+    batch.triangles.clear();
+    batch.comments.clear();
+    if (n == 0) return 0;
+    file_->read(header_.point_offset + next_ * stride, n * stride, buffer_);
+    decode_records(buffer_.data(), n, stride, header_, frame_, batch.positions.data(),
+                   frame_.rgb >= 0 ? batch.colors.data() : nullptr);
+    next_ += n;
+    return n;
+  }
+  void rewind() override { next_ = 0; }
+  std::uint64_t bytes_done() const override {
+    return header_.point_offset + next_ * header_.record_length;
+  }
+
+  void set_info(PointStreamInfo info) { info_ = std::move(info); }
+
+ private:
+  std::unique_ptr<FileWindow> file_;
+  LasHeader header_;
+  LasFrame frame_;
+  std::uint64_t next_ = 0;
+  std::vector<char> buffer_;
+};
+
+}  // namespace
+
+std::unique_ptr<PointStream> open_las_stream(const std::string& path,
+                                             const PointReadOptions& options) {
+  auto file = std::make_unique<FileWindow>(path);
+  std::vector<char> prefix;
+  file->read(0, static_cast<std::size_t>(std::min<std::uint64_t>(file->size(), 1 << 16)), prefix);
+  if (has_gzip_magic({prefix.data(), prefix.size()})) return nullptr;
+  const std::string_view head(prefix.data(), prefix.size());
+  const LasHeader h = LasFile(path, head, false, file->size()).parse_header();
+
+  // The first pass: the statistics read_las finds, a window at a time.
+  const std::size_t stride = h.record_length;
+  const std::uint64_t per_window = std::max<std::uint64_t>(1, kStreamWindowBytes / stride);
+  const int rgb = options.read_colors ? kRgbOffset[h.format] : -1;
+  RecordStats stats;
+  std::vector<char> window;
+  const auto for_windows = [&](const std::function<bool(std::uint64_t, std::uint64_t)>& fn) {
+    for (std::uint64_t first = 0; first < h.point_count; first += per_window) {
+      const std::uint64_t n = std::min(per_window, h.point_count - first);
+      file->read(h.point_offset + first * stride, static_cast<std::size_t>(n * stride), window);
+      if (!fn(first, n)) return;
+    }
+  };
+  for_windows([&](std::uint64_t, std::uint64_t n) {
+    scan_records(window.data(), static_cast<std::size_t>(n), stride, rgb, stats);
+    return true;
+  });
+  const LasFrame frame = las_frame(
+      path, h, stats, options.read_colors, true, false, [&](int axis, std::int32_t v) {
+        std::uint64_t found = h.point_count - 1;
+        for_windows([&](std::uint64_t first, std::uint64_t n) {
+          for (std::uint64_t i = 0; i < n; ++i) {
+            if (i32(window.data() + i * stride + 4 * axis) == v) {
+              found = first + i;
+              return false;
+            }
+          }
+          return true;
+        });
+        return found;
+      });
+
+  PointStreamInfo info;
+  info.path = path;
+  info.point_count = h.point_count;
+  info.has_colors = frame.rgb >= 0;
+  info.file_size = file->size();
+  info.origin = frame.origin;
+  info.up = {0, 0, 1};
+  info.comments = las_comments(h);
+  auto stream = std::make_unique<LasStream>(std::move(file), h, frame);
+  stream->set_info(std::move(info));
+  return stream;
+}
+
+}  // namespace io_detail
 }  // namespace pointillist

@@ -8,7 +8,7 @@
 namespace pointillist::ply {
 
 void BodyContext::fail_at_byte(std::size_t offset, const std::string& what) const {
-  throw FormatError(path + ": byte " + std::to_string(offset) +
+  throw FormatError(path + ": byte " + std::to_string(byte_base + offset) +
                     (compressed ? " (decompressed)" : "") + ": " + what);
 }
 
@@ -19,7 +19,8 @@ void BodyContext::fail_at_char(const char* pos, const std::string& what) const {
 
 std::string BodyContext::instance(std::size_t element, std::uint64_t index) const {
   const Element& e = header->elements[element];
-  return e.name + " " + std::to_string(index) + " of " + std::to_string(e.count);
+  return e.name + " " + std::to_string(index_base + index) + " of " +
+         std::to_string(index_total != 0 ? index_total : e.count);
 }
 
 std::string BodyContext::property(std::size_t element, std::size_t property_index) const {

@@ -76,6 +76,11 @@ struct BodyContext {
   ThreadPool* pool = nullptr;
   // Told about body bytes decoded, in chunks; may be called from several threads.
   std::function<void(std::uint64_t)> on_bytes;
+  // A window of a streamed file: `data` starts at byte `byte_base` of the file and its first
+  // vertex is vertex `index_base` of `index_total` (0: the header's count), for messages.
+  std::uint64_t byte_base = 0;
+  std::uint64_t index_base = 0;
+  std::uint64_t index_total = 0;
 
   // "path: byte N: what" (binary bodies).
   [[noreturn]] void fail_at_byte(std::size_t offset, const std::string& what) const;

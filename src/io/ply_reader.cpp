@@ -16,6 +16,8 @@
 #include "pointillist/core/error.hpp"
 #include "pointillist/core/thread_pool.hpp"
 #include "pointillist/io/ply.hpp"
+#include "file_window.hpp"
+#include "streams.hpp"
 
 namespace pointillist {
 namespace ply {
@@ -110,9 +112,9 @@ void plan_face(const std::string& path, const Element& element, ElementPlan& pla
 
 // Turns progress in body bytes into units of the file size; a .gz file spends the first half
 // of its units on inflating and the second half on decoding.
-class ReadProgress {
+class PlyProgress {
  public:
-  ReadProgress(Progress& progress, std::uint64_t total)
+  PlyProgress(Progress& progress, std::uint64_t total)
       : phase_(progress, "read", total), total_(total) {}
   void advance(std::uint64_t units) {
     if (units == 0) return;
@@ -132,6 +134,22 @@ class ReadProgress {
 };
 
 
+// The header's comments, except that our own writer's coordinate frame ("origin: X Y Z",
+// "up: X Y Z") goes to `origin` and `up`.
+void take_header_comments(const Header& header, std::vector<std::string>& comments,
+                          std::array<double, 3>& origin, Vec3f& up) {
+  for (const std::string& c : header.comments) {
+    if (c.starts_with("origin: ") && io_detail::read_triple(c, 8, origin)) continue;
+    std::array<double, 3> axis{};
+    if (c.starts_with("up: ") && io_detail::read_triple(c, 4, axis) &&
+        (axis[0] != 0 || axis[1] != 0 || axis[2] != 0)) {
+      up = normalized(Vec3f{float(axis[0]), float(axis[1]), float(axis[2])});
+      continue;
+    }
+    comments.push_back(c);
+  }
+}
+
 // Sizes a large output array. Asking for transparent huge pages before the first touch makes
 // filling hundreds of MB take a few hundred page faults instead of tens of thousands (measured:
 // the faults were a quarter of the time of a 200 MB binary read).
@@ -150,7 +168,7 @@ void resize_output(std::vector<T>& v, std::size_t n) {
 // One read: the header, the plans, the output arrays. Not movable (ctx points into it).
 class PlyRead {
  public:
-  PlyRead(const std::string& path, const PlyReadOptions& options, ReadProgress& progress)
+  PlyRead(const std::string& path, const PlyReadOptions& options, PlyProgress& progress)
       : options_(options), progress_(progress) {
     ctx.path = path;
     ctx.pool = options.pool;
@@ -228,20 +246,12 @@ class PlyRead {
 
   PointSet finish() {
     if (points.has_normals()) io_detail::finish_normals(points.normals);
-    // Our own writer keeps the coordinate frame in two comments ("origin: X Y Z", "up: X Y Z").
-    for (const std::string& c : header.comments) {
-      if (c.starts_with("origin: ") && io_detail::read_triple(c, 8, points.origin)) continue;
-      std::array<double, 3> up{};
-      if (c.starts_with("up: ") && io_detail::read_triple(c, 4, up) &&
-          (up[0] != 0 || up[1] != 0 || up[2] != 0)) {
-        points.up = normalized(Vec3f{float(up[0]), float(up[1]), float(up[2])});
-        continue;
-      }
-      points.comments.push_back(c);
-    }
+    take_header_comments(header, points.comments, points.origin, points.up);
     progress_.finish();
     return std::move(points);
   }
+
+  const VertexPlanResult& vertex_plan() const { return vertex_plan_; }
 
   Header header;
   BodyContext ctx;
@@ -249,7 +259,7 @@ class PlyRead {
 
  private:
   const PlyReadOptions& options_;
-  ReadProgress& progress_;
+  PlyProgress& progress_;
   VertexPlanResult vertex_plan_;
 };
 
@@ -289,7 +299,7 @@ std::uint64_t header_limit(std::string_view prefix, const std::string& path) {
 // is inflated.
 PointSet parse_stream(GzipInflater& inflater,
                       const std::function<StreamState(std::size_t)>& wait, const std::string& path,
-                      const PlyReadOptions& options, ReadProgress& progress) {
+                      const PlyReadOptions& options, PlyProgress& progress) {
   StreamState state = wait(1 << 16);
   while (!state.finished && !has_header_end({inflater.data(), state.available}))
     state = wait(std::max<std::size_t>(state.available * 2, 1 << 16));
@@ -324,7 +334,7 @@ PointSet parse_stream(GzipInflater& inflater,
 // the caller then starts over with a growing buffer.
 std::optional<PointSet> read_gzip_streaming(const FileBytes& raw,
                                             const std::string& path, const PlyReadOptions& options,
-                                            ReadProgress& progress,
+                                            PlyProgress& progress,
                                             const std::function<void(std::uint64_t)>& on_inflate) {
   GzipInflater inflater(raw.view(), path);
   inflater.set_limit([&](std::string_view prefix) { return header_limit(prefix, path); });
@@ -360,7 +370,7 @@ std::optional<PointSet> read_gzip_streaming(const FileBytes& raw,
 PointSet read_ply(const std::string& path, Progress& progress, const PlyReadOptions& options) {
   using namespace ply;
   FileBytes raw = FileBytes::map(path);
-  ReadProgress read_progress(progress, raw.file_size());
+  PlyProgress read_progress(progress, raw.file_size());
   // Inflating earns the first half of the progress units of a .gz file.
   std::uint64_t inflated = 0;
   const auto on_inflate = [&](std::uint64_t consumed) {
@@ -390,4 +400,150 @@ PointSet read_ply(const std::string& path, Progress& progress, const PlyReadOpti
   return read.finish();
 }
 
+namespace io_detail {
+namespace {
+
+using namespace ply;
+
+// Unit normals as finish_normals leaves them, a window at a time: a zero or non-finite normal
+// becomes (0, 0, 1). (read_ply drops the normals of a file where none is usable; the chunked
+// conversion asks saw_usable_normals() after its first pass for the same rule.)
+bool normalize_window(std::vector<Vec3f>& normals) {
+  bool any = false;
+  for (Vec3f& n : normals) {
+    const float length2 = dot(n, n);
+    if (length2 > 0.99999f && length2 < 1.00001f) {
+      any = true;
+    } else if (length2 > 0.0f && std::isfinite(length2)) {
+      n = n / std::sqrt(length2);
+      any = true;
+    } else {
+      n = {0, 0, 1};
+    }
+  }
+  return any;
+}
+
+class PlyStream final : public PointStream {
+ public:
+  PlyStream(std::unique_ptr<FileWindow> file, const Header& header, std::size_t vertex_element,
+            const ElementPlan& plan, std::uint64_t vertex_offset, const VertexPlanResult& vp,
+            ThreadPool* pool)
+      : file_(std::move(file)), vertex_offset_(vertex_offset), vp_(vp) {
+    window_header_.format = header.format;
+    window_header_.elements = {header.elements[vertex_element]};
+    window_header_.body_offset = 0;
+    ctx_.path = file_->path();
+    ctx_.header = &window_header_;
+    ctx_.plans = {plan};
+    ctx_.pool = pool;
+    std::copy_n(vp.scales, 3, ctx_.vertex.color_scale);
+  }
+
+  std::size_t read(PointSet& batch, std::size_t max) override {
+    Element& element = window_header_.elements[0];
+    const std::size_t stride = element.fixed_size();
+    const std::uint64_t n =
+        std::min<std::uint64_t>({max, info_.point_count - next_,
+                                 std::max<std::uint64_t>(1, kStreamWindowBytes / stride)});
+    batch.positions.resize(n);
+    batch.normals.resize(vp_.normals ? n : 0);
+    batch.colors.resize(vp_.colors ? n : 0);
+    batch.radii.resize(vp_.radii ? n : 0);
+    batch.triangles.clear();
+    batch.comments.clear();
+    if (n == 0) return 0;
+    const std::uint64_t at = vertex_offset_ + next_ * stride;
+    file_->read(at, static_cast<std::size_t>(n * stride), buffer_);
+    element.count = n;
+    ctx_.data = {buffer_.data(), buffer_.size()};
+    ctx_.vertex_count = n;
+    ctx_.vertex.positions = batch.positions.data();
+    ctx_.vertex.normals = vp_.normals ? batch.normals.data() : nullptr;
+    ctx_.vertex.colors = vp_.colors ? batch.colors.data() : nullptr;
+    ctx_.vertex.radii = vp_.radii ? batch.radii.data() : nullptr;
+    ctx_.byte_base = at;
+    ctx_.index_base = next_;
+    ctx_.index_total = info_.point_count;
+    std::vector<Triangle> none;
+    decode_binary_body(ctx_, none);
+    if (vp_.normals && normalize_window(batch.normals)) usable_normals_ = true;
+    next_ += n;
+    return n;
+  }
+  void rewind() override { next_ = 0; }
+  std::uint64_t bytes_done() const override {
+    return vertex_offset_ + next_ * window_header_.elements[0].fixed_size();
+  }
+  bool saw_usable_normals() const override { return usable_normals_; }
+
+  void set_info(PointStreamInfo info) { info_ = std::move(info); }
+
+ private:
+  std::unique_ptr<FileWindow> file_;
+  std::uint64_t vertex_offset_;
+  VertexPlanResult vp_;
+  Header window_header_;
+  BodyContext ctx_;
+  std::uint64_t next_ = 0;
+  bool usable_normals_ = false;
+  std::vector<char> buffer_;
+};
+
+}  // namespace
+
+std::unique_ptr<PointStream> open_ply_stream(const std::string& path,
+                                             const PointReadOptions& options) {
+  auto file = std::make_unique<FileWindow>(path);
+  constexpr std::size_t kMaxHeaderBytes = 16 << 20;
+  std::vector<char> prefix;
+  for (std::size_t want = 1 << 16;; want *= 4) {
+    file->read(0, static_cast<std::size_t>(std::min<std::uint64_t>(file->size(), want)), prefix);
+    const std::string_view head(prefix.data(), prefix.size());
+    if (has_gzip_magic(head)) return nullptr;
+    if (has_header_end(head) || prefix.size() == file->size() || want >= kMaxHeaderBytes) break;
+  }
+  PlyProgress progress(Progress::none(), 1);
+  const PlyReadOptions read_options{.read_colors = options.read_colors, .pool = options.pool};
+  PlyRead read(path, read_options, progress);
+  read.prepare({prefix.data(), prefix.size()}, false);
+  const Header& header = read.header;
+  if (header.format == Format::Ascii) return nullptr;
+  std::uint64_t offset = header.body_offset;
+  std::size_t vertex = 0;
+  for (; header.elements[vertex].name != "vertex"; ++vertex) {
+    const Element& e = header.elements[vertex];
+    if (e.has_lists()) return nullptr;  // where the vertices start depends on the lists
+    offset += e.count * e.fixed_size();
+  }
+  const Element& element = header.elements[vertex];
+  if (element.has_lists()) return nullptr;
+  const std::uint64_t need = offset + element.count * element.fixed_size();
+  if (need > file->size()) {
+    throw FormatError(path + ": byte " + std::to_string(file->size()) + ": file ends early: " +
+                      std::to_string(element.count) + " vertices of " +
+                      std::to_string(element.fixed_size()) + " bytes from byte " +
+                      std::to_string(offset) + " need " + std::to_string(need) +
+                      " bytes, the file has " + std::to_string(file->size()) +
+                      "; the file is truncated");
+  }
+  PointStreamInfo info;
+  info.path = path;
+  info.point_count = element.count;
+  info.has_normals = read.vertex_plan().normals;
+  info.has_colors = read.vertex_plan().colors;
+  info.has_radii = read.vertex_plan().radii;
+  for (std::size_t e = 0; e < header.elements.size(); ++e) {
+    if (read.ctx.plans[e].kind == ElementPlan::Kind::Face && header.elements[e].count > 0)
+      info.is_mesh = true;
+  }
+  info.file_size = file->size();
+  take_header_comments(header, info.comments, info.origin, info.up);
+  auto stream = std::make_unique<PlyStream>(std::move(file), header, vertex, read.ctx.plans[vertex],
+                                            offset, read.vertex_plan(), options.pool);
+  stream->set_info(std::move(info));
+  return stream;
+}
+
+}  // namespace io_detail
 }  // namespace pointillist

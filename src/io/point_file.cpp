@@ -4,6 +4,7 @@
 
 #include <cctype>
 #include <charconv>
+#include <filesystem>
 #include <string_view>
 
 #include "pointillist/core/error.hpp"
@@ -11,6 +12,8 @@
 #include "pointillist/io/obj.hpp"
 #include "pointillist/io/ply.hpp"
 #include "pointillist/io/xyz.hpp"
+#include "pointillist/io/point_stream.hpp"
+#include "streams.hpp"
 #include "text_numbers.hpp"
 
 namespace pointillist {
@@ -93,6 +96,76 @@ std::optional<std::array<double, 3>> point_set_origin(const PointSet& points) {
     }
   }
   return std::nullopt;
+}
+
+namespace {
+
+// A file without a streaming form, read whole when opened and handed out in batches.
+class WholeFileStream final : public PointStream {
+ public:
+  WholeFileStream(const std::string& path, PointSet points) : points_(std::move(points)) {
+    info_.path = path;
+    info_.point_count = points_.size();
+    info_.has_normals = points_.has_normals();
+    info_.has_colors = points_.has_colors();
+    info_.has_radii = points_.has_radii();
+    info_.is_mesh = points_.is_mesh();
+    info_.streamed = false;
+    info_.resident_bytes = points_.size() * (sizeof(Vec3f) * (1 + info_.has_normals) +
+                                             sizeof(Rgb8) * info_.has_colors +
+                                             sizeof(float) * info_.has_radii) +
+                           points_.triangles.size() * sizeof(points_.triangles[0]);
+    std::error_code error;
+    info_.file_size = std::filesystem::file_size(path, error);
+    info_.origin = point_set_origin(points_).value_or(std::array<double, 3>{});
+    info_.up = points_.up;
+    for (const std::string& c : points_.comments) {
+      if (!c.starts_with("origin: ")) info_.comments.push_back(c);
+    }
+  }
+
+  std::size_t read(PointSet& batch, std::size_t max) override {
+    const std::size_t n = std::min(max, points_.size() - next_);
+    const auto take = [&](auto& dst, const auto& src) {
+      if (src.empty()) {
+        dst.clear();
+      } else {
+        dst.assign(src.begin() + std::ptrdiff_t(next_), src.begin() + std::ptrdiff_t(next_ + n));
+      }
+    };
+    take(batch.positions, points_.positions);
+    take(batch.normals, points_.normals);
+    take(batch.colors, points_.colors);
+    take(batch.radii, points_.radii);
+    batch.triangles.clear();
+    batch.comments.clear();
+    next_ += n;
+    return n;
+  }
+  void rewind() override { next_ = 0; }
+  std::uint64_t bytes_done() const override {
+    return points_.size() == 0 ? info_.file_size : info_.file_size * next_ / points_.size();
+  }
+
+ private:
+  PointSet points_;
+  std::size_t next_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<PointStream> open_point_stream(const std::string& path,
+                                               const PointReadOptions& options) {
+  if (!std::filesystem::exists(path)) {
+    throw IoError(path + ": no such file; check the path (models fetched by "
+                         "scripts/fetch-models.sh are in ~/.cache/pointillist/models)");
+  }
+  std::unique_ptr<PointStream> stream;
+  const Kind kind = kind_of(path);
+  if (kind == Kind::Ply) stream = io_detail::open_ply_stream(path, options);
+  if (kind == Kind::Las) stream = io_detail::open_las_stream(path, options);
+  if (stream) return stream;
+  return std::make_unique<WholeFileStream>(path, read_point_file(path, Progress::none(), options));
 }
 
 }  // namespace pointillist

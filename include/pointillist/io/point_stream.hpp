@@ -1,0 +1,69 @@
+// Scan files read a batch of points at a time, in constant memory: the input side of the
+// chunked conversion (pipeline/chunked_convert.hpp), which reads its inputs several times and
+// never holds them whole.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pointillist/core/point_set.hpp"
+#include "pointillist/io/point_file.hpp"
+
+namespace pointillist {
+
+// What a stream knows once it is open.
+struct PointStreamInfo {
+  std::string path;
+  std::uint64_t point_count = 0;  // points the stream yields
+  bool has_normals = false;
+  bool has_colors = false;
+  bool has_radii = false;
+  // The file has faces (a mesh): its vertices stream like points, but the faces do not; the
+  // chunked conversion takes point clouds only.
+  bool is_mesh = false;
+  // Read in windows of the file, so memory does not grow with the file. False: the reader has
+  // no streaming form for this file (text, OBJ, ASCII PLY and compressed files are read whole
+  // when the stream opens) and `resident_bytes` says what it holds.
+  bool streamed = true;
+  std::uint64_t resident_bytes = 0;
+  std::uint64_t file_size = 0;
+  // The frame and comments read_point_file would give (origin = 0 when positions are absolute).
+  std::array<double, 3> origin{};
+  Vec3f up{0, 1, 0};
+  std::vector<std::string> comments;
+};
+
+class PointStream {
+ public:
+  virtual ~PointStream() = default;
+  const PointStreamInfo& info() const { return info_; }
+  // Replaces `batch`'s positions (and normals, colors, radii as info() says; triangles and
+  // comments are left empty) with the next points, at most `max`; returns how many (0 at the
+  // end). The points are those read_point_file returns, in the same order and bits. Throws
+  // FormatError naming the file and byte (or line) of bad data, IoError when reading fails.
+  virtual std::size_t read(PointSet& batch, std::size_t max) = 0;
+  // Starts again from the first point.
+  virtual void rewind() = 0;
+  // Bytes of the file consumed by the reads since the last rewind (for progress).
+  virtual std::uint64_t bytes_done() const = 0;
+  // Whether some normal read so far was usable (not zero, finite). A file whose normals are all
+  // unusable has none in substance: read_point_file drops them, and a caller that streams the
+  // whole file should too.
+  virtual bool saw_usable_normals() const { return info_.has_normals; }
+
+ protected:
+  PointStreamInfo info_;
+};
+
+// Opens `path` as read_point_file would read it (the reader chosen by the extension). Binary
+// PLY (a vertex element of fixed-size records) and LAS are streamed; LAS runs one pass over the
+// records at open to find the origin and colour scale read_las uses. Other files are read whole
+// at open (info().streamed false). Throws what read_point_file throws for a bad file, and
+// IoError for a missing one.
+std::unique_ptr<PointStream> open_point_stream(const std::string& path,
+                                               const PointReadOptions& options = {});
+
+}  // namespace pointillist

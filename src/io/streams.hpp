@@ -1,0 +1,27 @@
+// The streaming forms of the readers (private to io; see point_stream.hpp).
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "pointillist/io/point_stream.hpp"
+
+namespace pointillist::io_detail {
+
+// A binary PLY file whose vertex element has fixed-size records and follows only fixed-size
+// elements, read a window of vertices at a time; null for any other PLY file (ASCII, gzip,
+// lists before or in the vertex element), which the caller reads whole. Throws what read_ply
+// throws for a bad header or a file too short for its vertices.
+std::unique_ptr<PointStream> open_ply_stream(const std::string& path,
+                                             const PointReadOptions& options);
+
+// An uncompressed LAS file, read a window of records at a time after one pass over all of them
+// (the origin and the colour scale, as read_las finds them); null for a gzip file. Throws what
+// read_las throws.
+std::unique_ptr<PointStream> open_las_stream(const std::string& path,
+                                             const PointReadOptions& options);
+
+// The bytes of a window: enough for a few million records without holding many at once.
+inline constexpr std::size_t kStreamWindowBytes = std::size_t{32} << 20;
+
+}  // namespace pointillist::io_detail

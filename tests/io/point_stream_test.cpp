@@ -1,0 +1,216 @@
+// Streamed reading: every stream yields, batch by batch, exactly the points read_point_file
+// reads from the same file (the whole-file readers are the oracle), and bad data is reported
+// at the same place.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include "io/io_test_support.hpp"
+#include "io/las_builder.hpp"
+#include "pointillist/core/error.hpp"
+#include "pointillist/io/ply.hpp"
+#include "pointillist/io/point_stream.hpp"
+#include "testing/testing.hpp"
+
+namespace pointillist {
+namespace {
+
+using testing::TempDir;
+
+// Every point of `stream`, read `batch` at a time (twice, with a rewind in between, to check
+// that rewinding starts over).
+PointSet drain(PointStream& stream, std::size_t batch) {
+  PointSet all, part;
+  for (int pass = 0; pass < 2; ++pass) {
+    all = PointSet{};
+    stream.rewind();
+    while (const std::size_t n = stream.read(part, batch)) {
+      EXPECT_LE(n, batch);
+      EXPECT_EQ(part.size(), n);
+      const auto append = [](auto& dst, const auto& src) {
+        dst.insert(dst.end(), src.begin(), src.end());
+      };
+      append(all.positions, part.positions);
+      append(all.normals, part.normals);
+      append(all.colors, part.colors);
+      append(all.radii, part.radii);
+    }
+  }
+  return all;
+}
+
+template <class T>
+bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
+}
+
+void expect_same_points(const PointSet& streamed, const PointSet& whole) {
+  EXPECT_EQ(streamed.size(), whole.size());
+  EXPECT_TRUE(same_bits(streamed.positions, whole.positions));
+  EXPECT_TRUE(same_bits(streamed.normals, whole.normals));
+  EXPECT_TRUE(same_bits(streamed.colors, whole.colors));
+  EXPECT_TRUE(same_bits(streamed.radii, whole.radii));
+}
+
+PointSet sample_points(std::size_t n, bool normals, bool colors, bool radii) {
+  PointSet p;
+  for (std::size_t i = 0; i < n; ++i) {
+    const float t = float(i) * 0.37f;
+    p.positions.push_back({std::cos(t) * 3.0f, std::sin(t) * 2.0f, float(i) * 0.01f - 4.0f});
+    if (normals) p.normals.push_back(normalized(Vec3f{std::cos(t), std::sin(t), 0.25f}));
+    if (colors) p.colors.push_back({std::uint8_t(i), std::uint8_t(i * 7), std::uint8_t(i * 13)});
+    if (radii) p.radii.push_back(0.01f + float(i % 17) * 0.001f);
+  }
+  return p;
+}
+
+TEST(PointStream, BinaryPlyGivesTheSamePointsAsTheWholeFileReader) {
+  TempDir dir;
+  for (const PlyEncoding encoding : {PlyEncoding::BinaryLittleEndian,
+                                     PlyEncoding::BinaryBigEndian}) {
+    const std::string path = dir.file("cloud.ply");
+    PointSet points = sample_points(5000, true, true, true);
+    points.origin = {1000.5, -20, 3};
+    points.up = {0, 0, 1};
+    points.comments = {"scanned on a Tuesday"};
+    write_ply(path, points, {.encoding = encoding});
+    const auto stream = open_point_stream(path);
+    const PointStreamInfo& info = stream->info();
+    EXPECT_TRUE(info.streamed);
+    EXPECT_FALSE(info.is_mesh);
+    EXPECT_EQ(info.point_count, 5000u);
+    EXPECT_TRUE(info.has_normals && info.has_colors && info.has_radii);
+    const PointSet whole = read_point_file(path);
+    EXPECT_EQ(info.origin, whole.origin);
+    EXPECT_EQ(info.up, whole.up);
+    EXPECT_EQ(info.comments, whole.comments);
+    expect_same_points(drain(*stream, 777), whole);
+    EXPECT_EQ(stream->bytes_done(), info.file_size);
+    EXPECT_TRUE(stream->saw_usable_normals());
+  }
+}
+
+// Hand-made bytes: an element of fixed-size records before the vertices, and faces after them.
+TEST(PointStream, FindsVerticesAfterAnotherElementAndFlagsMeshes) {
+  TempDir dir;
+  std::string bytes =
+      "ply\nformat binary_little_endian 1.0\nelement camera 2\nproperty double a\n"
+      "property uchar b\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  for (int c = 0; c < 2; ++c) {
+    testing::put(bytes, 1.5 * c);
+    testing::put(bytes, std::uint8_t(c));
+  }
+  for (int v = 0; v < 3; ++v) {
+    testing::put(bytes, float(v));
+    testing::put(bytes, float(v * 2));
+    testing::put(bytes, float(-v));
+  }
+  testing::put(bytes, std::uint8_t(3));
+  for (int v = 0; v < 3; ++v) testing::put(bytes, std::int32_t(v));
+  const std::string path = dir.file("mesh.ply");
+  testing::write_file(path, bytes);
+  const auto stream = open_point_stream(path);
+  EXPECT_TRUE(stream->info().streamed);
+  EXPECT_TRUE(stream->info().is_mesh);
+  const PointSet streamed = drain(*stream, 2);
+  ASSERT_EQ(streamed.size(), 3u);
+  EXPECT_EQ(streamed.positions[2], (Vec3f{2, 4, -2}));
+  expect_same_points(streamed, read_point_file(path));
+}
+
+TEST(PointStream, ReportsBadValuesAtTheSamePlaceAsTheWholeFileReader) {
+  TempDir dir;
+  PointSet points = sample_points(3000, false, false, false);
+  points.positions[2345].y = std::numeric_limits<float>::quiet_NaN();
+  const std::string path = dir.file("nan.ply");
+  write_ply(path, points);
+  std::string whole_message, stream_message;
+  try {
+    read_point_file(path);
+  } catch (const FormatError& e) {
+    whole_message = e.what();
+  }
+  try {
+    const auto stream = open_point_stream(path);
+    drain(*stream, 1000);
+  } catch (const FormatError& e) {
+    stream_message = e.what();
+  }
+  EXPECT_NE(whole_message.find("vertex 2345 of 3000"), std::string::npos) << whole_message;
+  EXPECT_EQ(stream_message, whole_message);
+}
+
+TEST(PointStream, RefusesATruncatedBinaryPlyWhenOpened) {
+  TempDir dir;
+  const std::string path = dir.file("short.ply");
+  write_ply(path, sample_points(100, false, true, false));
+  std::string bytes = testing::read_file(path);
+  bytes.resize(bytes.size() - 5);
+  testing::write_file(path, bytes);
+  try {
+    open_point_stream(path);
+    FAIL() << "a truncated file opened";
+  } catch (const FormatError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find(path), std::string::npos) << m;
+    EXPECT_NE(m.find("truncated"), std::string::npos) << m;
+  }
+}
+
+TEST(PointStream, AllZeroNormalsAreSeenAsUnusable) {
+  TempDir dir;
+  PointSet points = sample_points(50, true, false, false);
+  for (Vec3f& n : points.normals) n = {0, 0, 0};
+  const std::string path = dir.file("zeros.ply");
+  write_ply(path, points);
+  EXPECT_FALSE(read_point_file(path).has_normals());  // what the stream must let callers know
+  const auto stream = open_point_stream(path);
+  drain(*stream, 16);
+  EXPECT_FALSE(stream->saw_usable_normals());
+}
+
+TEST(PointStream, TextAndAsciiFilesAreReadWholeWithTheSamePoints) {
+  TempDir dir;
+  const std::string ascii = dir.file("cloud.ply");
+  write_ply(ascii, sample_points(300, true, true, false), {.encoding = PlyEncoding::Ascii});
+  const std::string text = dir.file("cloud.xyz");
+  testing::write_file(text, "1 2 3 255 0 0\n4 5 6 0 255 0\n7 8 9 0 0 255\n");
+  for (const std::string& path : {ascii, text}) {
+    const auto stream = open_point_stream(path);
+    EXPECT_FALSE(stream->info().streamed);
+    EXPECT_GT(stream->info().resident_bytes, 0u);
+    expect_same_points(drain(*stream, 64), read_point_file(path));
+  }
+}
+
+TEST(PointStream, LasGivesTheSamePointsOriginAndColoursAsTheWholeFileReader) {
+  TempDir dir;
+  testing::LasSpec spec{.format = 3, .scale = {0.01, 0.01, 0.01}, .offset = {500000, 5400000, 0}};
+  std::vector<testing::LasPoint> points;
+  for (std::int32_t i = 0; i < 70000; ++i) {
+    points.push_back({i * 7 - 5000, (i * 13) % 100000, -i, static_cast<std::uint16_t>(i * 5),
+                      static_cast<std::uint16_t>(i * 3), static_cast<std::uint16_t>(i)});
+  }
+  const std::string path = dir.file("tile.las");
+  testing::write_file(path, testing::build_las(spec, points));
+  const auto stream = open_point_stream(path);
+  EXPECT_TRUE(stream->info().streamed);
+  const PointSet whole = read_point_file(path);
+  EXPECT_EQ(stream->info().origin, whole.origin);
+  EXPECT_NE(whole.origin, (std::array<double, 3>{}));  // the shift is exercised
+  EXPECT_EQ(stream->info().up, whole.up);
+  EXPECT_EQ(stream->info().comments, whole.comments);
+  EXPECT_TRUE(stream->info().has_colors);
+  expect_same_points(drain(*stream, 4096), whole);
+}
+
+TEST(PointStream, MissingFileIsAnIoError) {
+  TempDir dir;
+  EXPECT_THROW(open_point_stream(dir.file("nothing.ply")), IoError);
+}
+
+}  // namespace
+}  // namespace pointillist
