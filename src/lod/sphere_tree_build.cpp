@@ -182,7 +182,8 @@ void compute_attributes(const PointSet& points, std::span<const std::uint32_t> o
 }  // namespace
 
 SphereTree build_sphere_tree(const PointSet& points, ThreadPool& pool, Progress& progress,
-                             const SphereTreeOptions& options) {
+                             const SphereTreeOptions& options,
+                             std::vector<std::uint32_t>* split_order) {
   lod_detail::check_splat_attributes(points, "cannot build a splat hierarchy");
   const auto n = static_cast<std::uint32_t>(points.size());
   SphereTree tree;
@@ -199,8 +200,14 @@ SphereTree build_sphere_tree(const PointSet& points, ThreadPool& pool, Progress&
   ProgressPhase phase(progress, "hierarchy", std::uint64_t{n} + shape.node_count);
 
   // The partition first: its per-axis lists are freed before the node array is allocated.
-  const std::vector<std::uint32_t> order = lod_detail::median_split_order(
-      points.positions, pool, options.parallel_grain_points, progress);
+  std::vector<std::uint32_t> order;
+  if (options.presorted) {
+    order.resize(n);
+    for (std::uint32_t i = 0; i < n; ++i) order[i] = i;
+  } else {
+    order = lod_detail::median_split_order(points.positions, pool, options.parallel_grain_points,
+                                           progress);
+  }
 
   tree.nodes.resize(shape.node_count);
   std::vector<std::uint32_t> range_begin(shape.node_count);
@@ -208,6 +215,7 @@ SphereTree build_sphere_tree(const PointSet& points, ThreadPool& pool, Progress&
   tree.depth = static_cast<std::uint32_t>(levels.size() - 2);
 
   compute_attributes(points, order, range_begin, levels, tree.nodes, pool, phase);
+  if (split_order) *split_order = std::move(order);
   return tree;
 }
 

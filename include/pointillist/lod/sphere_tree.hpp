@@ -69,6 +69,9 @@ struct SphereTreeOptions {
   // Subtrees smaller than this many points are built by one task; larger ones split in parallel.
   // Only changes speed, never the result.
   std::size_t parallel_grain_points = 1 << 15;
+  // The points are already in the order the median splits put them in (a build's `split_order`
+  // applied to its points): the partition is skipped, and the tree is the one that build made.
+  bool presorted = false;
 };
 
 // Builds the hierarchy over `points` (positions, normals and radii required; colors optional).
@@ -84,9 +87,22 @@ struct SphereTreeOptions {
 // "hierarchy". Throws Error when points is empty, when normals or radii are missing or of the
 // wrong length, on more than 2^31 points, or when a position, normal or radius is not finite
 // (radius also negative), naming the point.
+// With `split_order`, also the order of the points that the splits found: leaf k of the tree in
+// range order is points[split_order[k]] (a build over the points in that order with
+// `presorted` gives the same tree without partitioning again).
 SphereTree build_sphere_tree(const PointSet& points, ThreadPool& pool,
                              Progress& progress = Progress::none(),
-                             const SphereTreeOptions& options = {});
+                             const SphereTreeOptions& options = {},
+                             std::vector<std::uint32_t>* split_order = nullptr);
+
+// The top of a hierarchy over subtrees built apart (the chunked conversion): the `roots` (the
+// root nodes of the subtrees, in a spatially coherent order) become, in order, the last level of
+// a breadth-first tree whose interior nodes have 2-4 children and bound them as
+// build_sphere_tree's do; every root is at the same depth, ceil(log4(roots)). The roots keep
+// their child_count (their children are not in this tree) and get first_child 0. bounds,
+// view_sphere, leaf_count, origin and up are left for the caller. Throws Error for no roots or
+// more than 2^20.
+SphereTree build_top_tree(std::span<const SphereNode> roots, bool has_colors);
 
 // The leaves of a hierarchy as splats: positions = leaf centres, normals, radii and (when the
 // tree has them) colors, in node order. Lets another level-of-detail structure (e.g. a Sequential
