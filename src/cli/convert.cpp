@@ -1,4 +1,6 @@
 // `pointillist convert`: pipeline::convert with a progress bar and a summary line.
+#include <sys/resource.h>
+
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -32,6 +34,17 @@ int run_convert(const ConvertCommandOptions& o) {
     std::printf("converted %zu points in %.2f s (%.2f M points/s) -> %s, %s, %.1f bytes/point\n",
                 n, seconds, n / seconds / 1e6, o.output.c_str(), human_bytes(size).c_str(),
                 n ? size / double(n) : 0.0);
+    struct rusage usage {};
+    ::getrusage(RUSAGE_SELF, &usage);
+    const double peak = double(usage.ru_maxrss) * 1024.0;
+    if (r.chunks > 0) {
+      std::printf("in %zu chunks (%.1f%% halo points), peak memory %s (%.0f bytes/point)\n",
+                  r.chunks, n ? 100.0 * double(r.halo_points) / double(n) : 0.0,
+                  human_bytes(peak).c_str(), n ? peak / double(n) : 0.0);
+    } else {
+      std::printf("in one piece, peak memory %s (%.0f bytes/point)\n", human_bytes(peak).c_str(),
+                  n ? peak / double(n) : 0.0);
+    }
   }
   return 0;
 }
@@ -78,13 +91,20 @@ Command add_convert_command(CLI::App& app) {
                      {{"side", EdgeTest::Side}, {"linsen", EdgeTest::Linsen}},
                      "With --features: side (per pair) or linsen (angular gap)", "side")
       ->group(kGroupOutput);
+  auto memory = std::make_shared<std::string>();
+  cmd->add_option("--memory", *memory,
+                  "Memory the conversion may use (e.g. 8G, 500M; default: half of the physical "
+                  "memory). Point clouds that need more are converted to .ptl in chunks");
+  cmd->add_option("--chunk-points", o->convert.chunk_points,
+                  ".ptl: convert in chunks of at most this many points, whatever the memory");
   add_columns(cmd, o->convert.columns);
   add_prepare_options(cmd, o->convert.prepare);
   add_threads(cmd, o->threads);
   cmd->add_flag("-q,--quiet", o->quiet, "No progress bars and no summary");
-  return {cmd, [o, trim, trim_option, features, with_features] {
+  return {cmd, [o, trim, trim_option, features, with_features, memory] {
             if (trim_option->count() > 0) o->convert.leaf_trim = *trim;
             if (*with_features) o->convert.features = *features;
+            if (!memory->empty()) o->convert.memory_budget = parse_bytes(*memory, "--memory");
             return run_convert(*o);
           }};
 }

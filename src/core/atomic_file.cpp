@@ -157,6 +157,19 @@ void AtomicFile::write(const void* data, std::size_t size) {
   used_ += size;
 }
 
+void AtomicFile::write_at(std::uint64_t offset, const void* data, std::size_t size) {
+  flush();
+  const char* bytes = static_cast<const char*>(data);
+  while (size > 0) {
+    const ssize_t n = ::pwrite(fd_, bytes, size, static_cast<off_t>(offset));
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) throw IoError(errno_message("cannot write " + path_ + " (its temporary file " + temp_path_ + ")"));
+    bytes += n;
+    offset += static_cast<std::uint64_t>(n);
+    size -= static_cast<std::size_t>(n);
+  }
+}
+
 void AtomicFile::flush() {
   const char* p = buffer_.data();
   std::size_t left = used_;

@@ -472,5 +472,13 @@ std::unique_ptr<PointStream> open_las_stream(const std::string& path,
   return stream;
 }
 
+std::optional<std::uint64_t> las_header_point_count(const std::string& path) {
+  FileWindow file(path);
+  std::vector<char> prefix;
+  file.read(0, static_cast<std::size_t>(std::min<std::uint64_t>(file.size(), 1 << 16)), prefix);
+  if (has_gzip_magic({prefix.data(), prefix.size()})) return std::nullopt;
+  return LasFile(path, {prefix.data(), prefix.size()}, false, file.size()).parse_header().point_count;
+}
+
 }  // namespace io_detail
 }  // namespace pointillist

@@ -168,4 +168,21 @@ std::unique_ptr<PointStream> open_point_stream(const std::string& path,
   return std::make_unique<WholeFileStream>(path, read_point_file(path, Progress::none(), options));
 }
 
+std::uint64_t point_count_estimate(const std::string& path) {
+  if (!std::filesystem::exists(path)) {
+    throw IoError(path + ": no such file; check the path (models fetched by "
+                         "scripts/fetch-models.sh are in ~/.cache/pointillist/models)");
+  }
+  const Kind kind = kind_of(path);
+  if (kind == Kind::Ply) {
+    if (const auto stream = io_detail::open_ply_stream(path, {})) return stream->info().point_count;
+  }
+  if (kind == Kind::Las) {
+    if (const auto count = io_detail::las_header_point_count(path)) return *count;
+  }
+  const std::uint64_t size = std::filesystem::file_size(path);
+  const bool gzip = path.size() > 3 && path.compare(path.size() - 3, 3, ".gz") == 0;
+  return (gzip ? 16 : 1) * size / 6 + 1;
+}
+
 }  // namespace pointillist

@@ -1,7 +1,9 @@
 // The streaming forms of the readers (private to io; see point_stream.hpp).
 #pragma once
 
+#include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "pointillist/io/point_stream.hpp"
@@ -20,6 +22,10 @@ std::unique_ptr<PointStream> open_ply_stream(const std::string& path,
 // read_las throws.
 std::unique_ptr<PointStream> open_las_stream(const std::string& path,
                                              const PointReadOptions& options);
+
+// The point count a LAS file's header states (checked as read_las checks it: every record must
+// be in the file); nothing for a gzip file. Throws what read_las throws for a bad header.
+std::optional<std::uint64_t> las_header_point_count(const std::string& path);
 
 // The bytes of a window: enough for a few million records without holding many at once.
 inline constexpr std::size_t kStreamWindowBytes = std::size_t{32} << 20;

@@ -181,6 +181,10 @@ void compute_attributes(const PointSet& points, std::span<const std::uint32_t> o
 
 }  // namespace
 
+bool sphere_tree_root_halves(std::uint64_t n) {
+  return n < (std::uint64_t{1} << 32) && tree_shape(static_cast<std::uint32_t>(n)).root_halves_only;
+}
+
 SphereTree build_sphere_tree(const PointSet& points, ThreadPool& pool, Progress& progress,
                              const SphereTreeOptions& options,
                              std::vector<std::uint32_t>* split_order) {

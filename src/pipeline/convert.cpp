@@ -3,6 +3,8 @@
 
 #include "pointillist/core/atomic_file.hpp"
 
+#include <unistd.h>
+
 #include <filesystem>
 #include <sstream>
 
@@ -14,6 +16,8 @@
 #include "pointillist/io/ply.hpp"
 #include "pointillist/lod/tree_features.hpp"
 #include "pointillist/io/point_file.hpp"
+#include "pointillist/io/point_stream.hpp"
+#include "chunked.hpp"
 #include "pointillist/lod/sphere_tree.hpp"
 #include "pointillist/pipeline/model.hpp"
 
@@ -59,7 +63,37 @@ void check_convert_options(const std::string& output, const ConvertOptions& o) {
   }
 }
 
+// The metadata's first lines: generator, sources (a survey of hundreds of tiles names the first
+// few, so the metadata stays readable in info), how normals and radii were made.
+std::string metadata_head(std::span<const std::string> inputs, const ConvertOptions& o) {
+  std::ostringstream meta;
+  meta << "generator: pointillist " << "0.1.0" << "\n";
+  constexpr std::size_t kListedSources = 5;
+  for (std::size_t i = 0; i < inputs.size() && i < kListedSources; ++i) {
+    meta << "source: " << inputs[i] << "\n";
+  }
+  if (inputs.size() > kListedSources) {
+    meta << "source: ... and " << inputs.size() - kListedSources << " more files\n";
+  }
+  meta << "normals: " << normal_source_name(o.prepare.normals) << "\n"
+       << "k: " << o.prepare.k << "\n"
+       << "radius_scale: " << o.prepare.radius_scale << "\n";
+  return meta.str();
+}
+
+std::string gigabytes(std::uint64_t bytes) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f GB", double(bytes) / 1e9);
+  return text;
+}
+
 }  // namespace
+
+std::uint64_t default_memory_budget() {
+  const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGE_SIZE);
+  if (pages <= 0 || page <= 0) return std::uint64_t{4} << 30;
+  return std::uint64_t(pages) * std::uint64_t(page) / 2;
+}
 
 ConvertResult convert(std::span<const std::string> inputs, const std::string& output,
                       const ConvertOptions& o, ThreadPool& pool, Progress& progress) {
@@ -71,6 +105,26 @@ ConvertResult convert(std::span<const std::string> inputs, const std::string& ou
                   "); give the source scan (" + supported_point_file_extensions() +
                   ") to convert, or render the model directly");
     }
+  }
+  // Inputs too large for the memory budget in one piece go to .ptl v2 in chunks.
+  const std::uint64_t budget = o.memory_budget ? o.memory_budget : default_memory_budget();
+  std::uint64_t estimate = 0;
+  for (const std::string& path : inputs) estimate += point_count_estimate(path);
+  const bool to_v2 = ends_with(output, ".ptl") && o.ptl_version == 2;
+  const bool over = estimate > budget / chunking::kInCoreBytesPerPoint;
+  if (to_v2 && (o.chunk_points != 0 || over)) {
+    const std::uint64_t chunk_points =
+        o.chunk_points ? o.chunk_points
+                       : std::max<std::uint64_t>(budget / chunking::kChunkBytesPerPoint, 1024);
+    return chunking::convert_chunked(inputs, output, o, metadata_head(inputs, o), chunk_points,
+                                     pool, progress);
+  }
+  if (over) {
+    throw Error("convert: the inputs hold up to " + std::to_string(estimate) +
+                " points, which need about " +
+                gigabytes(estimate * chunking::kInCoreBytesPerPoint) +
+                " of memory in one piece, over the budget of " + gigabytes(budget) +
+                "; write a .ptl (converted in chunks within the budget), or raise --memory");
   }
   std::vector<std::string> warnings;
   PointSet points = merge_inputs(inputs, pool, progress, {.columns = o.columns}, &warnings);
@@ -107,18 +161,7 @@ ConvertResult convert_points(PointSet points, std::span<const std::string> input
   } else if (to_ptl) {
     const SphereTree tree = build_sphere_tree(points, pool, progress);
     std::ostringstream meta;
-    meta << "generator: pointillist " << "0.1.0" << "\n";
-    // A survey of hundreds of tiles names the first few (the metadata stays readable in info).
-    constexpr std::size_t kListedSources = 5;
-    for (std::size_t i = 0; i < inputs.size() && i < kListedSources; ++i) {
-      meta << "source: " << inputs[i] << "\n";
-    }
-    if (inputs.size() > kListedSources) {
-      meta << "source: ... and " << inputs.size() - kListedSources << " more files\n";
-    }
-    meta << "normals: " << normal_source_name(o.prepare.normals) << "\n"
-         << "k: " << o.prepare.k << "\n"
-         << "radius_scale: " << o.prepare.radius_scale << "\n";
+    meta << metadata_head(inputs, o);
     for (const auto& c : points.comments) meta << "comment: " << c << "\n";
     ProgressPhase phase(progress, "write", 0);
     if (o.ptl_version == 1) {

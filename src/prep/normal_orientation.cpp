@@ -186,7 +186,8 @@ Vec3f centroid(std::span<const Vec3f> positions, ThreadPool& pool) {
 }  // namespace
 
 void orient_normals_ordered(const OrderedCloud& cloud, std::uint32_t graph_k,
-                            std::span<Vec3f> normals, ThreadPool& pool, Progress& progress) {
+                            std::span<Vec3f> normals, ThreadPool& pool, Progress& progress,
+                            const Vec3f* centre, std::vector<std::uint32_t>* components) {
   const std::size_t n = cloud.size();
   assert(normals.size() == n);
   const std::size_t m = std::min(graph_k, cloud.k);
@@ -194,7 +195,7 @@ void orient_normals_ordered(const OrderedCloud& cloud, std::uint32_t graph_k,
   if (n == 0) return;
   const std::span<const Vec3f> p = cloud.positions;
   const ReverseEdges reverse = m > 0 ? missing_reverse_edges(cloud, m, pool) : ReverseEdges{};
-  const Vec3f c = centroid(p, pool);
+  const Vec3f c = centre ? *centre : centroid(p, pool);
   const auto far = [&](std::size_t i) {
     const float f = length_squared(p[i] - c);
     return std::isfinite(f) ? f : -1.0f;
@@ -221,6 +222,8 @@ void orient_normals_ordered(const OrderedCloud& cloud, std::uint32_t graph_k,
   };
   const auto in_tree = [&](std::size_t i) { return nodes[i].slot == kInTree; };
   std::vector<std::uint32_t> members;
+  std::uint32_t component_count = 0;
+  if (components) components->assign(n, 0);
   const auto grow_tree = [&](std::uint32_t seed) {
     if (dot(nodes[seed].normal, p[seed] - c) < 0.0f) nodes[seed].normal = -nodes[seed].normal;
     nodes[seed].key = 0.0f;
@@ -245,6 +248,10 @@ void orient_normals_ordered(const OrderedCloud& cloud, std::uint32_t graph_k,
     // ambiguous (the edge of a ground plane) and turn a whole scan inside out.
     double vote = 0;
     for (const std::uint32_t u : members) vote += double(dot(nodes[u].normal, p[u] - c));
+    if (components) {
+      for (const std::uint32_t u : members) (*components)[u] = component_count;
+    }
+    ++component_count;
     if (vote < 0) {
       for (const std::uint32_t u : members) nodes[u].normal = -nodes[u].normal;
     }

@@ -48,8 +48,13 @@ std::vector<Vec3f> pca_normals_ordered(const OrderedCloud& cloud, std::uint32_t 
 // Flips normals in place so neighbours agree, propagating along a minimum spanning tree of the
 // symmetrized graph of the first `graph_k` neighbours (Hoppe et al. 1992, section 3.3);
 // progress phase "orientation".
+// `centre`: the point "away" is measured from; null: the cloud's centroid. `components`, when
+// not null, receives each point's connected component of the graph (numbered in the order they
+// were oriented), Morton order.
 void orient_normals_ordered(const OrderedCloud& cloud, std::uint32_t graph_k,
-                            std::span<Vec3f> normals, ThreadPool& pool, Progress& progress);
+                            std::span<Vec3f> normals, ThreadPool& pool, Progress& progress,
+                            const Vec3f* centre = nullptr,
+                            std::vector<std::uint32_t>* components = nullptr);
 
 // Mean distance to the first `neighbours` entries of each row, capped at outlier_ratio × the
 // median of the same over the row's first kOutlierNeighbours entries (all of them when the row

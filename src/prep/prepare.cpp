@@ -139,8 +139,16 @@ void prepare_splats(PointSet& points, ThreadPool& pool, Progress& progress,
 
   if (want_pca) {
     std::vector<Vec3f> normals = prep_detail::pca_normals_ordered(cloud, options.k, pool, progress);
-    prep_detail::orient_normals_ordered(cloud, options.k - 1, normals, pool, progress);
+    std::vector<std::uint32_t> components;
+    prep_detail::orient_normals_ordered(
+        cloud, options.k - 1, normals, pool, progress,
+        options.orientation_centre ? &*options.orientation_centre : nullptr,
+        options.orientation_components ? &components : nullptr);
     points.normals = prep_detail::to_caller_order<Vec3f>(cloud, normals, pool);
+    if (options.orientation_components) {
+      *options.orientation_components =
+          prep_detail::to_caller_order<std::uint32_t>(cloud, components, pool);
+    }
   } else {
     ProgressPhase phase(progress, "normals", n);
     if (source == NormalSource::Mesh) {

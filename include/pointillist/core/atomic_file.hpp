@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
@@ -24,6 +25,9 @@ class AtomicFile {
   // Buffered; throws IoError.
   void write(const void* data, std::size_t size);
   void write(const std::string& text) { write(text.data(), text.size()); }
+  // Writes at byte `offset` of the file (after flushing what write() buffered); the sequential
+  // write position is not moved. For files laid out before they are filled. Throws IoError.
+  void write_at(std::uint64_t offset, const void* data, std::size_t size);
   // Flushes, closes and renames into place. Throws IoError.
   void commit();
 

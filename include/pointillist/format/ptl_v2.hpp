@@ -35,6 +35,22 @@ constexpr std::uint32_t kPtlV2Version = 2;
 // cube-face grid with nearest-cell encoding (measured worst case 1.966° over 4·10^7 normals).
 constexpr double kPtlV2NormalErrorRad = 2.0 * 3.14159265358979323846 / 180.0;
 
+constexpr std::uint32_t kPtlNoPage = 0xffffffffu;
+
+// One page-table entry.
+struct PtlV2PageInfo {
+  std::uint64_t offset = 0;       // byte offset of the page in the file
+  std::uint32_t byte_size = 0;    // root table + records
+  std::uint32_t node_count = 0;   // records in the page
+  std::uint32_t parent_page = 0;  // page holding the roots; kPtlNoPage for page 0
+  // The roots are `root_count` consecutive interior nodes of the parent page's last level,
+  // starting at record `first_root` of the parent page. Page 0 has one root: the header's
+  // sphere, whose single child is the tree's root (record 0 of page 0).
+  std::uint32_t first_root = 0;
+  std::uint32_t root_count = 0;
+  std::uint32_t level_count = 0;  // levels of records below the roots
+};
+
 struct PtlV2WriteOptions {
   // Store RGB 565 colours (6-byte records) when the tree has colors; off: 4-byte records.
   bool write_colors = true;
@@ -89,20 +105,60 @@ PtlV2WriteReport write_ptl_v2(const std::string& path, const SphereTree& tree,
                               const std::string& metadata, const PtlV2WriteOptions& options,
                               ThreadPool& pool);
 
-constexpr std::uint32_t kPtlNoPage = 0xffffffffu;
 
-// One page-table entry.
-struct PtlV2PageInfo {
-  std::uint64_t offset = 0;       // byte offset of the page in the file
-  std::uint32_t byte_size = 0;    // root table + records
-  std::uint32_t node_count = 0;   // records in the page
-  std::uint32_t parent_page = 0;  // page holding the roots; kPtlNoPage for page 0
-  // The roots are `root_count` consecutive interior nodes of the parent page's last level,
-  // starting at record `first_root` of the parent page. Page 0 has one root: the header's
-  // sphere, whose single child is the tree's root (record 0 of page 0).
-  std::uint32_t first_root = 0;
-  std::uint32_t root_count = 0;
-  std::uint32_t level_count = 0;  // levels of records below the roots
+// Writing a file in parts (the chunked conversion): subtrees below a common top are encoded and
+// written one at a time, so no step holds the whole hierarchy.
+//   1. Each subtree (a tree from build_sphere_tree) is summarized: its root node, the cone code
+//      of its root over its decoded children, and the pages it will take below the root.
+//   2. A PtlV2PartWriter over the summaries (in a spatially coherent order) builds the top over
+//      the roots (build_top_tree), encodes it and lays out the file: header, page table, the top
+//      page, then each subtree's pages in turn, then the metadata.
+//   3. write_subtree(k, tree) encodes subtree k below its root's decoded sphere and writes its
+//      pages in place; subtrees may come in any order, one call at a time.
+//   4. finish() writes the header, the table, the top page and the metadata, and renames the
+//      file into place.
+// The file is an ordinary version 2 file; the same subtrees give the same bytes.
+struct PtlV2SubtreeSummary {
+  SphereNode root;                    // as built: true sphere, normal, cone, colour, children
+  std::uint32_t cone_code = 0;        // of an interior root, over its decoded children
+  std::uint64_t node_count = 0;       // nodes of the subtree, its root included
+  std::uint64_t leaf_count = 0;
+  std::uint32_t depth = 0;            // levels below its root
+  // Its pages below the root, in order, as if alone in a file: offsets from the first one's
+  // start, parent pages counted from the first (whose parent is the top page: kPtlNoPage here).
+  std::vector<PtlV2PageInfo> pages;
+};
+
+// Summarizes `tree` for a PtlV2PartWriter with the same options (colours only when the tree
+// and the options have them). Throws what write_ptl_v2 throws for a malformed tree.
+PtlV2SubtreeSummary summarize_ptl_v2_subtree(const SphereTree& tree,
+                                             const PtlV2WriteOptions& options);
+
+class PtlV2PartWriter {
+ public:
+  // Lays out `path` (written to a temporary file beside it) for the summarized subtrees. Throws
+  // Error for no subtrees, more than 2^20 or more than 2^32 - 2 nodes; OptionError for
+  // page_bytes < 1024 or features (not written in parts); IoError naming the file.
+  PtlV2PartWriter(const std::string& path, std::vector<PtlV2SubtreeSummary> subtrees,
+                  bool has_colors, const PtlV2WriteOptions& options = {});
+  ~PtlV2PartWriter();
+  PtlV2PartWriter(const PtlV2PartWriter&) = delete;
+  PtlV2PartWriter& operator=(const PtlV2PartWriter&) = delete;
+
+  std::size_t subtree_count() const;
+  // Encodes and writes subtree `k`, which must be the tree summarized as subtree k (checked: its
+  // root and node count). Throws Error when it is not, IoError when writing fails.
+  void write_subtree(std::size_t k, const SphereTree& tree, ThreadPool& pool);
+  // Writes the rest and renames the file into place. `bounds` and `view_sphere` are those of all
+  // the leaves; origin and up the model's frame. Throws Error when a subtree was not written,
+  // IoError when writing fails.
+  PtlV2WriteReport finish(const Aabb& bounds, const Sphere& view_sphere,
+                          const std::array<double, 3>& origin, Vec3f up,
+                          const std::string& metadata);
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
 };
 
 // A decoded page.

@@ -66,4 +66,10 @@ class PointStream {
 std::unique_ptr<PointStream> open_point_stream(const std::string& path,
                                                const PointReadOptions& options = {});
 
+// How many points `path` holds, found cheaply (no pass over the points): the header's count for
+// binary PLY and LAS; for other files an upper estimate from the file's size (a text line holds
+// at least 6 bytes; a gzip file is taken to inflate 16 times). Throws what open_point_stream
+// throws for a bad PLY or LAS header, IoError for a missing file.
+std::uint64_t point_count_estimate(const std::string& path);
+
 }  // namespace pointillist

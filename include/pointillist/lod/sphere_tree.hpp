@@ -95,6 +95,11 @@ SphereTree build_sphere_tree(const PointSet& points, ThreadPool& pool,
                              const SphereTreeOptions& options = {},
                              std::vector<std::uint32_t>* split_order = nullptr);
 
+// Whether build_sphere_tree gives the root of a hierarchy over n points only its two halves
+// (else its four quarters): the levels below then pair binary levels 1-2, 3-4, ... (else 0-1,
+// 2-3, ...), which a chunked build must follow to cut the same subtrees.
+bool sphere_tree_root_halves(std::uint64_t n);
+
 // The top of a hierarchy over subtrees built apart (the chunked conversion): the `roots` (the
 // root nodes of the subtrees, in a spatially coherent order) become, in order, the last level of
 // a breadth-first tree whose interior nodes have 2-4 children and bound them as

@@ -27,6 +27,13 @@ struct ConvertOptions {
   std::optional<quant::LeafTrim> leaf_trim;
   // .ptl v2 output: compute the sharp features on the hierarchy's leaves and store them.
   std::optional<FeatureOptions> features;
+  // Bytes of memory the conversion may use; 0: half of the physical memory. Point clouds that
+  // need more in one piece (about 220 bytes a point) are converted to .ptl v2 in chunks that
+  // fit; other outputs and meshes that do not fit are refused before any work.
+  std::uint64_t memory_budget = 0;
+  // Force the chunked conversion (.ptl v2) with chunks of at most this many points (rounded down
+  // to the hierarchy's levels); 0: only when the budget asks for it.
+  std::uint64_t chunk_points = 0;
 };
 
 struct ConvertResult {
@@ -35,7 +42,12 @@ struct ConvertResult {
   // Things the user should know that did not stop the work (inputs without colors, options
   // that do not apply to this output).
   std::vector<std::string> warnings;
+  std::size_t chunks = 0;           // chunks of a chunked conversion (0: in one piece)
+  std::uint64_t halo_points = 0;    // points copied into other chunks' halos
 };
+
+// Half of the physical memory: the default ConvertOptions::memory_budget.
+std::uint64_t default_memory_budget();
 
 // Converts `inputs` (scans, merged in the first one's frame: see merge_inputs) to `output`,
 // chosen by its extension: .ptl, .qs (a mesh gives the bytes QSplat's qsplat_make writes) or

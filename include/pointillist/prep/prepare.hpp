@@ -2,7 +2,9 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "pointillist/core/point_set.hpp"
 #include "pointillist/core/progress.hpp"
@@ -34,6 +36,13 @@ struct PrepareOptions {
   // Off by default: it removes data. Not for meshes.
   bool drop_outliers = false;
   float outlier_ratio_drop = 3.0f;
+  // The point PCA normals are oriented away from (normal_orientation.cpp). Unset: the centroid
+  // of the points. A part of a larger cloud (a chunk) passes the whole cloud's centroid, so its
+  // normals are oriented as they would be in the whole.
+  std::optional<Vec3f> orientation_centre;
+  // When set and the normals are found by PCA: each point's connected component of the
+  // orientation graph (components are oriented each on its own), in the points' order.
+  std::vector<std::uint32_t>* orientation_components = nullptr;
   // Names the input in error messages (e.g. the file path).
   std::string input_name = "the input";
 };

@@ -1,0 +1,296 @@
+// Writing a .ptl version 2 file in parts (see PtlV2PartWriter in ptl_v2.hpp): the top of the
+// hierarchy over the subtrees' roots lives in page 0; each subtree's pages follow, planned from
+// its shape alone, so the layout is known before any subtree is encoded.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "ptl_v2_codec.hpp"
+#include "ptl_v2_encode.hpp"
+#include "pointillist/core/atomic_file.hpp"
+#include "pointillist/core/error.hpp"
+#include "pointillist/format/ptl_v2.hpp"
+
+namespace pointillist {
+
+using namespace ptl2;
+
+namespace {
+
+std::uint32_t record_size_for(bool colors, const PtlV2WriteOptions& options) {
+  return colors && options.write_colors ? 6 : 4;
+}
+
+}  // namespace
+
+PtlV2SubtreeSummary summarize_ptl_v2_subtree(const SphereTree& tree,
+                                             const PtlV2WriteOptions& options) {
+  PtlV2SubtreeSummary s;
+  std::uint64_t leaves = 0;
+  std::uint32_t depth = 0;
+  check_tree("a subtree", tree.nodes, leaves, depth);
+  const auto& nodes = tree.nodes;
+  const std::size_t n = nodes.size();
+  s.root = nodes[0];
+  s.node_count = n;
+  s.leaf_count = leaves;
+  s.depth = depth;
+  if (nodes[0].child_count > 0) {
+    // The root's cone holds its children's decoded cones, which hold theirs: bottom-up.
+    std::vector<std::uint32_t> normal_code(n);
+    for (std::size_t i = 0; i < n; ++i) normal_code[i] = encode_normal_nearest(normalized(nodes[i].normal));
+    std::vector<double> angle(n, 0.0);
+    for (std::size_t i = n; i-- > 0;) {
+      const SphereNode& nd = nodes[i];
+      if (nd.child_count == 0) continue;
+      const std::uint32_t cone =
+          encode_cone(nd, normal_code[i], {&normal_code[nd.first_child], nd.child_count},
+                      {&angle[nd.first_child], nd.child_count}, angle[i]);
+      if (i == 0) s.cone_code = cone;
+    }
+    const std::uint32_t record_size = record_size_for(tree.has_colors, options);
+    const std::vector<PagePlan> plan = plan_pages(nodes, record_size, options.page_bytes, true);
+    std::uint64_t offset = 0;
+    for (const PagePlan& pg : plan) {
+      s.pages.push_back(page_entry(pg, offset));
+      offset += pg.byte_size;
+    }
+  }
+  return s;
+}
+
+struct PtlV2PartWriter::State {
+  std::string path;
+  PtlV2WriteOptions options;
+  bool colors = false;
+  std::uint32_t record_size = 4;
+  std::vector<PtlV2SubtreeSummary> subtrees;
+  SphereTree top;
+  std::size_t first_root = 0;  // index of subtree 0's root in the top (its last level)
+  EncodedTree top_codes;
+  std::vector<PtlV2PageInfo> table;         // the whole file's
+  std::vector<std::uint32_t> first_page;    // table index of each subtree's first page
+  std::vector<bool> written;
+  std::uint64_t metadata_offset = 0;
+  std::uint64_t node_count = 0, leaf_count = 0;
+  std::uint32_t depth = 0;
+  EncodeStats stats;
+  std::optional<AtomicFile> file;
+};
+
+PtlV2PartWriter::PtlV2PartWriter(const std::string& path,
+                                 std::vector<PtlV2SubtreeSummary> subtrees, bool has_colors,
+                                 const PtlV2WriteOptions& options)
+    : state_(std::make_unique<State>()) {
+  State& st = *state_;
+  if (options.page_bytes < kMinPageBytes) {
+    throw OptionError("page_bytes " + std::to_string(options.page_bytes) +
+                      " is below the minimum " + std::to_string(kMinPageBytes));
+  }
+  if (options.features) {
+    throw OptionError("cannot write " + path + " in parts with sharp features (not built yet)");
+  }
+  st.path = path;
+  st.options = options;
+  st.colors = has_colors && options.write_colors;
+  st.record_size = record_size_for(has_colors, options);
+  st.subtrees = std::move(subtrees);
+  const std::size_t count = st.subtrees.size();
+  std::vector<SphereNode> roots;
+  roots.reserve(count);
+  for (const PtlV2SubtreeSummary& s : st.subtrees) roots.push_back(s.root);
+  st.top = build_top_tree(roots, has_colors);
+  SphereTree& top = st.top;
+  const std::size_t top_count = top.nodes.size();
+  st.first_root = top_count - count;
+
+  // The top's records, top-down against decoded parents (its last level: the subtrees' roots,
+  // encoded as interior nodes when they have children), then normals, then cones bottom-up
+  // (the roots' cones come with the summaries).
+  std::vector<std::uint32_t> parent(top_count, 0);
+  for (std::size_t i = 0; i < st.first_root; ++i) {
+    for (std::uint32_t k = 0; k < top.nodes[i].child_count; ++k)
+      parent[top.nodes[i].first_child + k] = static_cast<std::uint32_t>(i);
+  }
+  std::vector<Sphere> target(top_count);
+  for (std::size_t i = 0; i < top_count; ++i) target[i] = {top.nodes[i].center, top.nodes[i].radius};
+  EncodedTree& enc = st.top_codes;
+  enc.root_parent = count == 1 && top.nodes[0].child_count == 0 ? target[0] : grown(target[0]);
+  enc.decoded.resize(top_count);
+  enc.record.assign(top_count, 0);
+  enc.normal_code.resize(top_count);
+  enc.cone_angle.assign(top_count, 0.0);
+  for (std::size_t i = 0; i < top_count; ++i) {
+    const Sphere& p = i == 0 ? enc.root_parent : enc.decoded[parent[i]];
+    std::uint64_t fallbacks = st.stats.parent_fallbacks;
+    const SphereCode code =
+        encode_sphere(p, target[i], top.nodes[i].child_count, options.leaf_trim, st.stats);
+    if (i == 0) st.stats.parent_fallbacks = fallbacks;
+    enc.decoded[i] = code.decoded;
+    enc.record[i] = code.bits;
+    enc.normal_code[i] = encode_normal_nearest(normalized(top.nodes[i].normal));
+    enc.record[i] |= std::uint64_t{enc.normal_code[i]} << kNormalShift;
+  }
+  for (std::size_t i = top_count; i-- > 0;) {
+    const SphereNode& nd = top.nodes[i];
+    if (nd.child_count == 0) continue;
+    std::uint32_t cone = 0;
+    if (i >= st.first_root) {
+      cone = st.subtrees[i - st.first_root].cone_code;
+      enc.cone_angle[i] = cone < 3 ? cone_half_angle(cone) : 1e9;
+    } else {
+      cone = encode_cone(nd, enc.normal_code[i], {&enc.normal_code[nd.first_child], nd.child_count},
+                         {&enc.cone_angle[nd.first_child], nd.child_count}, enc.cone_angle[i]);
+    }
+    ++st.stats.cone_codes[cone];
+    enc.record[i] |= std::uint64_t{cone} << kConeShift;
+  }
+  if (st.colors) {
+    for (std::size_t i = 0; i < top_count; ++i)
+      enc.record[i] |= std::uint64_t{encode_rgb565_nearest(top.nodes[i].color)} << kColorShift;
+  }
+
+  // The layout: page 0 holds the whole top; then each subtree's pages.
+  std::uint64_t pages = 1;
+  for (const PtlV2SubtreeSummary& s : st.subtrees) pages += s.pages.size();
+  if (pages >= kPtlNoPage) throw Error("cannot write " + path + ": too many pages");
+  std::uint64_t offset = kHeaderSize + pages * kPageEntrySize;
+  PtlV2PageInfo top_page;
+  top_page.offset = offset;
+  top_page.byte_size = static_cast<std::uint32_t>(kRootEntrySize + top_count * st.record_size);
+  top_page.node_count = static_cast<std::uint32_t>(top_count);
+  top_page.parent_page = kPtlNoPage;
+  top_page.root_count = 1;
+  top_page.level_count = top.depth + 1;
+  st.table.push_back(top_page);
+  offset += top_page.byte_size;
+  st.node_count = top_count;
+  st.leaf_count = 0;
+  st.depth = top.depth;
+  for (std::size_t k = 0; k < count; ++k) {
+    const PtlV2SubtreeSummary& s = st.subtrees[k];
+    st.node_count += s.node_count - 1;
+    st.leaf_count += s.leaf_count;
+    st.depth = std::max(st.depth, top.depth + s.depth);
+    const auto base = static_cast<std::uint32_t>(st.table.size());
+    st.first_page.push_back(base);
+    for (std::size_t p = 0; p < s.pages.size(); ++p) {
+      PtlV2PageInfo e = s.pages[p];
+      e.offset += offset;
+      if (p == 0) {
+        e.parent_page = 0;
+        e.first_root = static_cast<std::uint32_t>(st.first_root + k);
+      } else {
+        e.parent_page += base;
+      }
+      st.table.push_back(e);
+    }
+    if (!s.pages.empty()) {
+      const PtlV2PageInfo& last = s.pages.back();
+      offset += last.offset + last.byte_size;
+    }
+  }
+  if (st.node_count > 0xfffffffeu) throw Error("cannot write " + path + ": more than 2^32 - 2 nodes");
+  st.metadata_offset = offset;
+  st.written.assign(count, false);
+  st.file.emplace(path);
+}
+
+PtlV2PartWriter::~PtlV2PartWriter() = default;
+
+std::size_t PtlV2PartWriter::subtree_count() const { return state_->subtrees.size(); }
+
+void PtlV2PartWriter::write_subtree(std::size_t k, const SphereTree& tree, ThreadPool& pool) {
+  State& st = *state_;
+  const PtlV2SubtreeSummary& s = st.subtrees.at(k);
+  if (tree.nodes.size() != s.node_count || tree.nodes.empty() ||
+      std::memcmp(&tree.nodes[0], &s.root, sizeof(SphereNode)) != 0) {
+    throw Error("cannot write " + st.path + ": subtree " + std::to_string(k) +
+                " is not the one summarized (its root or node count differs)");
+  }
+  st.written[k] = true;
+  if (s.pages.empty()) return;  // a single leaf: its record is in the top
+  std::uint64_t leaves = 0;
+  std::uint32_t depth = 0;
+  const std::vector<std::uint32_t> parent = check_tree(st.path, tree.nodes, leaves, depth);
+  const Sphere& decoded_root = st.top_codes.decoded[st.first_root + k];
+  const EncodedTree enc = encode_tree(tree.nodes, parent, nullptr, &decoded_root,
+                                      st.options.leaf_trim, st.colors, pool, st.stats);
+  --st.stats.cone_codes[s.cone_code];  // the root's cone is counted with the top
+  const std::vector<PagePlan> plan =
+      plan_pages(tree.nodes, st.record_size, st.options.page_bytes, true);
+  std::vector<std::uint8_t> bytes;
+  std::vector<Sphere> root_spheres;
+  std::vector<std::uint8_t> root_children;
+  for (std::size_t p = 0; p < plan.size(); ++p) {
+    root_spheres.clear();
+    root_children.clear();
+    for (const std::uint32_t r : plan[p].roots) {
+      root_spheres.push_back(enc.decoded[r]);
+      root_children.push_back(tree.nodes[r].child_count);
+    }
+    page_bytes(plan[p], root_spheres, root_children, enc.record, st.record_size, bytes);
+    st.file->write_at(st.table[st.first_page[k] + p].offset, bytes.data(), bytes.size());
+  }
+}
+
+PtlV2WriteReport PtlV2PartWriter::finish(const Aabb& bounds, const Sphere& view_sphere,
+                                         const std::array<double, 3>& origin, Vec3f up,
+                                         const std::string& metadata) {
+  State& st = *state_;
+  for (std::size_t k = 0; k < st.written.size(); ++k) {
+    if (!st.written[k]) {
+      throw Error("cannot write " + st.path + ": subtree " + std::to_string(k) +
+                  " of " + std::to_string(st.written.size()) + " was not written");
+    }
+  }
+  HeaderFields f;
+  f.colors = st.colors;
+  f.record_size = st.record_size;
+  f.leaf_trim = st.options.leaf_trim;
+  f.node_count = st.node_count;
+  f.leaf_count = st.leaf_count;
+  f.depth = st.depth;
+  f.page_bytes = st.options.page_bytes;
+  f.metadata_offset = st.metadata_offset;
+  f.metadata_size = metadata.size();
+  f.root_sphere = st.top_codes.root_parent;
+  f.bounds = bounds;
+  f.view_sphere = view_sphere;
+  f.origin = origin;
+  f.up = up;
+  const std::vector<std::uint8_t> head = header_and_table(f, st.table);
+  st.file->write_at(0, head.data(), head.size());
+  PagePlan top_page;
+  top_page.byte_size = st.table[0].byte_size;
+  top_page.nodes.resize(st.top.nodes.size());
+  for (std::size_t i = 0; i < top_page.nodes.size(); ++i) top_page.nodes[i] = std::uint32_t(i);
+  std::vector<std::uint8_t> bytes;
+  const Sphere header_root = st.top_codes.root_parent;
+  const std::uint8_t one = 1;
+  page_bytes(top_page, {&header_root, 1}, {&one, 1}, st.top_codes.record, st.record_size, bytes);
+  st.file->write_at(st.table[0].offset, bytes.data(), bytes.size());
+  st.file->write_at(st.metadata_offset, metadata.data(), metadata.size());
+  st.file->commit();
+
+  PtlV2WriteReport report;
+  report.file_size = st.metadata_offset + metadata.size();
+  report.record_bytes = st.node_count * st.record_size;
+  report.node_count = st.node_count;
+  report.leaf_count = st.leaf_count;
+  report.page_count = static_cast<std::uint32_t>(st.table.size());
+  report.record_size = st.record_size;
+  report.bytes_per_leaf = double(report.file_size) / double(std::max<std::uint64_t>(1, st.leaf_count));
+  report.spheres_enlarged = st.stats.spheres_enlarged;
+  report.parent_fallbacks = st.stats.parent_fallbacks;
+  report.mean_leaf_radius_ratio = st.stats.leaf_ratio_count
+                                      ? st.stats.leaf_ratio_sum / double(st.stats.leaf_ratio_count)
+                                      : 1;
+  for (int c = 0; c < 4; ++c) report.cone_codes[c] = st.stats.cone_codes[c];
+  return report;
+}
+
+}  // namespace pointillist

@@ -1,0 +1,81 @@
+// The chunks of a chunked conversion (private to pipeline): the top binary levels of the very
+// median splits build_sphere_tree makes over all the points (longest axis of the range's box,
+// the first n/2 points by (coordinate, input index) to the left), so each chunk holds exactly
+// the points of one subtree of the hierarchy a conversion in one piece builds, and the chunked
+// file decodes to the same hierarchy.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "pointillist/core/math.hpp"
+#include "pointillist/core/thread_pool.hpp"
+
+namespace pointillist::chunking {
+
+// A binary split: a point (coordinate c on `axis`, input index i) goes left when
+// (c, i) < (value, index), c taken with -0 as +0.
+struct Split {
+  std::uint8_t axis = 0;
+  float value = 0;
+  std::uint64_t index = 0;
+};
+
+struct ChunkPlan {
+  std::uint32_t levels = 0;         // binary levels; 2^levels chunks
+  std::vector<Split> splits;        // heap order: node j's children are 2j + 1 and 2j + 2
+  std::vector<std::uint64_t> counts;  // points per chunk, chunk order (left to right)
+  std::vector<Aabb> boxes;          // box of each chunk's points
+
+  std::size_t chunk_count() const { return counts.size(); }
+  // The chunk of a point.
+  std::uint32_t chunk_of(const Vec3f& p, std::uint64_t index) const {
+    std::size_t j = 0;
+    for (std::uint32_t l = 0; l < levels; ++l) {
+      const Split& s = splits[j];
+      const float c = p[s.axis] + 0.0f;
+      const bool left = c < s.value || (c == s.value && index < s.index);
+      j = 2 * j + (left ? 1 : 2);
+    }
+    return static_cast<std::uint32_t>(j - (splits.size()));
+  }
+  // Calls fn(chunk) for every chunk other than `own` whose box is nearer than `reach[chunk]`
+  // to `p` (a halo point for it); `max_reach` bounds every reach.
+  template <class Fn>
+  void for_near_chunks(const Vec3f& p, std::uint32_t own, std::span<const float> reach,
+                       float max_reach, Fn&& fn) const {
+    visit_near(0, 0, p, own, reach, max_reach, fn);
+  }
+
+ private:
+  template <class Fn>
+  void visit_near(std::size_t j, std::uint32_t level, const Vec3f& p, std::uint32_t own,
+                  std::span<const float> reach, float max_reach, Fn& fn) const {
+    if (level == levels) {
+      const auto chunk = static_cast<std::uint32_t>(j - splits.size());
+      if (chunk == own) return;
+      const Aabb& b = boxes[chunk];
+      float d2 = 0;
+      for (int a = 0; a < 3; ++a) {
+        const float below = b.lo[a] - p[a], above = p[a] - b.hi[a];
+        const float d = std::max({below, above, 0.0f});
+        d2 += d * d;
+      }
+      if (d2 < reach[chunk] * reach[chunk]) fn(chunk);
+      return;
+    }
+    const Split& s = splits[j];
+    const float c = p[s.axis];
+    if (c - max_reach <= s.value) visit_near(2 * j + 1, level + 1, p, own, reach, max_reach, fn);
+    if (c + max_reach >= s.value) visit_near(2 * j + 2, level + 1, p, own, reach, max_reach, fn);
+  }
+};
+
+// The plan with `levels` binary levels over `positions` (input order = index order). Chunk
+// members: `members` (when not null) gets each chunk's input indices, increasing. Parallel; the
+// same plan for any thread count.
+ChunkPlan plan_chunks(std::span<const Vec3f> positions, std::uint32_t levels, ThreadPool& pool,
+                      std::vector<std::vector<std::uint32_t>>* members = nullptr);
+
+}  // namespace pointillist::chunking

@@ -1,0 +1,32 @@
+// The chunked conversion (private to pipeline; see chunked_convert.cpp).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+
+#include "pointillist/core/progress.hpp"
+#include "pointillist/core/thread_pool.hpp"
+#include "pointillist/pipeline/convert.hpp"
+
+namespace pointillist::chunking {
+
+// Memory a conversion in one piece takes per point (measured 184 bytes for a cloud, 217 for a
+// mesh, with the output's hierarchy), and a chunk's per point of the chunk (its halo, the
+// prepared splats, the neighbour rows, the subtree and its encoding).
+constexpr std::uint64_t kInCoreBytesPerPoint = 220;
+constexpr std::uint64_t kChunkBytesPerPoint = 400;
+// A chunk's halo reaches this many point spacings beyond its box (a 16-neighbourhood on a
+// surface spans about 2.3).
+constexpr float kHaloSpacings = 6.0f;
+
+// Converts `inputs` (point clouds) to the .ptl v2 file `output` in chunks of at most
+// `max_chunk_points` points (rounded to the hierarchy's levels). `metadata_head` starts the
+// file's metadata (the comments follow). Throws OptionError for options it cannot honour yet
+// (--drop-outliers, --features), Error for a mesh input, and what reading and writing throw.
+ConvertResult convert_chunked(std::span<const std::string> inputs, const std::string& output,
+                              const ConvertOptions& options, const std::string& metadata_head,
+                              std::uint64_t max_chunk_points, ThreadPool& pool,
+                              Progress& progress);
+
+}  // namespace pointillist::chunking

@@ -1,0 +1,533 @@
+// The chunked conversion (see convert.hpp, ConvertOptions::memory_budget): scans larger than the
+// memory budget become a .ptl v2 file chunk by chunk.
+//   1. scan: the inputs are streamed once for their positions (12 bytes a point) and centroid;
+//   2. plan: the top binary levels of the hierarchy's median splits cut the points into chunks
+//      that are exactly subtrees of the one-piece hierarchy (chunk_plan.hpp);
+//   3. distribute: the inputs are streamed again into one file per chunk, with a halo: the
+//      points of other chunks near its box, so normals and radii see across its border;
+//   4. prepare: each chunk (and its halo) gets normals and radii, loses its halo, becomes its
+//      subtree, is summarized and kept on disk as its splats in split order;
+//   5. write: a PtlV2PartWriter lays out the file over the summaries; each chunk's subtree is
+//      rebuilt from its splats (no partition: they are in split order) and written in place.
+// Everything goes to a folder beside the output, removed at the end and on failure; the output
+// appears only when complete.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "chunk_orientation.hpp"
+#include "chunk_plan.hpp"
+#include "chunked.hpp"
+#include "pointillist/core/error.hpp"
+#include "pointillist/format/ptl_v2.hpp"
+#include "pointillist/io/point_stream.hpp"
+#include "pointillist/lod/sphere_tree.hpp"
+#include "pointillist/prep/prepare.hpp"
+
+namespace pointillist::chunking {
+namespace {
+
+constexpr Rgb8 kMissingColor{180, 180, 180};  // as merge_inputs gives parts without colours
+constexpr std::size_t kBatch = 1 << 20;      // points per read
+
+// The inputs as one stream, with merge_inputs' rules: parts move into the first part's frame,
+// normals and radii survive when every part has them, colours when any has them (grey else).
+class MergedInputs {
+ public:
+  MergedInputs(std::span<const std::string> paths, const std::string& columns) {
+    for (const std::string& path : paths) {
+      streams_.push_back(open_point_stream(path, {.columns = columns}));
+      const PointStreamInfo& info = streams_.back()->info();
+      if (info.is_mesh) {
+        throw Error(path + ": is a mesh; meshes are converted in one piece (give a larger "
+                           "--memory, or convert its vertices as points)");
+      }
+      count_ += info.point_count;
+      normals_ = normals_ && info.has_normals;
+      radii_ = radii_ && info.has_radii;
+      colors_ = colors_ || info.has_colors;
+      for (const std::string& c : info.comments) {
+        if (paths.size() == 1 || seen_.insert(c).second) comments_.push_back(c);
+      }
+    }
+    origin_ = streams_[0]->info().origin;
+    up_ = streams_[0]->info().up;
+  }
+
+  std::uint64_t count() const { return count_; }
+  bool has_normals() const { return normals_; }
+  bool has_radii() const { return radii_; }
+  bool has_colors() const { return colors_; }
+  const std::array<double, 3>& origin() const { return origin_; }
+  Vec3f up() const { return up_; }
+  const std::vector<std::string>& comments() const { return comments_; }
+  const std::vector<std::unique_ptr<PointStream>>& streams() const { return streams_; }
+  // After a full pass: a part whose normals were all unusable has none (as read_point_file).
+  void drop_unusable_normals() {
+    for (const auto& s : streams_) normals_ = normals_ && s->saw_usable_normals();
+  }
+
+  // Calls fn(batch, index of its first point) over every point, in order.
+  template <class Fn>
+  void for_each_batch(Fn&& fn) {
+    std::uint64_t next = 0;
+    PointSet batch;
+    for (const auto& stream : streams_) {
+      stream->rewind();
+      const std::array<double, 3>& o = stream->info().origin;
+      const double shift[3] = {o[0] - origin_[0], o[1] - origin_[1], o[2] - origin_[2]};
+      const bool shifted = shift[0] != 0 || shift[1] != 0 || shift[2] != 0;
+      while (const std::size_t n = stream->read(batch, kBatch)) {
+        if (shifted) {
+          for (Vec3f& p : batch.positions) {
+            p = {float(p.x + shift[0]), float(p.y + shift[1]), float(p.z + shift[2])};
+          }
+        }
+        if (!normals_) batch.normals.clear();
+        if (!radii_) batch.radii.clear();
+        if (colors_ && batch.colors.empty()) batch.colors.assign(n, kMissingColor);
+        fn(batch, next);
+        next += n;
+      }
+    }
+  }
+
+ private:
+  std::vector<std::unique_ptr<PointStream>> streams_;
+  std::uint64_t count_ = 0;
+  bool normals_ = true, radii_ = true, colors_ = false;
+  std::array<double, 3> origin_{};
+  Vec3f up_{0, 1, 0};
+  std::vector<std::string> comments_;
+  std::set<std::string> seen_;
+};
+
+// The folder of a conversion's temporary files, beside the output; a folder left by a killed
+// conversion into the same output is removed first.
+class WorkFolder {
+ public:
+  explicit WorkFolder(const std::string& output) : path_(output + ".chunks") {
+    std::error_code error;
+    std::filesystem::remove_all(path_, error);
+    if (!std::filesystem::create_directory(path_, error) || error) {
+      throw IoError(path_.string() + ": cannot create the folder for the chunks: " +
+                    error.message() + " (the output's folder must be writable)");
+    }
+  }
+  ~WorkFolder() {
+    std::error_code error;
+    std::filesystem::remove_all(path_, error);
+  }
+  std::string file(const std::string& name) const { return (path_ / name).string(); }
+
+ private:
+  std::filesystem::path path_;
+};
+
+[[noreturn]] void write_failed(const std::string& path) {
+  throw IoError(path + ": cannot write a chunk file (is the disk full?); the output was not "
+                       "written and the input is untouched");
+}
+
+// Appends records to one file per chunk through a buffer each.
+class ChunkFiles {
+ public:
+  ChunkFiles(const WorkFolder& folder, std::size_t chunks, const char* kind,
+             std::size_t buffer_bytes)
+      : buffers_(chunks), buffer_bytes_(buffer_bytes) {
+    for (std::size_t c = 0; c < chunks; ++c) paths_.push_back(folder.file(name(kind, c)));
+  }
+  static std::string name(const char* kind, std::size_t c) {
+    char text[48];
+    std::snprintf(text, sizeof text, "%s-%05zu", kind, c);
+    return text;
+  }
+  void append(std::size_t c, const void* data, std::size_t size) {
+    std::vector<char>& b = buffers_[c];
+    const char* bytes = static_cast<const char*>(data);
+    b.insert(b.end(), bytes, bytes + size);
+    if (b.size() >= buffer_bytes_) flush(c);
+  }
+  void flush_all() {
+    for (std::size_t c = 0; c < buffers_.size(); ++c) flush(c);
+  }
+  const std::string& path(std::size_t c) const { return paths_[c]; }
+
+ private:
+  void flush(std::size_t c) {
+    std::vector<char>& b = buffers_[c];
+    if (b.empty()) return;
+    std::ofstream out(paths_[c], std::ios::binary | std::ios::app);
+    out.write(b.data(), std::streamsize(b.size()));
+    if (!out) write_failed(paths_[c]);
+    b.clear();
+  }
+  std::vector<std::vector<char>> buffers_;
+  std::vector<std::string> paths_;
+  std::size_t buffer_bytes_;
+};
+
+// A chunk record: position, colour, flags (bit 0: halo), input index, then normal and radius
+// when present.
+struct RecordLayout {
+  bool normals = false, radii = false;
+  std::size_t size() const { return 24 + (normals ? 12 : 0) + (radii ? 4 : 0); }
+};
+
+void encode_record(const RecordLayout& l, const PointSet& b, std::size_t i, std::uint64_t index,
+                   bool halo, char* out) {
+  std::memcpy(out, &b.positions[i], 12);
+  const Rgb8 c = b.colors.empty() ? Rgb8{} : b.colors[i];
+  out[12] = char(c.r);
+  out[13] = char(c.g);
+  out[14] = char(c.b);
+  out[15] = halo ? 1 : 0;
+  std::memcpy(out + 16, &index, 8);
+  std::size_t at = 24;
+  if (l.normals) {
+    std::memcpy(out + at, &b.normals[i], 12);
+    at += 12;
+  }
+  if (l.radii) std::memcpy(out + at, &b.radii[i], 4);
+}
+
+std::vector<char> read_whole(const std::string& path) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (!in) throw IoError(path + ": cannot read a chunk file back");
+  std::vector<char> bytes(static_cast<std::size_t>(in.tellg()));
+  in.seekg(0);
+  in.read(bytes.data(), std::streamsize(bytes.size()));
+  if (!in) throw IoError(path + ": cannot read a chunk file back");
+  return bytes;
+}
+
+// A chunk file's points, which of them are its own (not halo) and their input indices.
+PointSet read_chunk(const std::string& path, const RecordLayout& l, bool colors,
+                    std::vector<std::uint8_t>& own, std::vector<std::uint64_t>& index) {
+  const std::vector<char> bytes = read_whole(path);
+  const std::size_t n = bytes.size() / l.size();
+  PointSet p;
+  p.positions.resize(n);
+  if (colors) p.colors.resize(n);
+  if (l.normals) p.normals.resize(n);
+  if (l.radii) p.radii.resize(n);
+  own.resize(n);
+  index.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const char* r = bytes.data() + i * l.size();
+    std::memcpy(&p.positions[i], r, 12);
+    if (colors) p.colors[i] = {std::uint8_t(r[12]), std::uint8_t(r[13]), std::uint8_t(r[14])};
+    own[i] = r[15] == 0;
+    std::memcpy(&index[i], r + 16, 8);
+    std::size_t at = 24;
+    if (l.normals) {
+      std::memcpy(&p.normals[i], r + at, 12);
+      at += 12;
+    }
+    if (l.radii) std::memcpy(&p.radii[i], r + at, 4);
+  }
+  return p;
+}
+
+// A chunk's splats (position, normal, radius, colour; and, between the passes, each one's input
+// index and orientation piece) as arrays, in order.
+struct Splats {
+  PointSet points;
+  std::vector<std::uint64_t> index;
+  std::vector<std::uint32_t> piece;
+};
+
+void write_splats(const std::string& path, const Splats& s) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  const auto put = [&](const auto& v) {
+    out.write(reinterpret_cast<const char*>(v.data()), std::streamsize(v.size() * sizeof(v[0])));
+  };
+  put(s.points.positions);
+  put(s.points.normals);
+  put(s.points.radii);
+  put(s.points.colors);
+  put(s.index);
+  put(s.piece);
+  if (!out) write_failed(path);
+}
+
+Splats read_splats(const std::string& path, std::size_t n, bool colors, bool index, bool piece) {
+  const std::vector<char> bytes = read_whole(path);
+  Splats s;
+  s.points.positions.resize(n);
+  s.points.normals.resize(n);
+  s.points.radii.resize(n);
+  if (colors) s.points.colors.resize(n);
+  if (index) s.index.resize(n);
+  if (piece) s.piece.resize(n);
+  const std::size_t need = n * (28 + (colors ? 3 : 0) + (index ? 8 : 0) + (piece ? 4 : 0));
+  if (bytes.size() != need) throw IoError(path + ": a chunk file changed on disk");
+  const char* at = bytes.data();
+  const auto get = [&](auto& v) {
+    std::memcpy(v.data(), at, v.size() * sizeof(v[0]));
+    at += v.size() * sizeof(v[0]);
+  };
+  get(s.points.positions);
+  get(s.points.normals);
+  get(s.points.radii);
+  get(s.points.colors);
+  get(s.index);
+  get(s.piece);
+  return s;
+}
+
+// A halo point's view of its orientation, for the chunk that owns the point: its input index,
+// the chunk and piece that hold it as halo, and its normal there.
+struct Relation {
+  std::uint64_t index;
+  std::uint32_t chunk, piece;
+  Vec3f normal;
+};
+
+// Binary levels of the plan: enough chunks for `max_points` each, paired as the hierarchy's
+// levels pair (sphere_tree_root_halves), at least one level.
+std::uint32_t plan_levels(std::uint64_t n, std::uint64_t max_points) {
+  std::uint32_t levels = 1;
+  while ((n >> levels) > max_points && levels < 20) ++levels;
+  const bool odd = sphere_tree_root_halves(n);
+  if ((levels % 2 == 1) != odd) ++levels;
+  while (levels > 1 && (n >> levels) < 2) levels -= 2;
+  return levels;
+}
+
+}  // namespace
+
+ConvertResult convert_chunked(std::span<const std::string> inputs, const std::string& output,
+                              const ConvertOptions& o, const std::string& metadata_head,
+                              std::uint64_t max_chunk_points, ThreadPool& pool,
+                              Progress& progress) {
+  if (o.prepare.drop_outliers) {
+    throw OptionError("convert: --drop-outliers is not available for chunked conversion yet (the "
+                      "input needs more than --memory); give a larger --memory, or drop the "
+                      "outliers first (convert to .ply with --drop-outliers, in parts)");
+  }
+  if (o.features) {
+    throw OptionError("convert: --features are not available for chunked conversion yet (the "
+                      "input needs more than --memory); give a larger --memory");
+  }
+  MergedInputs in(inputs, o.columns);
+  const std::uint64_t n = in.count();
+  ConvertResult result;
+  result.input_points = n;
+
+  // 1. Positions and centroid.
+  std::vector<Vec3f> positions;
+  positions.reserve(n);
+  double sum[3] = {0, 0, 0};
+  {
+    ProgressPhase phase(progress, "scan", n);
+    in.for_each_batch([&](const PointSet& b, std::uint64_t) {
+      for (const Vec3f& p : b.positions) {
+        if (!is_finite(p)) {
+          throw Error(std::string(inputs.size() == 1 ? inputs[0] : "the inputs") +
+                      ": vertex " + std::to_string(positions.size()) +
+                      " has a non-finite position; remove it from the file");
+        }
+        positions.push_back(p);
+        sum[0] += p.x;
+        sum[1] += p.y;
+        sum[2] += p.z;
+      }
+      phase.advance(b.size());
+    });
+  }
+  in.drop_unusable_normals();
+  const Vec3f centroid{float(sum[0] / double(n)), float(sum[1] / double(n)),
+                       float(sum[2] / double(n))};
+
+  // 2. The plan.
+  const std::uint32_t levels = plan_levels(n, std::max<std::uint64_t>(max_chunk_points, 2));
+  ChunkPlan plan;
+  {
+    ProgressPhase phase(progress, "plan", n);
+    plan = plan_chunks(positions, levels, pool);
+    phase.advance(n);
+  }
+  std::vector<Vec3f>().swap(positions);
+  const std::size_t chunks = plan.chunk_count();
+  result.chunks = chunks;
+  // Halo reach: a multiple of the chunk's point spacing (its box's two largest extents over its
+  // point count, as for a surface), scaled with the neighbourhood size.
+  std::vector<float> reach(chunks);
+  float max_reach = 0;
+  const float neighbourhood = std::sqrt(std::max(16.0f, float(o.prepare.k)) / 16.0f);
+  for (std::size_t c = 0; c < chunks; ++c) {
+    const Vec3f e = plan.boxes[c].hi - plan.boxes[c].lo;
+    float x[3] = {e.x, e.y, e.z};
+    std::sort(x, x + 3);
+    const float spacing = std::sqrt(x[2] * x[1] / float(std::max<std::uint64_t>(plan.counts[c], 1)));
+    reach[c] = kHaloSpacings * spacing * neighbourhood;
+    max_reach = std::max(max_reach, reach[c]);
+  }
+
+  // 3. Distribute.
+  WorkFolder folder(output);
+  const RecordLayout layout{in.has_normals(), in.has_radii()};
+  const std::size_t buffer_bytes =
+      std::clamp<std::size_t>((std::size_t{256} << 20) / chunks, 4096, 1 << 20);
+  {
+    ChunkFiles files(folder, chunks, "chunk", buffer_bytes);
+    ProgressPhase phase(progress, "distribute", n);
+    std::vector<char> record(layout.size());
+    in.for_each_batch([&](const PointSet& b, std::uint64_t first) {
+      for (std::size_t i = 0; i < b.size(); ++i) {
+        const Vec3f& p = b.positions[i];
+        const std::uint32_t own = plan.chunk_of(p, first + i);
+        encode_record(layout, b, i, first + i, false, record.data());
+        files.append(own, record.data(), record.size());
+        record[15] = 1;
+        plan.for_near_chunks(p, own, reach, max_reach, [&](std::uint32_t c) {
+          files.append(c, record.data(), record.size());
+          ++result.halo_points;
+        });
+      }
+      phase.advance(b.size());
+    });
+    files.flush_all();
+  }
+
+  // 4. Prepare each chunk with its halo; keep its own splats, their input indices and
+  // orientation pieces; tell each halo point's owner how this chunk oriented it.
+  const bool colors = in.has_colors();
+  OrientationStitcher stitcher;
+  std::vector<std::uint64_t> own_count(chunks, 0);
+  bool pieces = false;
+  {
+    ChunkFiles relations(folder, chunks, "relations", buffer_bytes);
+    ProgressPhase phase(progress, "prepare", n);
+    for (std::size_t c = 0; c < chunks; ++c) {
+      const std::string path = folder.file(ChunkFiles::name("chunk", c));
+      std::vector<std::uint8_t> own;
+      Splats s;
+      s.points = read_chunk(path, layout, colors, own, s.index);
+      std::filesystem::remove(path);
+      PrepareOptions prepare = o.prepare;
+      prepare.orientation_centre = centroid;
+      prepare.input_name = inputs.size() == 1 ? inputs[0] : "the inputs";
+      prepare.orientation_components = &s.piece;
+      prepare_splats(s.points, pool, Progress::none(), prepare);
+      if (!s.piece.empty()) {
+        pieces = true;
+        std::vector<double> votes;
+        for (std::size_t i = 0; i < s.points.size(); ++i) {
+          if (votes.size() <= s.piece[i]) votes.resize(s.piece[i] + 1, 0.0);
+          if (own[i]) votes[s.piece[i]] += double(dot(s.points.normals[i], s.points.positions[i] - centroid));
+          if (own[i]) continue;
+          const Relation r{s.index[i], std::uint32_t(c), s.piece[i], s.points.normals[i]};
+          relations.append(plan.chunk_of(s.points.positions[i], s.index[i]), &r, sizeof r);
+        }
+        stitcher.add_chunk(c, std::move(votes));
+      } else {
+        stitcher.add_chunk(c, {});
+      }
+      // Own splats only.
+      std::size_t k = 0;
+      for (std::size_t i = 0; i < own.size(); ++i) {
+        if (!own[i]) continue;
+        s.index[k] = s.index[i];
+        if (!s.piece.empty()) s.piece[k] = s.piece[i];
+        ++k;
+      }
+      s.index.resize(k);
+      if (!s.piece.empty()) s.piece.resize(k);
+      keep_points(s.points, own);
+      own_count[c] = k;
+      write_splats(folder.file(ChunkFiles::name("chunk", c) + ".prepared"), s);
+      phase.advance(plan.counts[c]);
+    }
+    relations.flush_all();
+  }
+
+  // 5. Stitch the pieces of surfaces that cross chunks, and orient each surface as a whole.
+  if (pieces) {
+    ProgressPhase phase(progress, "orientation", n);
+    for (std::size_t c = 0; c < chunks; ++c) {
+      const std::string rel_path = folder.file(ChunkFiles::name("relations", c));
+      if (!std::filesystem::exists(rel_path)) continue;
+      const Splats s = read_splats(folder.file(ChunkFiles::name("chunk", c) + ".prepared"),
+                                   own_count[c], colors, true, true);
+      const std::vector<char> bytes = read_whole(rel_path);
+      std::filesystem::remove(rel_path);
+      for (std::size_t at = 0; at + sizeof(Relation) <= bytes.size(); at += sizeof(Relation)) {
+        Relation r;
+        std::memcpy(&r, bytes.data() + at, sizeof r);
+        const auto it = std::lower_bound(s.index.begin(), s.index.end(), r.index);
+        if (it == s.index.end() || *it != r.index) continue;
+        const std::size_t i = std::size_t(it - s.index.begin());
+        stitcher.relate(c, s.piece[i], r.chunk, r.piece, dot(s.points.normals[i], r.normal) >= 0);
+      }
+      phase.advance(plan.counts[c]);
+    }
+    stitcher.solve();
+  }
+
+  // 6. Each chunk's subtree and summary; its splats kept in split order.
+  std::vector<PtlV2SubtreeSummary> summaries(chunks);
+  Aabb bounds;
+  PtlV2WriteOptions v2;
+  if (o.leaf_trim) v2.leaf_trim = *o.leaf_trim;
+  {
+    ProgressPhase phase(progress, "hierarchy", n);
+    for (std::size_t c = 0; c < chunks; ++c) {
+      const std::string path = folder.file(ChunkFiles::name("chunk", c) + ".prepared");
+      Splats s = read_splats(path, own_count[c], colors, true, pieces);
+      std::filesystem::remove(path);
+      if (pieces) {
+        for (std::size_t i = 0; i < s.points.size(); ++i) {
+          if (stitcher.flipped(c, s.piece[i])) s.points.normals[i] = -s.points.normals[i];
+        }
+      }
+      std::vector<std::uint32_t> order;
+      const SphereTree tree = build_sphere_tree(s.points, pool, Progress::none(), {}, &order);
+      summaries[c] = summarize_ptl_v2_subtree(tree, v2);
+      bounds.extend(tree.bounds);
+      Splats sorted;
+      const auto permute = [&](auto& dst, const auto& src) {
+        dst.resize(src.size());
+        for (std::size_t k = 0; k < order.size() && !src.empty(); ++k) dst[k] = src[order[k]];
+      };
+      permute(sorted.points.positions, s.points.positions);
+      permute(sorted.points.normals, s.points.normals);
+      permute(sorted.points.radii, s.points.radii);
+      permute(sorted.points.colors, s.points.colors);
+      write_splats(folder.file(ChunkFiles::name("chunk", c) + ".splats"), sorted);
+      phase.advance(plan.counts[c]);
+    }
+  }
+
+  // 7. Write.
+  {
+    ProgressPhase phase(progress, "write", n);
+    PtlV2PartWriter writer(output, summaries, colors, v2);
+    const Vec3f centre = bounds.center();
+    float far2 = 0;
+    for (std::size_t c = 0; c < chunks; ++c) {
+      const std::string path = folder.file(ChunkFiles::name("chunk", c) + ".splats");
+      const Splats s = read_splats(path, summaries[c].leaf_count, colors, false, false);
+      std::filesystem::remove(path);
+      const SphereTree tree =
+          build_sphere_tree(s.points, pool, Progress::none(), {.presorted = true});
+      for (const Vec3f& p : s.points.positions) far2 = std::max(far2, length_squared(p - centre));
+      writer.write_subtree(c, tree, pool);
+      phase.advance(plan.counts[c]);
+    }
+    std::ostringstream meta;
+    meta << metadata_head;
+    for (const std::string& comment : in.comments()) meta << "comment: " << comment << "\n";
+    writer.finish(bounds, {centre, std::sqrt(far2)}, in.origin(), in.up(), meta.str());
+  }
+  result.output_points = n;
+  return result;
+}
+
+}  // namespace pointillist::chunking

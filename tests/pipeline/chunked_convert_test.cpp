@@ -1,0 +1,145 @@
+// The chunked conversion: a cloud forced into many small chunks gives the model the conversion in
+// one piece gives (the one-piece file is the oracle: its decoded hierarchy, its renders, its
+// normals), leaves nothing behind, and says what it cannot do.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include "pointillist/core/error.hpp"
+#include "pointillist/eval/image_compare.hpp"
+#include "pointillist/format/ptl_v2.hpp"
+#include "pointillist/io/ply.hpp"
+#include "pointillist/pipeline/convert.hpp"
+#include "pointillist/render/render.hpp"
+#include "pointillist/scene/analytic.hpp"
+#include "testing/testing.hpp"
+
+namespace pointillist {
+namespace {
+
+using testing::TempDir;
+
+// The demo scene (sphere, torus, cube) sampled without normals or radii, with smooth colours.
+std::string write_cloud(const TempDir& dir, std::size_t count, const std::string& name) {
+  PointSet p = sample_scene(demo_scene(), count, 11).points;
+  for (const Vec3f& x : p.positions) {
+    p.colors.push_back({std::uint8_t(128 + 60 * x.x), std::uint8_t(128 + 60 * x.y),
+                        std::uint8_t(128 + 60 * x.z)});
+  }
+  const std::string path = dir.file(name);
+  write_ply(path, p);
+  return path;
+}
+
+struct Converted {
+  SphereTree whole, parts;
+  ConvertResult parts_result;
+};
+
+Converted convert_both(const TempDir& dir, const std::string& input, std::uint64_t chunk_points) {
+  ThreadPool pool(2);
+  const std::string whole = dir.file("whole.ptl"), parts = dir.file("parts.ptl");
+  const std::vector<std::string> inputs{input};
+  const ConvertResult w = convert(inputs, whole, {}, pool, Progress::none());
+  EXPECT_EQ(w.chunks, 0u);
+  Converted c;
+  c.parts_result = convert(inputs, parts, {.chunk_points = chunk_points}, pool, Progress::none());
+  c.whole = PtlV2File::open(whole)->decode_all();
+  c.parts = PtlV2File::open(parts)->decode_all();
+  return c;
+}
+
+TEST(ChunkedConvert, ManySmallChunksGiveTheOnePieceHierarchy) {
+  TempDir dir;
+  const std::string input = write_cloud(dir, 60000, "scene.ply");
+  const Converted c = convert_both(dir, input, 2000);
+  EXPECT_GE(c.parts_result.chunks, 16u);
+  EXPECT_GT(c.parts_result.halo_points, 0u);
+  ASSERT_EQ(c.parts.nodes.size(), c.whole.nodes.size());
+  EXPECT_EQ(c.parts.leaf_count, c.whole.leaf_count);
+  EXPECT_EQ(c.parts.depth, c.whole.depth);
+  EXPECT_EQ(std::memcmp(&c.parts.bounds, &c.whole.bounds, sizeof(Aabb)), 0);
+  std::size_t differing = 0, normals_apart = 0;
+  double worst_deg = 0;
+  for (std::size_t i = 0; i < c.whole.nodes.size(); ++i) {
+    const SphereNode& a = c.whole.nodes[i];
+    const SphereNode& b = c.parts.nodes[i];
+    if (std::memcmp(&a, &b, sizeof(SphereNode)) != 0) ++differing;
+    if (a.child_count == 0) {
+      const double deg = std::acos(std::clamp(double(dot(a.normal, b.normal)), -1.0, 1.0)) *
+                         180.0 / 3.14159265358979;
+      worst_deg = std::max(worst_deg, deg);
+      if (deg > 1.0) ++normals_apart;
+    }
+  }
+  std::printf("[chunked] %zu chunks, %llu halo points, %zu of %zu nodes differ, worst leaf "
+              "normal %.3f deg\n",
+              c.parts_result.chunks, (unsigned long long)c.parts_result.halo_points, differing,
+              c.whole.nodes.size(), worst_deg);
+  // The chunks are subtrees of the one-piece hierarchy, prepared with enough halo: the same
+  // nodes, bit for bit.
+  EXPECT_EQ(differing, 0u);
+  EXPECT_EQ(normals_apart, 0u);
+  // The renders at three views.
+  ThreadPool pool(2);
+  for (const float az : {0.0f, 120.0f, 240.0f}) {
+    const Camera cam = orbit_camera(c.whole.view_sphere,
+                                    {.azimuth_deg = az, .elevation_deg = 25, .width = 400,
+                                     .height = 300});
+    Frame fa, fb;
+    render(c.whole.view(), cam, {}, pool, fa);
+    render(c.parts.view(), cam, {}, pool, fb);
+    EXPECT_GE(psnr_rgb({fa.width, fa.height, fa.color}, {fb.width, fb.height, fb.color}), 40.0)
+        << "azimuth " << az;
+    EXPECT_NEAR(double(fb.stats.splats), double(fa.stats.splats), 0.01 * double(fa.stats.splats));
+  }
+}
+
+TEST(ChunkedConvert, LeavesNoChunkFolderAndReplacesALeftOverOne) {
+  TempDir dir;
+  const std::string input = write_cloud(dir, 8000, "scene.ply");
+  const std::string out = dir.file("out.ptl");
+  // A folder left by a conversion that was killed.
+  std::filesystem::create_directory(out + ".chunks");
+  std::ofstream(out + ".chunks/chunk-00000.pts") << "stale";
+  ThreadPool pool(2);
+  const std::vector<std::string> inputs{input};
+  convert(inputs, out, {.chunk_points = 1000}, pool, Progress::none());
+  EXPECT_TRUE(std::filesystem::exists(out));
+  EXPECT_FALSE(std::filesystem::exists(out + ".chunks"));
+  std::size_t files = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir.path())) {
+    (void)e;
+    ++files;
+  }
+  EXPECT_EQ(files, 2u);  // the input and the output
+}
+
+TEST(ChunkedConvert, SaysWhatItCannotDoYet) {
+  TempDir dir;
+  const std::string input = write_cloud(dir, 4000, "scene.ply");
+  ThreadPool pool(1);
+  const std::vector<std::string> inputs{input};
+  ConvertOptions o{.chunk_points = 1000};
+  o.prepare.drop_outliers = true;
+  EXPECT_THROW(convert(inputs, dir.file("a.ptl"), o, pool, Progress::none()), OptionError);
+  // A budget too small for the input in one piece, for an output that is only written whole.
+  try {
+    convert(inputs, dir.file("a.ply"), {.memory_budget = 100000}, pool, Progress::none());
+    FAIL() << "a .ply over the budget was written";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("--memory"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.file("a.ptl")));
+  EXPECT_FALSE(std::filesystem::exists(dir.file("a.ply")));
+  // The same budget for .ptl converts in chunks.
+  const ConvertResult r =
+      convert(inputs, dir.file("b.ptl"), {.memory_budget = 500000}, pool, Progress::none());
+  EXPECT_GT(r.chunks, 1u);
+}
+
+}  // namespace
+}  // namespace pointillist
