@@ -12,11 +12,14 @@
 // Everything goes to a folder beside the output, removed at the end and on failure; the output
 // appears only when complete.
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <mutex>
 #include <set>
 #include <sstream>
 
@@ -300,6 +303,24 @@ std::uint32_t plan_levels(std::uint64_t n, std::uint64_t max_points) {
   return levels;
 }
 
+// Calls fn(chunk, pool) for every chunk, `workers` chunks at a time, each worker with a pool of
+// its own (one thread): the serial parts of preparing a chunk (its orientation tree) then
+// overlap. Results go to per-chunk slots, so they do not depend on the worker count.
+void for_each_chunk(std::size_t chunks, ThreadPool& pool,
+                    const std::function<void(std::size_t, ThreadPool&)>& fn) {
+  const std::size_t workers = std::min<std::size_t>(pool.thread_count(), chunks);
+  if (workers <= 1) {
+    for (std::size_t c = 0; c < chunks; ++c) fn(c, pool);
+    return;
+  }
+  std::vector<std::unique_ptr<ThreadPool>> pools;
+  for (std::size_t w = 0; w < workers; ++w) pools.push_back(std::make_unique<ThreadPool>(1));
+  std::atomic<std::size_t> next{0};
+  pool.run(workers, [&](std::size_t w) {
+    for (std::size_t c; (c = next.fetch_add(1)) < chunks;) fn(c, *pools[w]);
+  });
+}
+
 }  // namespace
 
 ConvertResult convert_chunked(std::span<const std::string> inputs, const std::string& output,
@@ -401,11 +422,13 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
   const bool colors = in.has_colors();
   OrientationStitcher stitcher;
   std::vector<std::uint64_t> own_count(chunks, 0);
-  bool pieces = false;
+  std::vector<std::vector<double>> votes(chunks);
+  std::atomic<bool> pieces{false};
   {
     ChunkFiles relations(folder, chunks, "relations", buffer_bytes);
+    std::mutex relations_mutex;
     ProgressPhase phase(progress, "prepare", n);
-    for (std::size_t c = 0; c < chunks; ++c) {
+    for_each_chunk(chunks, pool, [&](std::size_t c, ThreadPool& chunk_pool) {
       const std::string path = folder.file(ChunkFiles::name("chunk", c));
       std::vector<std::uint8_t> own;
       Splats s;
@@ -415,20 +438,22 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
       prepare.orientation_centre = centroid;
       prepare.input_name = inputs.size() == 1 ? inputs[0] : "the inputs";
       prepare.orientation_components = &s.piece;
-      prepare_splats(s.points, pool, Progress::none(), prepare);
+      prepare_splats(s.points, chunk_pool, Progress::none(), prepare);
       if (!s.piece.empty()) {
         pieces = true;
-        std::vector<double> votes;
+        std::vector<std::pair<std::uint32_t, Relation>> halo;  // (owner chunk, relation)
         for (std::size_t i = 0; i < s.points.size(); ++i) {
-          if (votes.size() <= s.piece[i]) votes.resize(s.piece[i] + 1, 0.0);
-          if (own[i]) votes[s.piece[i]] += double(dot(s.points.normals[i], s.points.positions[i] - centroid));
-          if (own[i]) continue;
-          const Relation r{s.index[i], std::uint32_t(c), s.piece[i], s.points.normals[i]};
-          relations.append(plan.chunk_of(s.points.positions[i], s.index[i]), &r, sizeof r);
+          if (votes[c].size() <= s.piece[i]) votes[c].resize(s.piece[i] + 1, 0.0);
+          if (own[i]) {
+            votes[c][s.piece[i]] +=
+                double(dot(s.points.normals[i], s.points.positions[i] - centroid));
+          } else {
+            halo.push_back({plan.chunk_of(s.points.positions[i], s.index[i]),
+                            {s.index[i], std::uint32_t(c), s.piece[i], s.points.normals[i]}});
+          }
         }
-        stitcher.add_chunk(c, std::move(votes));
-      } else {
-        stitcher.add_chunk(c, {});
+        const std::lock_guard<std::mutex> lock(relations_mutex);
+        for (const auto& [owner, r] : halo) relations.append(owner, &r, sizeof r);
       }
       // Own splats only.
       std::size_t k = 0;
@@ -444,8 +469,9 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
       own_count[c] = k;
       write_splats(folder.file(ChunkFiles::name("chunk", c) + ".prepared"), s);
       phase.advance(plan.counts[c]);
-    }
+    });
     relations.flush_all();
+    for (std::size_t c = 0; c < chunks; ++c) stitcher.add_chunk(c, std::move(votes[c]));
   }
 
   // 5. Stitch the pieces of surfaces that cross chunks, and orient each surface as a whole.
@@ -478,7 +504,8 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
   if (o.leaf_trim) v2.leaf_trim = *o.leaf_trim;
   {
     ProgressPhase phase(progress, "hierarchy", n);
-    for (std::size_t c = 0; c < chunks; ++c) {
+    std::vector<Aabb> boxes(chunks);
+    for_each_chunk(chunks, pool, [&](std::size_t c, ThreadPool& chunk_pool) {
       const std::string path = folder.file(ChunkFiles::name("chunk", c) + ".prepared");
       Splats s = read_splats(path, own_count[c], colors, true, pieces);
       std::filesystem::remove(path);
@@ -488,9 +515,10 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
         }
       }
       std::vector<std::uint32_t> order;
-      const SphereTree tree = build_sphere_tree(s.points, pool, Progress::none(), {}, &order);
+      const SphereTree tree =
+          build_sphere_tree(s.points, chunk_pool, Progress::none(), {}, &order);
       summaries[c] = summarize_ptl_v2_subtree(tree, v2);
-      bounds.extend(tree.bounds);
+      boxes[c] = tree.bounds;
       Splats sorted;
       const auto permute = [&](auto& dst, const auto& src) {
         dst.resize(src.size());
@@ -502,7 +530,8 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
       permute(sorted.points.colors, s.points.colors);
       write_splats(folder.file(ChunkFiles::name("chunk", c) + ".splats"), sorted);
       phase.advance(plan.counts[c]);
-    }
+    });
+    for (const Aabb& b : boxes) bounds.extend(b);
   }
 
   // 7. Write.

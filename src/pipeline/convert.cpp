@@ -115,7 +115,9 @@ ConvertResult convert(std::span<const std::string> inputs, const std::string& ou
   if (to_v2 && (o.chunk_points != 0 || over)) {
     const std::uint64_t chunk_points =
         o.chunk_points ? o.chunk_points
-                       : std::max<std::uint64_t>(budget / chunking::kChunkBytesPerPoint, 1024);
+                       : std::max<std::uint64_t>(budget / chunking::kChunkBytesPerPoint /
+                                                     pool.thread_count(),
+                                                 1024);
     return chunking::convert_chunked(inputs, output, o, metadata_head(inputs, o), chunk_points,
                                      pool, progress);
   }
