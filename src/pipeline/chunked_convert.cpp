@@ -391,9 +391,23 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
     max_reach = std::max(max_reach, reach[c]);
   }
 
-  // 3. Distribute.
+  // 3. Distribute, once the disk is known to hold the chunk files (each point once, plus its
+  // halo copies, then as prepared splats) and the output.
   WorkFolder folder(output);
   const RecordLayout layout{in.has_normals(), in.has_radii()};
+  {
+    const double halo_share = 0.1;  // a generous bound: chunks of 1 M points have about 2 %
+    const auto need = std::uint64_t(double(n) * (double(layout.size()) * (1 + halo_share) + 43 + 12));
+    std::error_code error;
+    const std::filesystem::space_info space =
+        std::filesystem::space(std::filesystem::path(folder.file("")).parent_path(), error);
+    if (!error && space.available < need) {
+      throw IoError(folder.file("") + ": the chunked conversion needs about " +
+                    std::to_string(need / 1000000) + " MB of free disk beside the output, " +
+                    std::to_string(space.available / 1000000) +
+                    " MB are free; free some space or write the output to another disk");
+    }
+  }
   const std::size_t buffer_bytes =
       std::clamp<std::size_t>((std::size_t{256} << 20) / chunks, 4096, 1 << 20);
   {
