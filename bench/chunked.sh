@@ -11,7 +11,8 @@
 #
 #   --points N     points of the generated cloud (default 10000000). 100000000 takes about
 #                  25 s to generate (1.2 GB), minutes to convert, and 17 GB in one piece.
-#   --memory LIST  budgets for the chunked runs (default 1G,4G)
+#   --memory LIST  budgets for the chunked runs (default 1G,512M; a budget the cloud fits in one
+#                  piece runs in one piece)
 #   --no-whole     skip the one-piece run (inputs too large for this machine's memory); ratios
 #                  are then left out
 set -euo pipefail
@@ -19,7 +20,7 @@ cd "$(dirname "$0")/.."
 bin="${POINTILLIST_BIN:-build/release/pointillist}"
 work="${CHUNKED_BENCH_WORK:-/tmp/pointillist-bench-chunked}"
 points=10000000
-memory="1G,4G"
+memory="1G,512M"
 whole=1
 while [ $# -gt 0 ]; do
   case "$1" in

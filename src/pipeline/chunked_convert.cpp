@@ -12,6 +12,7 @@
 // Everything goes to a folder beside the output, removed at the end and on failure; the output
 // appears only when complete.
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstring>
@@ -75,12 +76,20 @@ class MergedInputs {
     for (const auto& s : streams_) normals_ = normals_ && s->saw_usable_normals();
   }
 
-  // Calls fn(batch, index of its first point) over every point, in order.
+  // Calls fn(batch, index of its first point) over every point, in order; tells `progress`
+  // which file it reads when there are several.
   template <class Fn>
-  void for_each_batch(Fn&& fn) {
+  void for_each_batch(Progress& progress, Fn&& fn) {
     std::uint64_t next = 0;
     PointSet batch;
-    for (const auto& stream : streams_) {
+    for (std::size_t k = 0; k < streams_.size(); ++k) {
+      const auto& stream = streams_[k];
+      if (streams_.size() > 1) {
+        const std::string& path = stream->info().path;
+        const std::size_t slash = path.find_last_of('/');
+        progress.detail(path.substr(slash == std::string::npos ? 0 : slash + 1) + " (" +
+                        std::to_string(k + 1) + "/" + std::to_string(streams_.size()) + ")");
+      }
       stream->rewind();
       const std::array<double, 3>& o = stream->info().origin;
       const double shift[3] = {o[0] - origin_[0], o[1] - origin_[1], o[2] - origin_[2]};
@@ -303,6 +312,62 @@ std::uint32_t plan_levels(std::uint64_t n, std::uint64_t max_points) {
   return levels;
 }
 
+// The phases of a chunked conversion, each with its share of the whole job's time (measured on
+// 10 M points: preparing the chunks, their normals and radii, is most of it), as one overall
+// figure in points: phase names and totals go to `inner` as they are.
+class OverallProgress final : public Progress {
+ public:
+  OverallProgress(Progress& inner, std::uint64_t points) : inner_(inner), points_(points) {}
+  void begin_phase(std::string_view name, std::uint64_t total) override {
+    inner_.begin_phase(name, total);
+    phase_ = kPhases.size();
+    for (std::size_t i = 0; i < kPhases.size(); ++i) {
+      if (name == kPhases[i].name) phase_ = i;
+    }
+    total_ = total;
+    done_ = 0;
+    report();
+  }
+  void advance(std::uint64_t units) override {
+    inner_.advance(units);
+    done_ += units;
+    report();
+  }
+  void end_phase() override {
+    if (phase_ < kPhases.size()) finished_ += kPhases[phase_].share;
+    phase_ = kPhases.size();
+    inner_.end_phase();
+    report();
+  }
+  void detail(std::string_view text) override { inner_.detail(text); }
+
+ private:
+  struct Phase {
+    std::string_view name;
+    double share;
+  };
+  static constexpr std::array<Phase, 7> kPhases = {{{"scan", 0.03},
+                                                    {"plan", 0.03},
+                                                    {"distribute", 0.05},
+                                                    {"prepare", 0.55},
+                                                    {"orientation", 0.02},
+                                                    {"hierarchy", 0.12},
+                                                    {"write", 0.20}}};
+  void report() {
+    double f = finished_;
+    if (phase_ < kPhases.size() && total_ > 0) {
+      f += kPhases[phase_].share * std::min(1.0, double(done_.load()) / double(total_));
+    }
+    inner_.overall(std::uint64_t(std::min(1.0, f) * double(points_)), points_);
+  }
+  Progress& inner_;
+  std::uint64_t points_;
+  std::size_t phase_ = kPhases.size();
+  std::uint64_t total_ = 0;
+  std::atomic<std::uint64_t> done_{0};
+  double finished_ = 0;
+};
+
 // Calls fn(chunk, pool) for every chunk, `workers` chunks at a time, each worker with a pool of
 // its own (one thread): the serial parts of preparing a chunk (its orientation tree) then
 // overlap. Results go to per-chunk slots, so they do not depend on the worker count.
@@ -326,7 +391,7 @@ void for_each_chunk(std::size_t chunks, ThreadPool& pool,
 ConvertResult convert_chunked(std::span<const std::string> inputs, const std::string& output,
                               const ConvertOptions& o, const std::string& metadata_head,
                               std::uint64_t max_chunk_points, ThreadPool& pool,
-                              Progress& progress) {
+                              Progress& outer_progress) {
   if (o.prepare.drop_outliers) {
     throw OptionError("convert: --drop-outliers is not available for chunked conversion yet (the "
                       "input needs more than --memory); give a larger --memory, or drop the "
@@ -338,6 +403,8 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
   }
   MergedInputs in(inputs, o.columns);
   const std::uint64_t n = in.count();
+  OverallProgress overall(outer_progress, n);
+  Progress& progress = overall;
   ConvertResult result;
   result.input_points = n;
 
@@ -347,7 +414,7 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
   double sum[3] = {0, 0, 0};
   {
     ProgressPhase phase(progress, "scan", n);
-    in.for_each_batch([&](const PointSet& b, std::uint64_t) {
+    in.for_each_batch(progress, [&](const PointSet& b, std::uint64_t) {
       for (const Vec3f& p : b.positions) {
         if (!is_finite(p)) {
           throw Error(std::string(inputs.size() == 1 ? inputs[0] : "the inputs") +
@@ -414,7 +481,7 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
     ChunkFiles files(folder, chunks, "chunk", buffer_bytes);
     ProgressPhase phase(progress, "distribute", n);
     std::vector<char> record(layout.size());
-    in.for_each_batch([&](const PointSet& b, std::uint64_t first) {
+    in.for_each_batch(progress, [&](const PointSet& b, std::uint64_t first) {
       for (std::size_t i = 0; i < b.size(); ++i) {
         const Vec3f& p = b.positions[i];
         const std::uint32_t own = plan.chunk_of(p, first + i);

@@ -19,6 +19,16 @@ class Progress {
   // The current phase is finished.
   virtual void end_phase() = 0;
 
+  // The whole job across its phases (a chunked conversion): `done` of `total` points' worth of
+  // work, for an overall bar with throughput and time left. Default: ignored.
+  virtual void overall(std::uint64_t done, std::uint64_t total) {
+    (void)done;
+    (void)total;
+  }
+  // What the current phase works on (an input file's name), shown beside it until the phase ends
+  // or another detail comes. Default: ignored.
+  virtual void detail(std::string_view text) { (void)text; }
+
   // A sink that ignores everything (stateless, so sharing it is harmless).
   static Progress& none();
 };
