@@ -2,6 +2,7 @@
 #include "pointillist/spatial/knn.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cassert>
 #include <limits>
 #include <nanoflann.hpp>
@@ -63,33 +64,64 @@ std::vector<std::uint32_t> k_nearest_neighbours(std::span<const Vec3f> points, T
   const CloudAdaptor adaptor{tree_points};
   const KdTree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(kLeafSize));
 
-  // Ask for one more than k: the query point finds itself and is then dropped.
-  const std::size_t wanted = std::min(k + 1, n);
+  // Ask for one more than k (the query point finds itself and is then dropped), and one more to
+  // see whether points at the same distance straddle the k-th place: which of them the tree
+  // returns depends on the tree, so such a query is asked again for kTieSlack more, and the cut
+  // among the tied points is made here by their positions. The same neighbours are then found in
+  // any subset of the points that holds them (a chunk and its halo, pipeline/chunked_convert.cpp)
+  // as long as at most kTieSlack + 1 points tie at the cut.
+  constexpr std::size_t kTieSlack = 8;
+  const std::size_t wanted = std::min(k + 2, n);
+  const std::size_t wanted_tied = std::min(k + 1 + kTieSlack, n);
   parallel_for(pool, n, kQueryGrain, [&](std::size_t begin, std::size_t end) {
-    std::vector<std::uint32_t> found_index(wanted);
-    std::vector<float> found_d2(wanted);
+    std::vector<std::uint32_t> found_index(wanted_tied);
+    std::vector<float> found_d2(wanted_tied);
     std::vector<Neighbour> row;
-    row.reserve(wanted);
+    row.reserve(wanted_tied);
     for (std::size_t j = begin; j < end; ++j) {
-      nanoflann::KNNResultSet<float, std::uint32_t, std::size_t> results(wanted);
-      results.init(found_index.data(), found_d2.data());
       const Vec3f q = tree_points[j];
       const float query[3] = {q.x, q.y, q.z};
-      tree.findNeighbors(results, query, nanoflann::SearchParams());
-      const std::size_t found = results.size();
-
-      row.clear();
-      bool dropped_self = false;
-      for (std::size_t i = 0; i < found; ++i) {
-        if (!dropped_self && found_index[i] == j) {
-          dropped_self = true;
-          continue;
+      const auto query_row = [&](std::size_t count) {
+        nanoflann::KNNResultSet<float, std::uint32_t, std::size_t> results(count);
+        results.init(found_index.data(), found_d2.data());
+        tree.findNeighbors(results, query, nanoflann::SearchParams());
+        const std::size_t found = results.size();
+        row.clear();
+        bool dropped_self = false;
+        for (std::size_t i = 0; i < found; ++i) {
+          if (!dropped_self && found_index[i] == j) {
+            dropped_self = true;
+            continue;
+          }
+          row.push_back({found_d2[i], original(found_index[i])});
         }
-        row.push_back({found_d2[i], original(found_index[i])});
+      };
+      query_row(wanted);
+      if (row.size() > k && row[k].d2 == row[k - 1].d2 && wanted_tied > wanted) {
+        query_row(wanted_tied);
       }
-      // Many copies of the query point can crowd it out of its own list; then drop the farthest.
-      if (row.size() > k) row.resize(k);
-      // Rows come sorted by distance; order equal distances by index (insertion sort, ~linear).
+      // Rows come sorted by distance. Equal distances at the cut: the lowest positions (x, then
+      // y, then z) make it. (Many copies of the query point can crowd it out of its own list;
+      // then the farthest is dropped.)
+      if (row.size() > k) {
+        const float cut = row[k - 1].d2;
+        std::size_t first = k - 1, last = k;
+        while (first > 0 && row[first - 1].d2 == cut) --first;
+        while (last < row.size() && row[last].d2 == cut) ++last;
+        if (last > k) {
+          const auto position = [&](const Neighbour& nb) {
+            const Vec3f p = points[nb.index];
+            return std::array<float, 3>{p.x, p.y, p.z};
+          };
+          std::sort(row.begin() + std::ptrdiff_t(first), row.begin() + std::ptrdiff_t(last),
+                    [&](const Neighbour& a, const Neighbour& b) {
+                      const auto pa = position(a), pb = position(b);
+                      return pa < pb || (pa == pb && a.index < b.index);
+                    });
+        }
+        row.resize(k);
+      }
+      // Order equal distances by index (insertion sort, ~linear).
       for (std::size_t i = 1; i < row.size(); ++i) {
         const Neighbour x = row[i];
         std::size_t m = i;

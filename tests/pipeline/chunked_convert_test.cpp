@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 #include "pointillist/core/error.hpp"
 #include "pointillist/eval/image_compare.hpp"
@@ -15,6 +16,8 @@
 #include "pointillist/pipeline/convert.hpp"
 #include "pointillist/render/render.hpp"
 #include "pointillist/scene/analytic.hpp"
+#include "io/io_test_support.hpp"
+#include "io/las_builder.hpp"
 #include "testing/testing.hpp"
 
 namespace pointillist {
@@ -96,6 +99,60 @@ TEST(ChunkedConvert, ManySmallChunksGiveTheOnePieceHierarchy) {
         << "azimuth " << az;
     EXPECT_NEAR(double(fb.stats.splats), double(fa.stats.splats), 0.01 * double(fa.stats.splats));
   }
+}
+
+// Two georeferenced LAS tiles of one survey, side by side, one without colours: merged by the
+// same rules in chunks as in one piece.
+TEST(ChunkedConvert, MergesTilesAsTheConversionInOnePieceDoes) {
+  TempDir dir;
+  testing::LasSpec spec{.format = 3, .scale = {0.001, 0.001, 0.001},
+                        .offset = {500000, 5400000, 10}};
+  std::vector<testing::LasPoint> a, b;
+  for (std::int32_t i = 0; i < 15000; ++i) {
+    const double t = i * 0.013;
+    const auto x = std::int32_t(20000 * std::cos(t) + (i % 97) * 3);
+    const auto y = std::int32_t(20000 * std::sin(t) + (i % 89) * 3);
+    a.push_back({x, y, (i * 37) % 5000, std::uint16_t(i * 5), std::uint16_t(i * 3), 900});
+    b.push_back({x + 45000, y + 12000, (i * 41) % 5000, 0, 0, 0});
+  }
+  const std::string la = dir.file("a.las"), lb = dir.file("b.las");
+  testing::write_file(la, testing::build_las(spec, a));
+  spec.format = 1;  // no colours
+  testing::write_file(lb, testing::build_las(spec, b));
+  const std::vector<std::string> inputs{la, lb};
+  ThreadPool pool(2);
+  const std::string whole = dir.file("whole.ptl"), parts = dir.file("parts.ptl");
+  const ConvertResult w = convert(inputs, whole, {}, pool, Progress::none());
+  const ConvertResult p = convert(inputs, parts, {.chunk_points = 3000}, pool, Progress::none());
+  EXPECT_EQ(w.chunks, 0u);
+  EXPECT_GE(p.chunks, 8u);
+  const auto fw = PtlV2File::open(whole), fp = PtlV2File::open(parts);
+  EXPECT_EQ(fp->origin(), fw->origin());
+  EXPECT_EQ(fp->up(), fw->up());
+  EXPECT_EQ(fp->metadata(), fw->metadata());
+  const SphereTree tw = fw->decode_all(), tp = fp->decode_all();
+  ASSERT_EQ(tp.nodes.size(), tw.nodes.size());
+  EXPECT_EQ(std::memcmp(tp.nodes.data(), tw.nodes.data(), tw.nodes.size() * sizeof(SphereNode)), 0);
+}
+
+TEST(ChunkedConvert, ABadPointStopsItWithoutLeavingAnything) {
+  TempDir dir;
+  PointSet p = sample_scene(demo_scene(), 5000, 3).points;
+  p.positions[4321].z = std::numeric_limits<float>::infinity();
+  const std::string input = dir.file("bad.ply");
+  write_ply(input, p);
+  ThreadPool pool(2);
+  const std::vector<std::string> inputs{input};
+  try {
+    convert(inputs, dir.file("out.ptl"), {.chunk_points = 1000}, pool, Progress::none());
+    FAIL() << "converted a file with an infinite coordinate";
+  } catch (const Error& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("bad.ply"), std::string::npos) << m;
+    EXPECT_NE(m.find("4321"), std::string::npos) << m;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.file("out.ptl")));
+  EXPECT_FALSE(std::filesystem::exists(dir.file("out.ptl.chunks")));
 }
 
 TEST(ChunkedConvert, LeavesNoChunkFolderAndReplacesALeftOverOne) {

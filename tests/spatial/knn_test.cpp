@@ -8,6 +8,7 @@
 #include <numeric>
 #include <random>
 #include <set>
+#include <tuple>
 
 using namespace pointillist;
 
@@ -95,6 +96,46 @@ TEST(KNearestNeighbours, EqualDistancesAreOrderedByIndex) {
                                                centre + 1,  centre + 6, centre + 36};
   EXPECT_EQ(std::vector<std::uint32_t>(nb.begin() + centre * k, nb.begin() + centre * k + k),
             expected);
+}
+
+// On a grid, an interior point with k = 4 has 6 face neighbours tied at distance 1: the cut takes
+// the 4 lowest positions (x, then y, then z), whatever else is in the set, so a subset holding
+// a point's neighbourhood (a chunk and its halo) finds the same neighbours as the whole.
+TEST(KNearestNeighbours, TiesAtTheCutGoToTheLowestPositionsInAnySubset) {
+  const std::vector<Vec3f> all = grid_points(9);
+  ThreadPool pool(2);
+  const std::uint32_t k = 4;
+  const auto whole = k_nearest_neighbours(all, pool, {.k = k});
+  const std::size_t centre = 4 + 9 * (4 + 9 * 4);  // (4, 4, 4)
+  std::vector<Vec3f> got;
+  for (std::uint32_t j = 0; j < k; ++j) got.push_back(all[whole[centre * k + j]]);
+  std::sort(got.begin(), got.end(), [](Vec3f a, Vec3f b) {
+    return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
+  });
+  const std::vector<Vec3f> lowest = {{3, 4, 4}, {4, 3, 4}, {4, 4, 3}, {4, 4, 5}};
+  EXPECT_EQ(got, lowest);
+  // Subsets: the points within distance 2.5 of the centre, in shuffled orders.
+  std::mt19937 rng(3);
+  for (int trial = 0; trial < 5; ++trial) {
+    std::vector<std::size_t> keep;
+    for (std::size_t i = 0; i < all.size(); ++i) {
+      if (length_squared(all[i] - all[centre]) <= 6.25f) keep.push_back(i);
+    }
+    std::shuffle(keep.begin(), keep.end(), rng);
+    std::vector<Vec3f> part;
+    std::size_t at = 0;
+    for (std::size_t i = 0; i < keep.size(); ++i) {
+      part.push_back(all[keep[i]]);
+      if (keep[i] == centre) at = i;
+    }
+    const auto sub = k_nearest_neighbours(part, pool, {.k = k});
+    std::set<std::size_t> a, b;
+    for (std::uint32_t j = 0; j < k; ++j) {
+      a.insert(whole[centre * k + j]);
+      b.insert(keep[sub[at * k + j]]);
+    }
+    EXPECT_EQ(a, b) << "trial " << trial;
+  }
 }
 
 TEST(KNearestNeighbours, SameResultForAnyThreadCountAndOrderFlag) {

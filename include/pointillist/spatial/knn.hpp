@@ -26,7 +26,9 @@ struct KnnOptions {
 // neighbours exist only when n <= k; then the missing entries repeat the last found neighbour,
 // or the point itself when n == 1. `squared_distances`, when not null, receives the matching
 // squared Euclidean distances (n*k entries).
-// Equal distances: which of several equidistant points make the cut depends only on the points;
+// Equal distances: of several equidistant points at the k-th place, those with the lowest
+// positions (x, then y, then z) make the cut (up to 9 tied there; more are cut as the kd-tree
+// finds them), so the same neighbours are found in any subset of the points that holds them;
 // within a row, equal distances are ordered by index. Copies of a point (distance 0) are
 // neighbours like any other point. Parallel over points (progress phase "neighbours"); the result
 // does not depend on the thread count. Positions must be finite. Memory: the result plus about
