@@ -21,7 +21,7 @@ int longest(const float extent[3]) {
 ChunkPlan plan_chunks(std::span<const Vec3f> positions, std::uint32_t levels, ThreadPool& pool,
                       std::vector<std::vector<std::uint32_t>>* members) {
   const std::size_t n = positions.size();
-  if (n >= (std::size_t{1} << 32) || levels > 20 || (n >> levels) < 2) {
+  if (n == 0 || n >= (std::size_t{1} << 32) || levels > 20 || (levels > 0 && (n >> levels) < 2)) {
     throw Error("cannot plan " + std::to_string(std::size_t{1} << levels) + " chunks over " +
                 std::to_string(n) + " points");
   }

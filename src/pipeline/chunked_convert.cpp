@@ -21,6 +21,7 @@
 #include <fstream>
 #include <functional>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -61,6 +62,20 @@ class MergedInputs {
     }
     origin_ = streams_[0]->info().origin;
     up_ = streams_[0]->info().up;
+  }
+
+  // As merge_inputs warns: files without colours among files with them are drawn grey.
+  std::optional<std::string> colour_warning() const {
+    std::vector<std::string> without;
+    for (const auto& s : streams_) {
+      if (!s->info().has_colors) without.push_back(s->info().path);
+    }
+    if (!colors_ || without.empty()) return std::nullopt;
+    std::string list;
+    for (std::size_t i = 0; i < without.size() && i < 5; ++i) list += (i ? ", " : "") + without[i];
+    if (without.size() > 5) list += ", ...";
+    return std::to_string(without.size()) + " of " + std::to_string(streams_.size()) +
+           " input files have no colors; their points are grey (" + list + ")";
   }
 
   std::uint64_t count() const { return count_; }
@@ -281,6 +296,7 @@ Splats read_splats(const std::string& path, std::size_t n, bool colors, bool ind
   if (bytes.size() != need) throw IoError(path + ": a chunk file changed on disk");
   const char* at = bytes.data();
   const auto get = [&](auto& v) {
+    if (v.empty()) return;  // (an empty vector's data() may be null, which memcpy refuses)
     std::memcpy(v.data(), at, v.size() * sizeof(v[0]));
     at += v.size() * sizeof(v[0]);
   };
@@ -312,9 +328,10 @@ std::uint32_t plan_levels(std::uint64_t n, std::uint64_t max_points) {
   return levels;
 }
 
-// The phases of a chunked conversion, each with its share of the whole job's time (measured on
-// 10 M points: preparing the chunks, their normals and radii, is most of it), as one overall
-// figure in points: phase names and totals go to `inner` as they are.
+// The phases of a chunked conversion, each with its share of the whole job's time (estimates
+// from the profile of a 10 M-point run, where preparing the chunks, their neighbours, normals
+// and radii, is most of it), as one overall figure in points: phase names and totals go to
+// `inner` as they are.
 class OverallProgress final : public Progress {
  public:
   OverallProgress(Progress& inner, std::uint64_t points) : inner_(inner), points_(points) {}
@@ -407,6 +424,7 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
   Progress& progress = overall;
   ConvertResult result;
   result.input_points = n;
+  if (const auto warning = in.colour_warning()) result.warnings.push_back(*warning);
 
   // 1. Positions and centroid.
   std::vector<Vec3f> positions;
@@ -435,6 +453,13 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
 
   // 2. The plan.
   const std::uint32_t levels = plan_levels(n, std::max<std::uint64_t>(max_chunk_points, 2));
+  if (o.memory_budget != 0 && n * kPlanBytesPerPoint > o.memory_budget) {
+    result.warnings.push_back(
+        "the chunk plan holds " + std::to_string(kPlanBytesPerPoint) +
+        " bytes a point (" + std::to_string(n * kPlanBytesPerPoint / 1000000) +
+        " MB for these inputs), more than --memory; the conversion goes on above the budget "
+        "while the plan is made");
+  }
   ChunkPlan plan;
   {
     ProgressPhase phase(progress, "plan", n);

@@ -126,6 +126,8 @@ TEST(ChunkedConvert, MergesTilesAsTheConversionInOnePieceDoes) {
   const ConvertResult p = convert(inputs, parts, {.chunk_points = 3000}, pool, Progress::none());
   EXPECT_EQ(w.chunks, 0u);
   EXPECT_GE(p.chunks, 8u);
+  ASSERT_EQ(w.warnings.size(), 1u);  // b.las has no colours
+  EXPECT_EQ(p.warnings, w.warnings);
   const auto fw = PtlV2File::open(whole), fp = PtlV2File::open(parts);
   EXPECT_EQ(fp->origin(), fw->origin());
   EXPECT_EQ(fp->up(), fw->up());
