@@ -9,7 +9,10 @@
 #include <span>
 #include <vector>
 
+#include <string>
+
 #include "pointillist/core/math.hpp"
+#include "pointillist/core/progress.hpp"
 #include "pointillist/core/thread_pool.hpp"
 
 namespace pointillist::chunking {
@@ -77,5 +80,16 @@ struct ChunkPlan {
 // same plan for any thread count.
 ChunkPlan plan_chunks(std::span<const Vec3f> positions, std::uint32_t levels, ThreadPool& pool,
                       std::vector<std::vector<std::uint32_t>>* members = nullptr);
+
+// The plan of plan_chunks without the positions in memory: `path` holds the `n` positions
+// (Vec3f records, 12 bytes each, in index order), `box` is their box. Each level reads the file
+// about twice (a count of the split coordinates' top 16 bits for every range, then the points of
+// the bucket holding each median, selected in memory); more when a bucket holds more than
+// `max_candidates` points (the level's ranges together), as with many equal coordinates.
+// Memory: 256 KiB a range and thread, and 32 bytes a candidate. The same plan for any thread
+// count. Reports n / levels to `progress` after each level. Throws IoError.
+ChunkPlan plan_chunks_on_disk(const std::string& path, std::uint64_t n, const Aabb& box,
+                              std::uint32_t levels, std::size_t max_candidates, ThreadPool& pool,
+                              Progress& progress);
 
 }  // namespace pointillist::chunking

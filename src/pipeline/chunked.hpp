@@ -16,7 +16,8 @@ namespace pointillist::chunking {
 // prepared splats, the neighbour rows, the subtree and its encoding).
 constexpr std::uint64_t kInCoreBytesPerPoint = 220;
 constexpr std::uint64_t kChunkBytesPerPoint = 400;
-// The chunk plan holds every position and its place in the split order.
+// The chunk plan in memory holds every position and its place in the split order; over the
+// budget, the plan works from a file of the positions instead.
 constexpr std::uint64_t kPlanBytesPerPoint = 16;
 // A chunk's halo reaches this many point spacings beyond its box (a 16-neighbourhood on a
 // surface spans about 2.3).

@@ -1,8 +1,10 @@
 // The chunked conversion (see convert.hpp, ConvertOptions::memory_budget): scans larger than the
 // memory budget become a .ptl v2 file chunk by chunk.
-//   1. scan: the inputs are streamed once for their positions (12 bytes a point) and centroid;
+//   1. scan: the inputs are streamed once for their positions (12 bytes a point, in memory or,
+//      when the budget cannot hold them, in a file) and centroid;
 //   2. plan: the top binary levels of the hierarchy's median splits cut the points into chunks
-//      that are exactly subtrees of the one-piece hierarchy (chunk_plan.hpp);
+//      that are exactly subtrees of the one-piece hierarchy (chunk_plan.hpp; out of core by
+//      radix selection when the positions are on disk);
 //   3. distribute: the inputs are streamed again into one file per chunk, with a halo: the
 //      points of other chunks near its box, so normals and radii see across its border;
 //   4. prepare: each chunk (and its halo) gets normals and radii, loses its halo, becomes its
@@ -243,45 +245,87 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
   result.input_points = n;
   if (const auto warning = in.colour_warning()) result.warnings.push_back(*warning);
 
-  // 1. Positions and centroid.
+  // The plan holds every position in memory when the budget allows, else it works from a file
+  // of them.
+  const std::uint64_t budget = o.memory_budget ? o.memory_budget : default_memory_budget();
+  const bool plan_on_disk = n * kPlanBytesPerPoint > budget;
+  const std::uint32_t levels = plan_levels(n, std::max<std::uint64_t>(max_chunk_points, 2));
+
+  // The folder, once the disk is known to hold the conversion's files at their peak: the
+  // positions (for a plan on disk), then the chunk files (each point once, plus its halo
+  // copies), which become the prepared splats (43 bytes each), then the splats in split order
+  // (31 bytes) as the output is written.
+  WorkFolder folder(output);
+  const RecordLayout layout{in.has_normals(), in.has_radii()};
+  {
+    const double halo_share = 0.1;  // a generous bound: chunks of 1 M points have about 2 %
+    const double per_point = std::max({plan_on_disk ? 12.0 : 0.0,
+                                       double(layout.size()) * (1 + halo_share), 43.0, 31.0 + 12});
+    const auto need = std::uint64_t(double(n) * per_point + double(max_chunk_points) * 43);
+    std::error_code error;
+    const std::filesystem::space_info space =
+        std::filesystem::space(std::filesystem::path(folder.file("")).parent_path(), error);
+    if (!error && space.available < need) {
+      throw IoError(folder.file("") + ": the chunked conversion needs about " +
+                    std::to_string(need / 1000000) + " MB of free disk beside the output, " +
+                    std::to_string(space.available / 1000000) +
+                    " MB are free; free some space or write the output to another disk");
+    }
+  }
+
+  // 1. Positions, their box and centroid.
   std::vector<Vec3f> positions;
-  positions.reserve(n);
+  std::optional<ChunkFiles> position_file;
+  if (plan_on_disk) {
+    position_file.emplace(folder, 1, "positions", std::size_t{1} << 22);
+  } else {
+    positions.reserve(n);
+  }
   double sum[3] = {0, 0, 0};
+  Aabb box;
   {
     ProgressPhase phase(progress, "scan", n);
+    std::uint64_t seen = 0;
     in.for_each_batch(progress, [&](const PointSet& b, std::uint64_t) {
       for (const Vec3f& p : b.positions) {
         if (!is_finite(p)) {
           throw Error(std::string(inputs.size() == 1 ? inputs[0] : "the inputs") +
-                      ": vertex " + std::to_string(positions.size()) +
+                      ": vertex " + std::to_string(seen) +
                       " has a non-finite position; remove it from the file");
         }
-        positions.push_back(p);
+        ++seen;
+        if (plan_on_disk) {
+          position_file->append(0, &p, sizeof p);
+        } else {
+          positions.push_back(p);
+        }
+        box.extend(p);
         sum[0] += p.x;
         sum[1] += p.y;
         sum[2] += p.z;
       }
       phase.advance(b.size());
     });
+    if (position_file) position_file->flush_all();
   }
   in.drop_unusable_normals();
   const Vec3f centroid{float(sum[0] / double(n)), float(sum[1] / double(n)),
                        float(sum[2] / double(n))};
 
   // 2. The plan.
-  const std::uint32_t levels = plan_levels(n, std::max<std::uint64_t>(max_chunk_points, 2));
-  if (o.memory_budget != 0 && n * kPlanBytesPerPoint > o.memory_budget) {
-    result.warnings.push_back(
-        "the chunk plan holds " + std::to_string(kPlanBytesPerPoint) +
-        " bytes a point (" + std::to_string(n * kPlanBytesPerPoint / 1000000) +
-        " MB for these inputs), more than --memory; the conversion goes on above the budget "
-        "while the plan is made");
-  }
   ChunkPlan plan;
   {
     ProgressPhase phase(progress, "plan", n);
-    plan = plan_chunks(positions, levels, pool);
-    phase.advance(n);
+    if (plan_on_disk) {
+      const std::string path = folder.file(ChunkFiles::name("positions", 0));
+      // A quarter of the budget for the selections' candidates (32 bytes each).
+      const std::size_t candidates = std::max<std::uint64_t>(budget / 4 / 32, 1024);
+      plan = plan_chunks_on_disk(path, n, box, levels, candidates, pool, progress);
+      std::filesystem::remove(path);
+    } else {
+      plan = plan_chunks(positions, levels, pool);
+      phase.advance(n);
+    }
   }
   std::vector<Vec3f>().swap(positions);
   const std::size_t chunks = plan.chunk_count();
@@ -300,23 +344,7 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
     max_reach = std::max(max_reach, reach[c]);
   }
 
-  // 3. Distribute, once the disk is known to hold the chunk files (each point once, plus its
-  // halo copies, then as prepared splats) and the output.
-  WorkFolder folder(output);
-  const RecordLayout layout{in.has_normals(), in.has_radii()};
-  {
-    const double halo_share = 0.1;  // a generous bound: chunks of 1 M points have about 2 %
-    const auto need = std::uint64_t(double(n) * (double(layout.size()) * (1 + halo_share) + 43 + 12));
-    std::error_code error;
-    const std::filesystem::space_info space =
-        std::filesystem::space(std::filesystem::path(folder.file("")).parent_path(), error);
-    if (!error && space.available < need) {
-      throw IoError(folder.file("") + ": the chunked conversion needs about " +
-                    std::to_string(need / 1000000) + " MB of free disk beside the output, " +
-                    std::to_string(space.available / 1000000) +
-                    " MB are free; free some space or write the output to another disk");
-    }
-  }
+  // 3. Distribute.
   const std::size_t buffer_bytes =
       std::clamp<std::size_t>((std::size_t{256} << 20) / chunks, 4096, 1 << 20);
   {

@@ -42,14 +42,15 @@ struct Converted {
   ConvertResult parts_result;
 };
 
-Converted convert_both(const TempDir& dir, const std::string& input, std::uint64_t chunk_points) {
+Converted convert_both(const TempDir& dir, const std::string& input,
+                       const ConvertOptions& parts_options) {
   ThreadPool pool(2);
   const std::string whole = dir.file("whole.ptl"), parts = dir.file("parts.ptl");
   const std::vector<std::string> inputs{input};
   const ConvertResult w = convert(inputs, whole, {}, pool, Progress::none());
   EXPECT_EQ(w.chunks, 0u);
   Converted c;
-  c.parts_result = convert(inputs, parts, {.chunk_points = chunk_points}, pool, Progress::none());
+  c.parts_result = convert(inputs, parts, parts_options, pool, Progress::none());
   c.whole = PtlV2File::open(whole)->decode_all();
   c.parts = PtlV2File::open(parts)->decode_all();
   return c;
@@ -58,7 +59,7 @@ Converted convert_both(const TempDir& dir, const std::string& input, std::uint64
 TEST(ChunkedConvert, ManySmallChunksGiveTheOnePieceHierarchy) {
   TempDir dir;
   const std::string input = write_cloud(dir, 60000, "scene.ply");
-  const Converted c = convert_both(dir, input, 2000);
+  const Converted c = convert_both(dir, input, {.chunk_points = 2000});
   EXPECT_GE(c.parts_result.chunks, 16u);
   EXPECT_GT(c.parts_result.halo_points, 0u);
   ASSERT_EQ(c.parts.nodes.size(), c.whole.nodes.size());
@@ -99,6 +100,22 @@ TEST(ChunkedConvert, ManySmallChunksGiveTheOnePieceHierarchy) {
         << "azimuth " << az;
     EXPECT_NEAR(double(fb.stats.splats), double(fa.stats.splats), 0.01 * double(fa.stats.splats));
   }
+}
+
+// A budget too small for the plan's positions: the plan works from a file of them (radix
+// selection, here with a few digits per split) and still cuts the one-piece hierarchy's subtrees.
+TEST(ChunkedConvert, APlanOnDiskGivesTheOnePieceHierarchy) {
+  TempDir dir;
+  const std::string input = write_cloud(dir, 30000, "scene.ply");
+  const Converted c = convert_both(dir, input, {.memory_budget = 100000, .chunk_points = 2000});
+  EXPECT_GE(c.parts_result.chunks, 8u);
+  ASSERT_EQ(c.parts.nodes.size(), c.whole.nodes.size());
+  std::size_t differing = 0;
+  for (std::size_t i = 0; i < c.whole.nodes.size(); ++i) {
+    differing += std::memcmp(&c.whole.nodes[i], &c.parts.nodes[i], sizeof(SphereNode)) != 0;
+  }
+  EXPECT_EQ(differing, 0u);
+  EXPECT_FALSE(std::filesystem::exists(dir.file("parts.ptl.chunks")));
 }
 
 // Two georeferenced LAS tiles of one survey, side by side, one without colours: merged by the

@@ -1,0 +1,137 @@
+// The chunk plans, in memory and on disk, against a brute-force oracle: every range sorted by
+// (coordinate, input index) on the longest axis of its box and cut at its middle, as the
+// hierarchy's median splits cut it. Coordinates with many equal values make the on-disk
+// selection read the index digits too.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <random>
+
+#include "chunk_plan.hpp"
+#include "pointillist/core/error.hpp"
+#include "testing/testing.hpp"
+
+namespace pointillist::chunking {
+namespace {
+
+struct Oracle {
+  std::vector<Split> splits;
+  std::vector<std::uint64_t> counts;
+  std::vector<Aabb> boxes;
+};
+
+Oracle brute_force(const std::vector<Vec3f>& p, std::uint32_t levels) {
+  std::vector<std::vector<std::uint32_t>> ranges(1);
+  for (std::uint32_t i = 0; i < p.size(); ++i) ranges[0].push_back(i);
+  Oracle o;
+  for (std::uint32_t level = 0; level < levels; ++level) {
+    std::vector<std::vector<std::uint32_t>> next;
+    for (auto& r : ranges) {
+      Aabb box;
+      for (std::uint32_t i : r) box.extend(p[i]);
+      const int axis = box.longest_axis();
+      std::sort(r.begin(), r.end(), [&](std::uint32_t a, std::uint32_t b) {
+        const float ca = p[a][axis] + 0.0f, cb = p[b][axis] + 0.0f;
+        return ca < cb || (ca == cb && a < b);
+      });
+      const std::size_t mid = r.size() / 2;
+      o.splits.push_back({std::uint8_t(axis), p[r[mid]][axis] + 0.0f, r[mid]});
+      next.emplace_back(r.begin(), r.begin() + std::ptrdiff_t(mid));
+      next.emplace_back(r.begin() + std::ptrdiff_t(mid), r.end());
+    }
+    ranges = std::move(next);
+  }
+  for (const auto& r : ranges) {
+    Aabb box;
+    for (std::uint32_t i : r) box.extend(p[i]);
+    o.counts.push_back(r.size());
+    o.boxes.push_back(box);
+  }
+  return o;
+}
+
+void expect_plan(const ChunkPlan& plan, const Oracle& o, const std::vector<Vec3f>& p) {
+  ASSERT_EQ(plan.splits.size(), o.splits.size());
+  for (std::size_t j = 0; j < o.splits.size(); ++j) {
+    EXPECT_EQ(plan.splits[j].axis, o.splits[j].axis) << "split " << j;
+    EXPECT_EQ(plan.splits[j].value, o.splits[j].value) << "split " << j;
+    EXPECT_EQ(plan.splits[j].index, o.splits[j].index) << "split " << j;
+  }
+  EXPECT_EQ(plan.counts, o.counts);
+  ASSERT_EQ(plan.boxes.size(), o.boxes.size());
+  for (std::size_t c = 0; c < o.boxes.size(); ++c) {
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_EQ(plan.boxes[c].lo[a], o.boxes[c].lo[a]) << "chunk " << c;
+      EXPECT_EQ(plan.boxes[c].hi[a], o.boxes[c].hi[a]) << "chunk " << c;
+    }
+  }
+  // chunk_of agrees with the oracle's counts.
+  std::vector<std::uint64_t> seen(o.counts.size(), 0);
+  for (std::size_t i = 0; i < p.size(); ++i) ++seen[plan.chunk_of(p[i], i)];
+  EXPECT_EQ(seen, o.counts);
+}
+
+// A slab with few distinct coordinates along x (ties), -0 and +0 among them, and a spread in y.
+std::vector<Vec3f> tied_points(std::size_t n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<int> coarse(-4, 4);
+  std::uniform_real_distribution<float> fine(-1.0f, 1.0f);
+  std::vector<Vec3f> p(n);
+  for (Vec3f& x : p) {
+    const int k = coarse(rng);
+    x = {k == 0 ? (rng() % 2 ? -0.0f : 0.0f) : float(k), 0.5f * fine(rng), 0.01f * fine(rng)};
+  }
+  return p;
+}
+
+std::string write_positions(const testing::TempDir& dir, const std::vector<Vec3f>& p) {
+  const std::string path = dir.file("positions");
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  EXPECT_NE(f, nullptr);
+  EXPECT_EQ(std::fwrite(p.data(), sizeof(Vec3f), p.size(), f), p.size());
+  std::fclose(f);
+  return path;
+}
+
+TEST(ChunkPlan, InMemoryPlanIsTheHierarchysMedianSplits) {
+  const std::vector<Vec3f> p = tied_points(6001, 3);
+  ThreadPool pool(2);
+  expect_plan(plan_chunks(p, 4, pool), brute_force(p, 4), p);
+}
+
+TEST(ChunkPlan, OnDiskPlanIsTheSamePlanWhateverItsCandidateBudget) {
+  testing::TempDir dir;
+  const std::vector<Vec3f> p = tied_points(6001, 5);
+  const std::string path = write_positions(dir, p);
+  Aabb box;
+  for (const Vec3f& x : p) box.extend(x);
+  const Oracle o = brute_force(p, 4);
+  for (unsigned threads : {1u, 2u}) {
+    ThreadPool pool(threads);
+    // All candidates at once; a few (coordinate digits); one (every index digit too).
+    for (std::size_t budget : {std::size_t{1} << 20, std::size_t{400}, std::size_t{1}}) {
+      SCOPED_TRACE(::testing::Message() << threads << " threads, " << budget << " candidates");
+      expect_plan(plan_chunks_on_disk(path, p.size(), box, 4, budget, pool, Progress::none()), o,
+                  p);
+    }
+  }
+}
+
+TEST(ChunkPlan, OnDiskPlanSaysWhenThePositionFileIsShort) {
+  testing::TempDir dir;
+  const std::vector<Vec3f> p = tied_points(1000, 7);
+  const std::string path = write_positions(dir, p);
+  Aabb box;
+  for (const Vec3f& x : p) box.extend(x);
+  ThreadPool pool(1);
+  try {
+    plan_chunks_on_disk(path, 2000, box, 2, 100, pool, Progress::none());
+    FAIL() << "a short file was accepted";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("ends early"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace pointillist::chunking
