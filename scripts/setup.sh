@@ -11,6 +11,9 @@ packages=(
   # xauth for xvfb-run) to test it headless
   libsdl2-dev libsdl2-ttf-dev fonts-dejavu-core xvfb xauth
   jq
+  # convert under mpirun: chunk jobs on several processes or machines (CMake's POINTILLIST_MPI,
+  # on when OpenMPI is found)
+  openmpi-bin libopenmpi-dev
   libgtest-dev libgmock-dev googletest libbenchmark-dev
   # make fuzz: clang 14, its libFuzzer and sanitizer runtimes (libclang-rt-14-dev), and
   # llvm-symbolizer (llvm-14) for stacks with file and line

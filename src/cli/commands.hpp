@@ -28,6 +28,8 @@ struct Command {
   std::function<int()> run;
 };
 Command add_convert_command(CLI::App& app);
+// The MPI job this process belongs to when started by mpirun (set by main), or null.
+ChunkJobs*& mpi_job();
 Command add_render_command(CLI::App& app);
 Command add_info_command(CLI::App& app);
 Command add_demo_command(CLI::App& app);

@@ -10,21 +10,32 @@
 #include "options.hpp"
 #include "terminal_progress.hpp"
 #include "util.hpp"
+#include "pointillist/pipeline/chunk_jobs.hpp"
 #include "pointillist/pipeline/convert.hpp"
 
 namespace pointillist::cli {
 
+ChunkJobs*& mpi_job() {
+  static ChunkJobs* job = nullptr;
+  return job;
+}
+
 int run_convert(const ConvertCommandOptions& o) {
   const auto start = std::chrono::steady_clock::now();
   ThreadPool pool(o.threads);
-  TerminalProgress progress(!o.quiet && TerminalProgress::stderr_is_terminal());
-  const ConvertResult r = convert(o.inputs, o.output, o.convert, pool, progress);
+  ConvertOptions options = o.convert;
+  options.jobs = mpi_job();
+  // Under mpirun, rank 0 speaks for the job.
+  const bool lead = options.jobs == nullptr || options.jobs->rank() == 0;
+  const bool quiet = o.quiet || !lead;
+  TerminalProgress progress(!quiet && TerminalProgress::stderr_is_terminal());
+  const ConvertResult r = convert(o.inputs, o.output, options, pool, progress);
   for (const auto& w : r.warnings) {
-    std::fprintf(stderr, "pointillist convert: warning: %s\n", w.c_str());
+    if (lead) std::fprintf(stderr, "pointillist convert: warning: %s\n", w.c_str());
   }
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (!o.quiet) {
+  if (!quiet) {
     if (o.convert.prepare.drop_outliers) {
       std::printf("dropped %zu outliers of %zu points\n", r.input_points - r.output_points,
                   r.input_points);
@@ -37,7 +48,12 @@ int run_convert(const ConvertCommandOptions& o) {
     struct rusage usage {};
     ::getrusage(RUSAGE_SELF, &usage);
     const double peak = double(usage.ru_maxrss) * 1024.0;
-    if (r.chunks > 0) {
+    if (r.chunks > 0 && options.jobs != nullptr && options.jobs->size() > 1) {
+      std::printf("in %zu chunks (%.1f%% halo points) on %d MPI ranks, peak memory of rank 0 %s "
+                  "(%.0f bytes/point)\n",
+                  r.chunks, n ? 100.0 * double(r.halo_points) / double(n) : 0.0,
+                  options.jobs->size(), human_bytes(peak).c_str(), n ? peak / double(n) : 0.0);
+    } else if (r.chunks > 0) {
       std::printf("in %zu chunks (%.1f%% halo points), peak memory %s (%.0f bytes/point)\n",
                   r.chunks, n ? 100.0 * double(r.halo_points) / double(n) : 0.0,
                   human_bytes(peak).c_str(), n ? peak / double(n) : 0.0);

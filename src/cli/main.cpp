@@ -4,13 +4,17 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <cstdlib>
+#include <memory>
 #include <new>
+#include <string>
 #include <vector>
 
 #include "commands.hpp"
 #include "options.hpp"
 #include "pointillist/core/atomic_file.hpp"
 #include "pointillist/core/error.hpp"
+#include "pointillist/pipeline/chunk_jobs.hpp"
 
 namespace pc = pointillist::cli;
 
@@ -26,6 +30,30 @@ int main(int argc, char** argv) {
   if (const std::string error = pc::unknown_word(app, argc, argv); !error.empty()) {
     std::fprintf(stderr, "pointillist: error: %s\n", error.c_str());
     return 2;
+  }
+  // Under mpirun with several processes, `convert` shares its chunk jobs among them; the other
+  // commands would only repeat each other's work and race on their outputs.
+  std::unique_ptr<pointillist::ChunkJobs> job;
+  const char* world = std::getenv("OMPI_COMM_WORLD_SIZE");
+  if (pointillist::started_by_mpirun() && !(world && std::string(world) == "1")) {
+    if (!pointillist::mpi_built()) {
+      std::fprintf(stderr, "pointillist: error: started by mpirun, but this build has no MPI; "
+                           "install OpenMPI (scripts/setup.sh) and rebuild, or run without "
+                           "mpirun\n");
+      return 2;
+    }
+    if (argc < 2 || std::string(argv[1]) != "convert") {
+      std::fprintf(stderr, "pointillist: error: only `convert` runs under mpirun (its chunk "
+                           "jobs are shared among the ranks); run the other commands without it\n");
+      return 2;
+    }
+    try {
+      job = pointillist::join_mpi_job(&argc, &argv);
+    } catch (const pointillist::Error& e) {
+      std::fprintf(stderr, "pointillist: error: %s\n", e.what());
+      return 1;
+    }
+    pc::mpi_job() = job.get();
   }
   try {
     app.parse(argc, argv);
@@ -43,6 +71,8 @@ int main(int argc, char** argv) {
     for (const pc::Command& c : commands) {
       if (c.app->parsed()) return c.run();
     }
+  } catch (const pointillist::PeerFailed&) {
+    return 1;  // the rank that failed says why
   } catch (const pointillist::OptionError& e) {
     std::fprintf(stderr, "pointillist: error: %s\n", e.what());
     return 2;

@@ -27,6 +27,7 @@ WorkFolder::WorkFolder(const std::string& output) : path_(output + ".chunks") {
 }
 
 WorkFolder::~WorkFolder() {
+  if (!owner_) return;
   std::error_code error;
   std::filesystem::remove_all(path_, error);
 }

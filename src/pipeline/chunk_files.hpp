@@ -14,10 +14,13 @@ namespace pointillist::chunking {
 
 // The folder of a conversion's temporary files, beside the output; a folder left by a killed
 // conversion into the same output is removed first. Removed with everything in it when
-// destroyed.
+// destroyed. Another rank of an MPI job joins the folder rank 0 made (kJoin): it neither makes
+// nor removes it.
 class WorkFolder {
  public:
+  enum Join { kJoin };
   explicit WorkFolder(const std::string& output);
+  WorkFolder(const std::string& output, Join) : path_(output + ".chunks"), owner_(false) {}
   ~WorkFolder();
   WorkFolder(const WorkFolder&) = delete;
   WorkFolder& operator=(const WorkFolder&) = delete;
@@ -25,6 +28,7 @@ class WorkFolder {
 
  private:
   std::filesystem::path path_;
+  bool owner_ = true;
 };
 
 // Appends records to one file per chunk (KIND-NNNNN in the folder) through a buffer each.

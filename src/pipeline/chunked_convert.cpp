@@ -27,6 +27,8 @@
 #include <sstream>
 
 #include "chunk_files.hpp"
+#include "chunk_inputs.hpp"
+#include "chunk_messages.hpp"
 #include "chunk_orientation.hpp"
 #include "chunk_plan.hpp"
 #include "chunked.hpp"
@@ -34,107 +36,11 @@
 #include "pointillist/format/ptl_v2.hpp"
 #include "pointillist/io/point_stream.hpp"
 #include "pointillist/lod/sphere_tree.hpp"
+#include "pointillist/pipeline/chunk_jobs.hpp"
 #include "pointillist/prep/prepare.hpp"
 
 namespace pointillist::chunking {
 namespace {
-
-constexpr Rgb8 kMissingColor{180, 180, 180};  // as merge_inputs gives parts without colours
-constexpr std::size_t kBatch = 1 << 20;      // points per read
-
-// The inputs as one stream, with merge_inputs' rules: parts move into the first part's frame,
-// normals and radii survive when every part has them, colours when any has them (grey else).
-class MergedInputs {
- public:
-  MergedInputs(std::span<const std::string> paths, const std::string& columns) {
-    for (const std::string& path : paths) {
-      streams_.push_back(open_point_stream(path, {.columns = columns}));
-      const PointStreamInfo& info = streams_.back()->info();
-      if (info.is_mesh) {
-        throw Error(path + ": is a mesh; meshes are converted in one piece (give a larger "
-                           "--memory, or convert its vertices as points)");
-      }
-      count_ += info.point_count;
-      normals_ = normals_ && info.has_normals;
-      radii_ = radii_ && info.has_radii;
-      colors_ = colors_ || info.has_colors;
-      for (const std::string& c : info.comments) {
-        if (paths.size() == 1 || seen_.insert(c).second) comments_.push_back(c);
-      }
-    }
-    origin_ = streams_[0]->info().origin;
-    up_ = streams_[0]->info().up;
-  }
-
-  // As merge_inputs warns: files without colours among files with them are drawn grey.
-  std::optional<std::string> colour_warning() const {
-    std::vector<std::string> without;
-    for (const auto& s : streams_) {
-      if (!s->info().has_colors) without.push_back(s->info().path);
-    }
-    if (!colors_ || without.empty()) return std::nullopt;
-    std::string list;
-    for (std::size_t i = 0; i < without.size() && i < 5; ++i) list += (i ? ", " : "") + without[i];
-    if (without.size() > 5) list += ", ...";
-    return std::to_string(without.size()) + " of " + std::to_string(streams_.size()) +
-           " input files have no colors; their points are grey (" + list + ")";
-  }
-
-  std::uint64_t count() const { return count_; }
-  bool has_normals() const { return normals_; }
-  bool has_radii() const { return radii_; }
-  bool has_colors() const { return colors_; }
-  const std::array<double, 3>& origin() const { return origin_; }
-  Vec3f up() const { return up_; }
-  const std::vector<std::string>& comments() const { return comments_; }
-  const std::vector<std::unique_ptr<PointStream>>& streams() const { return streams_; }
-  // After a full pass: a part whose normals were all unusable has none (as read_point_file).
-  void drop_unusable_normals() {
-    for (const auto& s : streams_) normals_ = normals_ && s->saw_usable_normals();
-  }
-
-  // Calls fn(batch, index of its first point) over every point, in order; tells `progress`
-  // which file it reads when there are several.
-  template <class Fn>
-  void for_each_batch(Progress& progress, Fn&& fn) {
-    std::uint64_t next = 0;
-    PointSet batch;
-    for (std::size_t k = 0; k < streams_.size(); ++k) {
-      const auto& stream = streams_[k];
-      if (streams_.size() > 1) {
-        const std::string& path = stream->info().path;
-        const std::size_t slash = path.find_last_of('/');
-        progress.detail(path.substr(slash == std::string::npos ? 0 : slash + 1) + " (" +
-                        std::to_string(k + 1) + "/" + std::to_string(streams_.size()) + ")");
-      }
-      stream->rewind();
-      const std::array<double, 3>& o = stream->info().origin;
-      const double shift[3] = {o[0] - origin_[0], o[1] - origin_[1], o[2] - origin_[2]};
-      const bool shifted = shift[0] != 0 || shift[1] != 0 || shift[2] != 0;
-      while (const std::size_t n = stream->read(batch, kBatch)) {
-        if (shifted) {
-          for (Vec3f& p : batch.positions) {
-            p = {float(p.x + shift[0]), float(p.y + shift[1]), float(p.z + shift[2])};
-          }
-        }
-        if (!normals_) batch.normals.clear();
-        if (!radii_) batch.radii.clear();
-        if (colors_ && batch.colors.empty()) batch.colors.assign(n, kMissingColor);
-        fn(batch, next);
-        next += n;
-      }
-    }
-  }
-
- private:
-  std::vector<std::unique_ptr<PointStream>> streams_;
-  std::uint64_t count_ = 0;
-  bool normals_ = true, radii_ = true, colors_ = false;
-  std::array<double, 3> origin_{};
-  Vec3f up_{0, 1, 0};
-  std::vector<std::string> comments_;
-  std::set<std::string> seen_;
-};
 
 // Binary levels of the plan: enough chunks for `max_points` each, paired as the hierarchy's
 // levels pair (sphere_tree_root_halves), at least one level.
@@ -204,64 +110,97 @@ class OverallProgress final : public Progress {
   double finished_ = 0;
 };
 
-// Calls fn(chunk, pool) for every chunk, `workers` chunks at a time, each worker with a pool of
-// its own (one thread): the serial parts of preparing a chunk (its orientation tree) then
-// overlap. Results go to per-chunk slots, so they do not depend on the worker count.
-void for_each_chunk(std::size_t chunks, ThreadPool& pool,
+// Calls fn(chunk, pool) for each of `chunks`, `workers` chunks at a time, each worker with a
+// pool of its own (one thread): the serial parts of preparing a chunk (its orientation tree)
+// then overlap. Results go to per-chunk slots, so they do not depend on the worker count.
+void for_each_chunk(std::span<const std::size_t> chunks, ThreadPool& pool,
                     const std::function<void(std::size_t, ThreadPool&)>& fn) {
-  const std::size_t workers = std::min<std::size_t>(pool.thread_count(), chunks);
+  const std::size_t workers = std::min<std::size_t>(pool.thread_count(), chunks.size());
   if (workers <= 1) {
-    for (std::size_t c = 0; c < chunks; ++c) fn(c, pool);
+    for (const std::size_t c : chunks) fn(c, pool);
     return;
   }
   std::vector<std::unique_ptr<ThreadPool>> pools;
   for (std::size_t w = 0; w < workers; ++w) pools.push_back(std::make_unique<ThreadPool>(1));
   std::atomic<std::size_t> next{0};
   pool.run(workers, [&](std::size_t w) {
-    for (std::size_t c; (c = next.fetch_add(1)) < chunks;) fn(c, *pools[w]);
+    for (std::size_t k; (k = next.fetch_add(1)) < chunks.size();) fn(chunks[k], *pools[w]);
   });
 }
 
-}  // namespace
+// What rank 0 learns from the inputs and the plan, and every rank needs.
+struct Shared {
+  std::uint64_t n = 0;
+  RecordLayout layout;
+  bool colors = false;
+  Vec3f centroid;
+  ChunkPlan plan;
+  std::vector<float> reach;  // halo reach of each chunk
+  std::string input_name;    // for messages
+};
 
-ConvertResult convert_chunked(std::span<const std::string> inputs, const std::string& output,
-                              const ConvertOptions& o, const std::string& metadata_head,
-                              std::uint64_t max_chunk_points, ThreadPool& pool,
-                              Progress& outer_progress) {
-  if (o.prepare.drop_outliers) {
-    throw OptionError("convert: --drop-outliers is not available for chunked conversion yet (the "
-                      "input needs more than --memory); give a larger --memory, or drop the "
-                      "outliers first (convert to .ply with --drop-outliers, in parts)");
+void broadcast_shared(ChunkJobs& jobs, Shared& s) {
+  MessageWriter w;
+  if (jobs.rank() == 0) {
+    w.put(s.n);
+    w.put(s.layout);
+    w.put(s.colors);
+    w.put(s.centroid);
+    w.put(s.plan.levels);
+    w.put_vector(s.plan.splits);
+    w.put_vector(s.plan.counts);
+    w.put_vector(s.plan.boxes);
+    w.put_vector(s.reach);
+    w.put_vector(std::vector<char>(s.input_name.begin(), s.input_name.end()));
   }
-  if (o.features) {
-    throw OptionError("convert: --features are not available for chunked conversion yet (the "
-                      "input needs more than --memory); give a larger --memory");
-  }
-  MergedInputs in(inputs, o.columns);
-  const std::uint64_t n = in.count();
-  OverallProgress overall(outer_progress, n);
-  Progress& progress = overall;
-  ConvertResult result;
-  result.input_points = n;
-  if (const auto warning = in.colour_warning()) result.warnings.push_back(*warning);
+  jobs.broadcast(w.bytes());
+  if (jobs.rank() == 0) return;
+  MessageReader r(w.bytes());
+  s.n = r.get<std::uint64_t>();
+  s.layout = r.get<RecordLayout>();
+  s.colors = r.get<bool>();
+  s.centroid = r.get<Vec3f>();
+  s.plan.levels = r.get<std::uint32_t>();
+  s.plan.splits = r.get_vector<Split>();
+  s.plan.counts = r.get_vector<std::uint64_t>();
+  s.plan.boxes = r.get_vector<Aabb>();
+  s.reach = r.get_vector<float>();
+  const auto name = r.get_vector<char>();
+  s.input_name.assign(name.begin(), name.end());
+}
 
+// Runs fn, then settles with the other ranks: every rank throws when one failed.
+template <class Fn>
+void step(ChunkJobs& jobs, Fn&& fn) {
+  std::exception_ptr error;
+  try {
+    fn();
+  } catch (...) {
+    error = std::current_exception();
+  }
+  jobs.settle(error);
+}
+
+// Rank 0: the inputs scanned, the plan made, and the chunk files (with halos) written.
+void scan_plan_distribute(MergedInputs& in, const WorkFolder& folder, const ConvertOptions& o,
+                          std::uint64_t budget, std::uint32_t levels, ThreadPool& pool,
+                          Progress& progress, Shared& sh, ConvertResult& result) {
+  const std::uint64_t n = sh.n;
   // The plan holds every position in memory when the budget allows, else it works from a file
   // of them.
-  const std::uint64_t budget = o.memory_budget ? o.memory_budget : default_memory_budget();
   const bool plan_on_disk = n * kPlanBytesPerPoint > budget;
-  const std::uint32_t levels = plan_levels(n, std::max<std::uint64_t>(max_chunk_points, 2));
 
-  // The folder, once the disk is known to hold the conversion's files at their peak: the
-  // positions (for a plan on disk), then the chunk files (each point once, plus its halo
-  // copies), which become the prepared splats (43 bytes each), then the splats in split order
-  // (31 bytes) as the output is written.
-  WorkFolder folder(output);
-  const RecordLayout layout{in.has_normals(), in.has_radii()};
+  // The disk must hold the conversion's files at their peak: the positions (for a plan on
+  // disk), then the chunk files (each point once, plus its halo copies), which become the
+  // prepared splats (43 bytes each), then the splats in split order (31 bytes) as the output is
+  // written.
   {
     const double halo_share = 0.1;  // a generous bound: chunks of 1 M points have about 2 %
     const double per_point = std::max({plan_on_disk ? 12.0 : 0.0,
-                                       double(layout.size()) * (1 + halo_share), 43.0, 31.0 + 12});
-    const auto need = std::uint64_t(double(n) * per_point + double(max_chunk_points) * 43);
+                                       double(sh.layout.size()) * (1 + halo_share), 43.0,
+                                       31.0 + 12});
+    const std::uint64_t chunk = n >> levels;
+    const auto need = std::uint64_t(double(n) * per_point + double(chunk) * 43);
     std::error_code error;
     const std::filesystem::space_info space =
         std::filesystem::space(std::filesystem::path(folder.file("")).parent_path(), error);
@@ -289,8 +228,7 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
     in.for_each_batch(progress, [&](const PointSet& b, std::uint64_t) {
       for (const Vec3f& p : b.positions) {
         if (!is_finite(p)) {
-          throw Error(std::string(inputs.size() == 1 ? inputs[0] : "the inputs") +
-                      ": vertex " + std::to_string(seen) +
+          throw Error(sh.input_name + ": vertex " + std::to_string(seen) +
                       " has a non-finite position; remove it from the file");
         }
         ++seen;
@@ -309,30 +247,29 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
     if (position_file) position_file->flush_all();
   }
   in.drop_unusable_normals();
-  const Vec3f centroid{float(sum[0] / double(n)), float(sum[1] / double(n)),
-                       float(sum[2] / double(n))};
+  sh.layout = {in.has_normals(), in.has_radii()};
+  sh.centroid = {float(sum[0] / double(n)), float(sum[1] / double(n)), float(sum[2] / double(n))};
 
   // 2. The plan.
-  ChunkPlan plan;
   {
     ProgressPhase phase(progress, "plan", n);
     if (plan_on_disk) {
       const std::string path = folder.file(ChunkFiles::name("positions", 0));
       // A quarter of the budget for the selections' candidates (32 bytes each).
       const std::size_t candidates = std::max<std::uint64_t>(budget / 4 / 32, 1024);
-      plan = plan_chunks_on_disk(path, n, box, levels, candidates, pool, progress);
+      sh.plan = plan_chunks_on_disk(path, n, box, levels, candidates, pool, progress);
       std::filesystem::remove(path);
     } else {
-      plan = plan_chunks(positions, levels, pool);
+      sh.plan = plan_chunks(positions, levels, pool);
       phase.advance(n);
     }
   }
   std::vector<Vec3f>().swap(positions);
+  const ChunkPlan& plan = sh.plan;
   const std::size_t chunks = plan.chunk_count();
-  result.chunks = chunks;
   // Halo reach: a multiple of the chunk's point spacing (its box's two largest extents over its
   // point count, as for a surface), scaled with the neighbourhood size.
-  std::vector<float> reach(chunks);
+  sh.reach.assign(chunks, 0.0f);
   float max_reach = 0;
   const float neighbourhood = std::sqrt(std::max(16.0f, float(o.prepare.k)) / 16.0f);
   for (std::size_t c = 0; c < chunks; ++c) {
@@ -340,54 +277,111 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
     float x[3] = {e.x, e.y, e.z};
     std::sort(x, x + 3);
     const float spacing = std::sqrt(x[2] * x[1] / float(std::max<std::uint64_t>(plan.counts[c], 1)));
-    reach[c] = kHaloSpacings * spacing * neighbourhood;
-    max_reach = std::max(max_reach, reach[c]);
+    sh.reach[c] = kHaloSpacings * spacing * neighbourhood;
+    max_reach = std::max(max_reach, sh.reach[c]);
   }
 
   // 3. Distribute.
   const std::size_t buffer_bytes =
       std::clamp<std::size_t>((std::size_t{256} << 20) / chunks, 4096, 1 << 20);
-  {
-    ChunkFiles files(folder, chunks, "chunk", buffer_bytes);
-    ProgressPhase phase(progress, "distribute", n);
-    std::vector<char> record(layout.size());
-    in.for_each_batch(progress, [&](const PointSet& b, std::uint64_t first) {
-      for (std::size_t i = 0; i < b.size(); ++i) {
-        const Vec3f& p = b.positions[i];
-        const std::uint32_t own = plan.chunk_of(p, first + i);
-        encode_record(layout, b, i, first + i, false, record.data());
-        files.append(own, record.data(), record.size());
-        record[15] = 1;
-        plan.for_near_chunks(p, own, reach, max_reach, [&](std::uint32_t c) {
-          files.append(c, record.data(), record.size());
-          ++result.halo_points;
-        });
-      }
-      phase.advance(b.size());
-    });
-    files.flush_all();
+  ChunkFiles files(folder, chunks, "chunk", buffer_bytes);
+  ProgressPhase phase(progress, "distribute", n);
+  std::vector<char> record(sh.layout.size());
+  in.for_each_batch(progress, [&](const PointSet& b, std::uint64_t first) {
+    for (std::size_t i = 0; i < b.size(); ++i) {
+      const Vec3f& p = b.positions[i];
+      const std::uint32_t own = plan.chunk_of(p, first + i);
+      encode_record(sh.layout, b, i, first + i, false, record.data());
+      files.append(own, record.data(), record.size());
+      record[15] = 1;
+      plan.for_near_chunks(p, own, sh.reach, max_reach, [&](std::uint32_t c) {
+        files.append(c, record.data(), record.size());
+        ++result.halo_points;
+      });
+    }
+    phase.advance(b.size());
+  });
+  files.flush_all();
+}
+
+std::string relations_kind(int rank) { return "relations" + std::to_string(rank); }
+
+}  // namespace
+
+ConvertResult convert_chunked(std::span<const std::string> inputs, const std::string& output,
+                              const ConvertOptions& o, const std::string& metadata_head,
+                              std::uint64_t max_chunk_points, ThreadPool& pool,
+                              Progress& outer_progress) {
+  if (o.prepare.drop_outliers) {
+    throw OptionError("convert: --drop-outliers is not available for chunked conversion yet (the "
+                      "input needs more than --memory); give a larger --memory, or drop the "
+                      "outliers first (convert to .ply with --drop-outliers, in parts)");
+  }
+  if (o.features) {
+    throw OptionError("convert: --features are not available for chunked conversion yet (the "
+                      "input needs more than --memory); give a larger --memory");
+  }
+  ChunkJobs& jobs = o.jobs ? *o.jobs : ChunkJobs::single();
+  const bool root = jobs.rank() == 0;
+  const std::uint64_t budget = o.memory_budget ? o.memory_budget : default_memory_budget();
+  ConvertResult result;
+  Shared sh;
+  sh.input_name = inputs.size() == 1 ? inputs[0] : "the inputs";
+  std::optional<MergedInputs> in;
+  std::optional<OverallProgress> overall;
+  std::optional<WorkFolder> folder;
+  Progress* progress_ptr = &Progress::none();
+  step(jobs, [&] {
+    if (!root) return;
+    in.emplace(inputs, o.columns);
+    sh.n = in->count();
+    sh.layout = {in->has_normals(), in->has_radii()};
+    sh.colors = in->has_colors();
+    overall.emplace(outer_progress, sh.n);
+    progress_ptr = &*overall;
+    if (const auto warning = in->colour_warning()) result.warnings.push_back(*warning);
+    const std::uint32_t levels = plan_levels(sh.n, std::max<std::uint64_t>(max_chunk_points, 2));
+    folder.emplace(output);
+    scan_plan_distribute(*in, *folder, o, budget, levels, pool, *progress_ptr, sh, result);
+  });
+  broadcast_shared(jobs, sh);
+  if (!root) folder.emplace(output, WorkFolder::kJoin);
+  Progress& progress = *progress_ptr;
+  const std::uint64_t n = sh.n;
+  const ChunkPlan& plan = sh.plan;
+  const std::size_t chunks = plan.chunk_count();
+  const bool colors = sh.colors;
+  result.input_points = n;
+  result.chunks = chunks;
+  // This rank's chunks, and their share of the points.
+  std::vector<std::size_t> mine;
+  std::uint64_t my_points = 0;
+  for (std::size_t c = std::size_t(jobs.rank()); c < chunks; c += std::size_t(jobs.size())) {
+    mine.push_back(c);
+    my_points += plan.counts[c];
   }
 
   // 4. Prepare each chunk with its halo; keep its own splats, their input indices and
   // orientation pieces; tell each halo point's owner how this chunk oriented it.
-  const bool colors = in.has_colors();
-  OrientationStitcher stitcher;
   std::vector<std::uint64_t> own_count(chunks, 0);
   std::vector<std::vector<double>> votes(chunks);
   std::atomic<bool> pieces{false};
-  {
-    ChunkFiles relations(folder, chunks, "relations", buffer_bytes);
+  step(jobs, [&] {
+    const std::string kind = relations_kind(jobs.rank());
+    const std::size_t buffer_bytes =
+        std::clamp<std::size_t>((std::size_t{64} << 20) / chunks, 4096, 1 << 20);
+    ChunkFiles relations(*folder, chunks, kind.c_str(), buffer_bytes);
     std::mutex relations_mutex;
-    ProgressPhase phase(progress, "prepare", n);
-    for_each_chunk(chunks, pool, [&](std::size_t c, ThreadPool& chunk_pool) {
-      const std::string path = folder.file(ChunkFiles::name("chunk", c));
+    ProgressPhase phase(progress, "prepare", my_points);
+    for_each_chunk(mine, pool, [&](std::size_t c, ThreadPool& chunk_pool) {
+      const std::string path = folder->file(ChunkFiles::name("chunk", c));
       std::vector<std::uint8_t> own;
       Splats s;
-      s.points = read_chunk(path, layout, colors, own, s.index);
+      s.points = read_chunk(path, sh.layout, colors, own, s.index);
       std::filesystem::remove(path);
       PrepareOptions prepare = o.prepare;
-      prepare.orientation_centre = centroid;
-      prepare.input_name = inputs.size() == 1 ? inputs[0] : "the inputs";
+      prepare.orientation_centre = sh.centroid;
+      prepare.input_name = sh.input_name;
       prepare.orientation_components = &s.piece;
       prepare_splats(s.points, chunk_pool, Progress::none(), prepare);
       if (!s.piece.empty()) {
@@ -397,7 +391,7 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
           if (votes[c].size() <= s.piece[i]) votes[c].resize(s.piece[i] + 1, 0.0);
           if (own[i]) {
             votes[c][s.piece[i]] +=
-                double(dot(s.points.normals[i], s.points.positions[i] - centroid));
+                double(dot(s.points.normals[i], s.points.positions[i] - sh.centroid));
           } else {
             halo.push_back({plan.chunk_of(s.points.positions[i], s.index[i]),
                             {s.index[i], std::uint32_t(c), s.piece[i], s.points.normals[i]}});
@@ -418,51 +412,103 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
       if (!s.piece.empty()) s.piece.resize(k);
       keep_points(s.points, own);
       own_count[c] = k;
-      write_splats(folder.file(ChunkFiles::name("chunk", c) + ".prepared"), s);
+      write_splats(folder->file(ChunkFiles::name("chunk", c) + ".prepared"), s);
       phase.advance(plan.counts[c]);
     });
     relations.flush_all();
-    for (std::size_t c = 0; c < chunks; ++c) stitcher.add_chunk(c, std::move(votes[c]));
+  });
+  {
+    // Rank 0 learns every chunk's count and votes.
+    MessageWriter w;
+    w.put(bool(pieces));
+    for (const std::size_t c : mine) {
+      w.put(std::uint64_t(c));
+      w.put(own_count[c]);
+      w.put_vector(votes[c]);
+    }
+    const std::vector<std::vector<char>> all = jobs.gather(w.bytes());
+    step(jobs, [&] {
+      for (std::size_t r = 1; r < all.size(); ++r) {
+        MessageReader m(all[r]);
+        if (m.get<bool>()) pieces = true;
+        while (!m.done()) {
+          const auto c = std::size_t(m.get<std::uint64_t>());
+          if (c >= chunks) throw Error("chunked conversion: a rank sent a chunk out of range");
+          own_count[c] = m.get<std::uint64_t>();
+          votes[c] = m.get_vector<double>();
+        }
+      }
+    });
   }
 
-  // 5. Stitch the pieces of surfaces that cross chunks, and orient each surface as a whole.
-  if (pieces) {
+  // 5. Stitch the pieces of surfaces that cross chunks, and orient each surface as a whole
+  // (rank 0); every rank learns which of its pieces flip.
+  std::vector<std::vector<std::uint8_t>> flips(chunks);
+  step(jobs, [&] {
+    if (!root || !pieces) return;
+    OrientationStitcher stitcher;
+    for (std::size_t c = 0; c < chunks; ++c) stitcher.add_chunk(c, votes[c]);
     ProgressPhase phase(progress, "orientation", n);
     for (std::size_t c = 0; c < chunks; ++c) {
-      const std::string rel_path = folder.file(ChunkFiles::name("relations", c));
-      if (!std::filesystem::exists(rel_path)) continue;
-      const Splats s = read_splats(folder.file(ChunkFiles::name("chunk", c) + ".prepared"),
-                                   own_count[c], colors, true, true);
-      const std::vector<char> bytes = read_whole(rel_path);
-      std::filesystem::remove(rel_path);
-      for (std::size_t at = 0; at + sizeof(Relation) <= bytes.size(); at += sizeof(Relation)) {
-        Relation r;
-        std::memcpy(&r, bytes.data() + at, sizeof r);
-        const auto it = std::lower_bound(s.index.begin(), s.index.end(), r.index);
-        if (it == s.index.end() || *it != r.index) continue;
-        const std::size_t i = std::size_t(it - s.index.begin());
-        stitcher.relate(c, s.piece[i], r.chunk, r.piece, dot(s.points.normals[i], r.normal) >= 0);
+      std::optional<Splats> s;
+      for (int rank = 0; rank < jobs.size(); ++rank) {
+        const std::string rel_path = folder->file(ChunkFiles::name(relations_kind(rank).c_str(), c));
+        if (!std::filesystem::exists(rel_path)) continue;
+        if (!s) {
+          s = read_splats(folder->file(ChunkFiles::name("chunk", c) + ".prepared"), own_count[c],
+                          colors, true, true);
+        }
+        const std::vector<char> bytes = read_whole(rel_path);
+        std::filesystem::remove(rel_path);
+        for (std::size_t at = 0; at + sizeof(Relation) <= bytes.size(); at += sizeof(Relation)) {
+          Relation r;
+          std::memcpy(&r, bytes.data() + at, sizeof r);
+          const auto it = std::lower_bound(s->index.begin(), s->index.end(), r.index);
+          if (it == s->index.end() || *it != r.index) continue;
+          const std::size_t i = std::size_t(it - s->index.begin());
+          stitcher.relate(c, s->piece[i], r.chunk, r.piece,
+                          dot(s->points.normals[i], r.normal) >= 0);
+        }
       }
       phase.advance(plan.counts[c]);
     }
     stitcher.solve();
+    for (std::size_t c = 0; c < chunks; ++c) {
+      for (std::uint32_t k = 0; k < votes[c].size(); ++k) {
+        flips[c].push_back(stitcher.flipped(c, k) ? 1 : 0);
+      }
+    }
+  });
+  {
+    MessageWriter w;
+    if (root) {
+      w.put(bool(pieces));
+      for (const auto& f : flips) w.put_vector(f);
+    }
+    jobs.broadcast(w.bytes());
+    if (!root) {
+      MessageReader m(w.bytes());
+      pieces = m.get<bool>();
+      for (auto& f : flips) f = m.get_vector<std::uint8_t>();
+    }
   }
 
   // 6. Each chunk's subtree and summary; its splats kept in split order.
   std::vector<PtlV2SubtreeSummary> summaries(chunks);
-  Aabb bounds;
+  std::vector<Aabb> boxes(chunks);
   PtlV2WriteOptions v2;
   if (o.leaf_trim) v2.leaf_trim = *o.leaf_trim;
-  {
-    ProgressPhase phase(progress, "hierarchy", n);
-    std::vector<Aabb> boxes(chunks);
-    for_each_chunk(chunks, pool, [&](std::size_t c, ThreadPool& chunk_pool) {
-      const std::string path = folder.file(ChunkFiles::name("chunk", c) + ".prepared");
+  step(jobs, [&] {
+    ProgressPhase phase(progress, "hierarchy", my_points);
+    for_each_chunk(mine, pool, [&](std::size_t c, ThreadPool& chunk_pool) {
+      const std::string path = folder->file(ChunkFiles::name("chunk", c) + ".prepared");
       Splats s = read_splats(path, own_count[c], colors, true, pieces);
       std::filesystem::remove(path);
       if (pieces) {
         for (std::size_t i = 0; i < s.points.size(); ++i) {
-          if (stitcher.flipped(c, s.piece[i])) s.points.normals[i] = -s.points.normals[i];
+          if (s.piece[i] < flips[c].size() && flips[c][s.piece[i]]) {
+            s.points.normals[i] = -s.points.normals[i];
+          }
         }
       }
       std::vector<std::uint32_t> order;
@@ -479,20 +525,55 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
       permute(sorted.points.normals, s.points.normals);
       permute(sorted.points.radii, s.points.radii);
       permute(sorted.points.colors, s.points.colors);
-      write_splats(folder.file(ChunkFiles::name("chunk", c) + ".splats"), sorted);
+      write_splats(folder->file(ChunkFiles::name("chunk", c) + ".splats"), sorted);
       phase.advance(plan.counts[c]);
     });
-    for (const Aabb& b : boxes) bounds.extend(b);
+  });
+  {
+    // Rank 0 learns every subtree's summary and box.
+    MessageWriter w;
+    for (const std::size_t c : mine) {
+      const PtlV2SubtreeSummary& t = summaries[c];
+      w.put(std::uint64_t(c));
+      w.put(boxes[c]);
+      w.put(t.root);
+      w.put(t.cone_code);
+      w.put(t.node_count);
+      w.put(t.leaf_count);
+      w.put(t.depth);
+      w.put_vector(t.pages);
+    }
+    const std::vector<std::vector<char>> all = jobs.gather(w.bytes());
+    step(jobs, [&] {
+      for (std::size_t r = 1; r < all.size(); ++r) {
+        MessageReader m(all[r]);
+        while (!m.done()) {
+          const auto c = std::size_t(m.get<std::uint64_t>());
+          if (c >= chunks) throw Error("chunked conversion: a rank sent a chunk out of range");
+          PtlV2SubtreeSummary& t = summaries[c];
+          boxes[c] = m.get<Aabb>();
+          t.root = m.get<SphereNode>();
+          t.cone_code = m.get<std::uint32_t>();
+          t.node_count = m.get<std::uint64_t>();
+          t.leaf_count = m.get<std::uint64_t>();
+          t.depth = m.get<std::uint32_t>();
+          t.pages = m.get_vector<PtlV2PageInfo>();
+        }
+      }
+    });
   }
 
-  // 7. Write.
-  {
+  // 7. Write (rank 0).
+  step(jobs, [&] {
+    if (!root) return;
+    Aabb bounds;
+    for (const Aabb& b : boxes) bounds.extend(b);
     ProgressPhase phase(progress, "write", n);
     PtlV2PartWriter writer(output, summaries, colors, v2);
     const Vec3f centre = bounds.center();
     float far2 = 0;
     for (std::size_t c = 0; c < chunks; ++c) {
-      const std::string path = folder.file(ChunkFiles::name("chunk", c) + ".splats");
+      const std::string path = folder->file(ChunkFiles::name("chunk", c) + ".splats");
       const Splats s = read_splats(path, summaries[c].leaf_count, colors, false, false);
       std::filesystem::remove(path);
       const SphereTree tree =
@@ -503,9 +584,9 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
     }
     std::ostringstream meta;
     meta << metadata_head;
-    for (const std::string& comment : in.comments()) meta << "comment: " << comment << "\n";
-    writer.finish(bounds, {centre, std::sqrt(far2)}, in.origin(), in.up(), meta.str());
-  }
+    for (const std::string& comment : in->comments()) meta << "comment: " << comment << "\n";
+    writer.finish(bounds, {centre, std::sqrt(far2)}, in->origin(), in->up(), meta.str());
+  });
   result.output_points = n;
   return result;
 }

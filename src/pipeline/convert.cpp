@@ -18,6 +18,7 @@
 #include "pointillist/io/point_file.hpp"
 #include "pointillist/io/point_stream.hpp"
 #include "chunked.hpp"
+#include "pointillist/pipeline/chunk_jobs.hpp"
 #include "pointillist/lod/sphere_tree.hpp"
 #include "pointillist/pipeline/model.hpp"
 
@@ -112,7 +113,8 @@ ConvertResult convert(std::span<const std::string> inputs, const std::string& ou
   for (const std::string& path : inputs) estimate += point_count_estimate(path);
   const bool to_v2 = ends_with(output, ".ptl") && o.ptl_version == 2;
   const bool over = estimate > budget / chunking::kInCoreBytesPerPoint;
-  if (to_v2 && (o.chunk_points != 0 || over)) {
+  const bool ranks = o.jobs != nullptr && o.jobs->size() > 1;
+  if (to_v2 && (o.chunk_points != 0 || over || ranks)) {
     const std::uint64_t chunk_points =
         o.chunk_points ? o.chunk_points
                        : std::max<std::uint64_t>(budget / chunking::kChunkBytesPerPoint /
@@ -128,6 +130,7 @@ ConvertResult convert(std::span<const std::string> inputs, const std::string& ou
                 " of memory in one piece, over the budget of " + gigabytes(budget) +
                 "; write a .ptl (converted in chunks within the budget), or raise --memory");
   }
+  if (ranks && o.jobs->rank() != 0) return {};  // rank 0 converts other outputs alone
   std::vector<std::string> warnings;
   PointSet points = merge_inputs(inputs, pool, progress, {.columns = o.columns}, &warnings);
   ConvertResult result = convert_points(std::move(points), inputs, output, o, pool, progress);

@@ -17,6 +17,8 @@
 
 namespace pointillist {
 
+class ChunkJobs;
+
 struct ConvertOptions {
   PrepareOptions prepare;    // normals, radii, outliers
   std::string columns;       // text inputs: the column layout (empty = detected)
@@ -34,6 +36,11 @@ struct ConvertOptions {
   // Force the chunked conversion (.ptl v2) with chunks of at most this many points (rounded down
   // to the hierarchy's levels); 0: only when the budget asks for it.
   std::uint64_t chunk_points = 0;
+  // The processes sharing a chunked conversion (chunk_jobs.hpp): null for this process alone.
+  // With more than one, a .ptl v2 output is always converted in chunks (the same file bytes as
+  // one process converting with the same options in chunks) and only rank 0 writes it; other
+  // outputs are converted by rank 0 alone.
+  ChunkJobs* jobs = nullptr;
 };
 
 struct ConvertResult {

@@ -1,0 +1,87 @@
+// The inputs of a chunked conversion as one stream (private to pipeline; chunked_convert.cpp).
+#pragma once
+
+#include <array>
+#include <memory>
+#include <optional>
+#include <set>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "pointillist/core/point_set.hpp"
+#include "pointillist/core/progress.hpp"
+#include "pointillist/io/point_stream.hpp"
+
+namespace pointillist::chunking {
+
+constexpr Rgb8 kMissingColor{180, 180, 180};  // as merge_inputs gives parts without colours
+constexpr std::size_t kBatch = 1 << 20;      // points per read
+
+// The inputs as one stream, with merge_inputs' rules: parts move into the first part's frame,
+// normals and radii survive when every part has them, colours when any has them (grey else).
+class MergedInputs {
+ public:
+  // Opens every input (a mesh is refused). Throws what open_point_stream throws.
+  MergedInputs(std::span<const std::string> paths, const std::string& columns);
+
+  // As merge_inputs warns: files without colours among files with them are drawn grey.
+  std::optional<std::string> colour_warning() const;
+
+  std::uint64_t count() const { return count_; }
+  bool has_normals() const { return normals_; }
+  bool has_radii() const { return radii_; }
+  bool has_colors() const { return colors_; }
+  const std::array<double, 3>& origin() const { return origin_; }
+  Vec3f up() const { return up_; }
+  const std::vector<std::string>& comments() const { return comments_; }
+  const std::vector<std::unique_ptr<PointStream>>& streams() const { return streams_; }
+  // After a full pass: a part whose normals were all unusable has none (as read_point_file).
+  void drop_unusable_normals() {
+    for (const auto& s : streams_) normals_ = normals_ && s->saw_usable_normals();
+  }
+
+  // Calls fn(batch, index of its first point) over every point, in order; tells `progress`
+  // which file it reads when there are several.
+  template <class Fn>
+  void for_each_batch(Progress& progress, Fn&& fn) {
+    std::uint64_t next = 0;
+    PointSet batch;
+    for (std::size_t k = 0; k < streams_.size(); ++k) {
+      const auto& stream = streams_[k];
+      if (streams_.size() > 1) {
+        const std::string& path = stream->info().path;
+        const std::size_t slash = path.find_last_of('/');
+        progress.detail(path.substr(slash == std::string::npos ? 0 : slash + 1) + " (" +
+                        std::to_string(k + 1) + "/" + std::to_string(streams_.size()) + ")");
+      }
+      stream->rewind();
+      const std::array<double, 3>& o = stream->info().origin;
+      const double shift[3] = {o[0] - origin_[0], o[1] - origin_[1], o[2] - origin_[2]};
+      const bool shifted = shift[0] != 0 || shift[1] != 0 || shift[2] != 0;
+      while (const std::size_t n = stream->read(batch, kBatch)) {
+        if (shifted) {
+          for (Vec3f& p : batch.positions) {
+            p = {float(p.x + shift[0]), float(p.y + shift[1]), float(p.z + shift[2])};
+          }
+        }
+        if (!normals_) batch.normals.clear();
+        if (!radii_) batch.radii.clear();
+        if (colors_ && batch.colors.empty()) batch.colors.assign(n, kMissingColor);
+        fn(batch, next);
+        next += n;
+      }
+    }
+  }
+
+ private:
+  std::vector<std::unique_ptr<PointStream>> streams_;
+  std::uint64_t count_ = 0;
+  bool normals_ = true, radii_ = true, colors_ = false;
+  std::array<double, 3> origin_{};
+  Vec3f up_{0, 1, 0};
+  std::vector<std::string> comments_;
+  std::set<std::string> seen_;
+};
+
+}  // namespace pointillist::chunking

@@ -1,0 +1,100 @@
+// `mpirun -n 2 --oversubscribe pointillist convert ...`: the chunk jobs shared by two ranks give
+// the file one process writes with the same options, byte for byte; a rank that fails stops the
+// whole job with one message and leaves nothing behind. Skipped (with the reason) in a build
+// without MPI or on a machine without mpirun.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <string>
+
+#include "cli/cli_run.hpp"
+#include "pointillist/io/ply.hpp"
+#include "pointillist/pipeline/chunk_jobs.hpp"
+#include "pointillist/scene/analytic.hpp"
+#include "testing/testing.hpp"
+
+namespace pointillist {
+namespace {
+
+using ::testing::HasSubstr;
+using testing::CliResult;
+using testing::TempDir;
+
+std::string file_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// mpirun with two ranks on this machine (as root too), the sanitizers' leak check off for
+// OpenMPI's own allocations.
+CliResult mpirun2(const std::string& args) {
+  return testing::run_shell(
+      "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 ASAN_OPTIONS=detect_leaks=0 "
+      "mpirun -n 2 --oversubscribe -x ASAN_OPTIONS " +
+      std::string(POINTILLIST_CLI_PATH) + " " + args);
+}
+
+bool skip_without_mpi() {
+  if (!mpi_built()) return true;
+  return testing::run_shell("command -v mpirun").exit_code != 0;
+}
+
+std::string write_cloud(const TempDir& dir, std::size_t count) {
+  PointSet p = sample_scene(demo_scene(), count, 5).points;
+  for (const Vec3f& x : p.positions) {
+    p.colors.push_back({std::uint8_t(128 + 60 * x.x), std::uint8_t(100 + 50 * x.y), 90});
+  }
+  const std::string path = dir.file("cloud.ply");
+  write_ply(path, p);
+  return path;
+}
+
+TEST(MpiConvert, TwoRanksWriteTheBytesOfOneProcess) {
+  if (skip_without_mpi()) GTEST_SKIP() << "this build has no MPI, or mpirun is not installed";
+  TempDir dir;
+  const std::string cloud = write_cloud(dir, 40000);
+  const std::string one = dir.file("one.ptl"), two = dir.file("two.ptl");
+  const CliResult a =
+      testing::run_cli("convert " + cloud + " -o " + one + " --chunk-points 2000 --threads 2");
+  ASSERT_EQ(a.exit_code, 0) << a.output;
+  const CliResult b = mpirun2("convert " + cloud + " -o " + two + " --chunk-points 2000 --threads 1");
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  // Rank 0 speaks for the job: one summary.
+  EXPECT_THAT(b.output, HasSubstr("on 2 MPI ranks"));
+  EXPECT_EQ(b.output.find("converted"), b.output.rfind("converted")) << b.output;
+  const std::string bytes_one = file_bytes(one), bytes_two = file_bytes(two);
+  ASSERT_GT(bytes_one.size(), 1000u);
+  EXPECT_TRUE(bytes_one == bytes_two) << "the files differ";
+  EXPECT_FALSE(std::filesystem::exists(two + ".chunks"));
+}
+
+TEST(MpiConvert, AFailingRankStopsEveryRankWithOneMessageAndLeavesNothing) {
+  if (skip_without_mpi()) GTEST_SKIP() << "this build has no MPI, or mpirun is not installed";
+  TempDir dir;
+  // Rank 0 finds a non-finite position while rank 1 waits for the plan.
+  PointSet p = sample_scene(demo_scene(), 20000, 5).points;
+  p.positions[12345].y = std::numeric_limits<float>::quiet_NaN();
+  const std::string cloud = dir.file("bad.ply");
+  write_ply(cloud, p);
+  const std::string out = dir.file("out.ptl");
+  const CliResult r = mpirun2("convert " + cloud + " -o " + out + " --chunk-points 2000");
+  EXPECT_NE(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("vertex 12345 of 20000: property y is not a finite number"));
+  EXPECT_EQ(r.output.find("vertex 12345"), r.output.rfind("vertex 12345")) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  EXPECT_FALSE(std::filesystem::exists(out + ".chunks"));
+}
+
+TEST(MpiConvert, OtherCommandsAreRefusedUnderMpirun) {
+  if (skip_without_mpi()) GTEST_SKIP() << "this build has no MPI, or mpirun is not installed";
+  const CliResult r = mpirun2("info /nonexistent.ptl");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_THAT(r.output, HasSubstr("only `convert` runs under mpirun"));
+}
+
+}  // namespace
+}  // namespace pointillist
