@@ -122,6 +122,7 @@ struct GenerateOptions {
   float spacing_scale = 1.0f;
   std::uint64_t seed = 1;
   bool with_normals = false;  // write the exact normals too
+  bool colors = false;        // write colours from the exact normals (analytic scenes)
   std::string sampling = "j";  // test scenes T*: j or r
   // Test scenes T*: also write the exact label image here (empty = none), seen with `view` (as
   // `render` would see the written .ply) on `background`.

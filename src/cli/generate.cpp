@@ -157,12 +157,54 @@ int run_generate(const GenerateOptions& o) {
   } else {
     throw OptionError("generate: unknown scene '" + o.scene + "'; use demo, sphere, torus or cube");
   }
-  SurfaceSamples samples = sample_scene(scene, o.points, o.seed);
-  if (o.with_normals) samples.points.normals = samples.true_normals;
-  write_ply(o.output, samples.points);
+  // Batches of 16 M samples (constant memory, any count): the first from --seed, so clouds up
+  // to 16 M points are those one draw gives; each further batch from a seed of its own.
+  constexpr std::size_t kBatch = std::size_t{16} << 20;
+  const std::uint64_t record = 12 + (o.with_normals ? 12 : 0) + (o.colors ? 3 : 0);
+  {
+    std::error_code error;
+    const std::filesystem::path folder =
+        std::filesystem::absolute(std::filesystem::path(o.output)).parent_path();
+    const auto space = std::filesystem::space(folder, error);
+    const std::uint64_t need = record * o.points + 4096;
+    if (!error && space.available < need) {
+      throw IoError(o.output + ": " + std::to_string(o.points) + " points need about " +
+                    std::to_string(need / 1000000) + " MB, and " +
+                    std::to_string(space.available / 1000000) +
+                    " MB are free there; free some space or write to another disk");
+    }
+  }
+  PointSet layout;
+  layout.positions.resize(1);
+  if (o.with_normals) layout.normals.resize(1);
+  if (o.colors) layout.colors.resize(1);
+  PlyPointWriter writer(o.output, layout, o.points);
+  TerminalProgress progress(!o.quiet && o.points > kBatch &&
+                            TerminalProgress::stderr_is_terminal());
+  {
+    ProgressPhase phase(progress, "generate", o.points);
+    for (std::size_t first = 0, b = 0; first < o.points; first += kBatch, ++b) {
+      const std::uint64_t seed = b == 0 ? o.seed : o.seed ^ (b * 0x9E3779B97F4A7C15ull);
+      SurfaceSamples samples = sample_scene(scene, std::min(kBatch, o.points - first), seed);
+      if (o.with_normals) samples.points.normals = samples.true_normals;
+      if (o.colors) {
+        // Colour by the exact normal: smooth, different on every face.
+        samples.points.colors.reserve(samples.points.size());
+        for (const Vec3f& n : samples.true_normals) {
+          samples.points.colors.push_back({std::uint8_t(127.5f + 127.0f * n.x),
+                                           std::uint8_t(127.5f + 127.0f * n.y),
+                                           std::uint8_t(127.5f + 127.0f * n.z)});
+        }
+      }
+      writer.write(samples.points);
+      phase.advance(samples.points.size());
+    }
+  }
+  writer.commit();
   if (!o.quiet) {
-    std::printf("generated %zu samples of the %s scene%s -> %s\n", samples.points.size(),
-                o.scene.c_str(), o.with_normals ? " with exact normals" : "", o.output.c_str());
+    std::printf("generated %zu samples of the %s scene%s%s -> %s\n", o.points, o.scene.c_str(),
+                o.with_normals ? " with exact normals" : "", o.colors ? " and colours" : "",
+                o.output.c_str());
   }
   return 0;
 }
@@ -209,6 +251,8 @@ Command add_generate_command(CLI::App& app) {
       ->check(CLI::Range(std::size_t{1}, std::size_t{2'000'000'000}));
   cmd->add_option("--seed", o->seed, "Random seed")->default_val(1);
   cmd->add_flag("--with-normals", o->with_normals, "Also write exact normals");
+  cmd->add_flag("--colors", o->colors,
+                "Also write colours (from the exact normal); demo, sphere, torus, cube");
   cmd->add_option("--reference", o->reference_output,
                   "Test scenes T*: also write the exact ray-cast image of the scene, unlit, each "
                   "pixel its face's colour, with the camera `render` uses for the .ply and the "
@@ -238,6 +282,10 @@ Command add_generate_command(CLI::App& app) {
             if (occlusion && cmd->count("--models") > 0 && cmd->count("--points") > 0) {
               o->warnings.push_back("--points is ignored: it sizes the generated statue, and "
                                     "--models gives the models");
+            }
+            if (cmd->count("--colors") > 0 && (occlusion || o->scene[0] == 'T')) {
+              o->warnings.push_back("--colors is ignored: it applies to --scene demo|sphere|"
+                                    "torus|cube (the test scenes colour each face)");
             }
             if (occlusion) {
               for (const char* name : {"--with-normals", "--sampling"}) {

@@ -29,7 +29,8 @@ void check_sizes(const std::string& path, const PointSet& points) {
                     std::to_string(v) + " of " + std::to_string(n));
 }
 
-std::string make_header(const PointSet& points, const PlyWriteOptions& options, bool faces) {
+std::string make_header(const PointSet& points, const PlyWriteOptions& options, bool faces,
+                        std::uint64_t count) {
   std::string h = "ply\nformat ";
   h += options.encoding == PlyEncoding::Ascii             ? "ascii"
        : options.encoding == PlyEncoding::BinaryBigEndian ? "binary_big_endian"
@@ -50,7 +51,7 @@ std::string make_header(const PointSet& points, const PlyWriteOptions& options, 
     h += "comment up: " + format_double(points.up.x) + " " + format_double(points.up.y) + " " +
          format_double(points.up.z) + "\n";
   }
-  h += "element vertex " + std::to_string(points.size()) + "\n";
+  h += "element vertex " + std::to_string(count) + "\n";
   h += "property float x\nproperty float y\nproperty float z\n";
   if (points.has_normals()) h += "property float nx\nproperty float ny\nproperty float nz\n";
   if (points.has_colors()) h += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
@@ -170,12 +171,42 @@ void write_ply(const std::string& path, const PointSet& points, const PlyWriteOp
   check_sizes(path, points);
   const bool faces = options.write_faces && points.is_mesh();
   AtomicFile file(path);
-  file.write(make_header(points, options, faces));
+  file.write(make_header(points, options, faces, points.size()));
   if (options.encoding == PlyEncoding::Ascii)
     write_ascii_body(file, points, faces);
   else
     write_binary_body(file, points, faces, options.encoding == PlyEncoding::BinaryBigEndian);
   file.commit();
+}
+
+PlyPointWriter::PlyPointWriter(const std::string& path, const PointSet& layout,
+                               std::uint64_t count)
+    : file_(std::make_unique<AtomicFile>(path)), path_(path), count_(count),
+      normals_(layout.has_normals()), colors_(layout.has_colors()), radii_(layout.has_radii()) {
+  file_->write(make_header(layout, {}, false, count));
+}
+
+PlyPointWriter::~PlyPointWriter() = default;
+
+void PlyPointWriter::write(const PointSet& batch) {
+  const bool same = batch.has_normals() == normals_ && batch.has_colors() == colors_ &&
+                    batch.has_radii() == radii_;
+  if (!same || batch.is_mesh() || batch.size() > count_ - written_) {
+    throw Error("cannot write " + path_ + ": a batch of " + std::to_string(batch.size()) +
+                " points does not fit the header (other properties, or more than the " +
+                std::to_string(count_) + " points announced)");
+  }
+  check_sizes(path_, batch);
+  write_binary_body(*file_, batch, false, false);
+  written_ += batch.size();
+}
+
+void PlyPointWriter::commit() {
+  if (written_ != count_) {
+    throw Error("cannot write " + path_ + ": " + std::to_string(written_) + " of the " +
+                std::to_string(count_) + " points announced were written");
+  }
+  file_->commit();
 }
 
 }  // namespace pointillist

@@ -188,7 +188,7 @@ void scan_plan_distribute(MergedInputs& in, const WorkFolder& folder, const Conv
   const std::uint64_t n = sh.n;
   // The plan holds every position in memory when the budget allows, else it works from a file
   // of them.
-  const bool plan_on_disk = n * kPlanBytesPerPoint > budget;
+  const bool plan_on_disk = n * kPlanBytesPerPoint > budget / 2;
 
   // The disk must hold the conversion's files at their peak: the positions (for a plan on
   // disk), then the chunk files (each point once, plus its halo copies), which become the

@@ -52,6 +52,26 @@ TEST(Cli, GenerateConvertInfoRenderRoundTrip) {
   EXPECT_EQ(img.pixels[0], (Rgb8{0, 0, 0}));
 }
 
+// generate --colors: each sample coloured by its exact normal, here the sphere's radial
+// direction.
+TEST(Cli, GenerateColoursEachSampleByItsExactNormal) {
+  pointillist::testing::TempDir dir;
+  const auto ply = dir.file("sphere.ply");
+  ASSERT_EQ(run("generate --scene sphere --points 2000 --colors -q -o " + ply).exit_code, 0);
+  const pointillist::PointSet p = pointillist::read_ply(ply);
+  ASSERT_EQ(p.size(), 2000u);
+  ASSERT_EQ(p.colors.size(), 2000u);
+  int worst = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const pointillist::Vec3f n = pointillist::normalized(p.positions[i]);
+    const int expect[3] = {int(127.5f + 127 * n.x), int(127.5f + 127 * n.y),
+                           int(127.5f + 127 * n.z)};
+    const int got[3] = {p.colors[i].r, p.colors[i].g, p.colors[i].b};
+    for (int a = 0; a < 3; ++a) worst = std::max(worst, std::abs(got[a] - expect[a]));
+  }
+  EXPECT_LE(worst, 1);
+}
+
 TEST(Cli, RenderStatsJsonHasTheRequiredFields) {
   pointillist::testing::TempDir dir;
   const auto ply = dir.file("scene.ply");

@@ -172,5 +172,63 @@ TEST(PlyWriter, FailureLeavesNoFileBehind) {
   EXPECT_FALSE(std::filesystem::exists(bad_path));
 }
 
+// The batch writer: the header written out by hand, then each batch's records in order, and
+// the reader gives the points back; a short or ill-fitting write leaves no file.
+TEST(PlyPointWriter, WritesBatchesUnderOneHeaderThatTheReaderReadsBack) {
+  TempDir dir;
+  const std::string path = dir.file("batches.ply");
+  PointSet layout;
+  layout.positions.resize(1);
+  layout.colors.resize(1);
+  layout.comments = {"made in batches"};
+  PlyPointWriter writer(path, layout, 5);
+  PointSet a, b;
+  a.positions = {{1, 2, 3}, {4, 5, 6}};
+  a.colors = {{1, 2, 3}, {4, 5, 6}};
+  b.positions = {{-1, -2, -3}, {0.5f, 0.25f, 0.125f}, {7, 8, 9}};
+  b.colors = {{7, 8, 9}, {10, 11, 12}, {255, 254, 253}};
+  writer.write(a);
+  writer.write(b);
+  EXPECT_FALSE(std::filesystem::exists(path));  // not before commit
+  writer.commit();
+  const std::string header =
+      "ply\nformat binary_little_endian 1.0\ncomment made in batches\nelement vertex 5\n"
+      "property float x\nproperty float y\nproperty float z\n"
+      "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n";
+  std::string body;
+  for (const PointSet* s : {&a, &b}) {
+    for (std::size_t i = 0; i < s->size(); ++i) {
+      for (float v : {s->positions[i].x, s->positions[i].y, s->positions[i].z}) put(body, v);
+      body += char(s->colors[i].r);
+      body += char(s->colors[i].g);
+      body += char(s->colors[i].b);
+    }
+  }
+  EXPECT_EQ(read_file(path), header + body);
+  const PointSet back = read_ply(path);
+  ASSERT_EQ(back.size(), 5u);
+  EXPECT_EQ(back.positions[3].y, 0.25f);
+  EXPECT_EQ(back.colors[4].g, 254);
+}
+
+TEST(PlyPointWriter, RefusesBatchesThatDoNotFitAndACountNotReached) {
+  TempDir dir;
+  const std::string path = dir.file("short.ply");
+  PointSet layout;
+  layout.positions.resize(1);
+  PointSet three;
+  three.positions = {{1, 2, 3}, {4, 5, 6}, {7, 8, 9}};
+  {
+    PlyPointWriter writer(path, layout, 2);
+    EXPECT_THROW(writer.write(three), Error);  // more than announced
+    PointSet coloured = three;
+    coloured.colors.assign(3, {1, 2, 3});
+    EXPECT_THROW(writer.write(coloured), Error);  // other properties
+    EXPECT_THROW(writer.commit(), Error);         // 0 of 2 written
+  }
+  EXPECT_FALSE(std::filesystem::exists(path));
+  EXPECT_TRUE(std::filesystem::is_empty(dir.path()));
+}
+
 }  // namespace
 }  // namespace pointillist

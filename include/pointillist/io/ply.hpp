@@ -1,6 +1,8 @@
 // PLY 1.0 ("Polygon File Format", Greg Turk 1994) reader and writer.
 #pragma once
 
+#include <cstdint>
+#include <memory>
 #include <string>
 
 #include "pointillist/core/point_set.hpp"
@@ -9,6 +11,7 @@
 namespace pointillist {
 
 class ThreadPool;
+class AtomicFile;
 
 struct PlyReadOptions {
   // Read `red green blue` / `diffuse_*` into PointSet::colors when present. Off: ignore colors.
@@ -52,5 +55,26 @@ struct PlyWriteOptions {
 // position count or a triangle indexes past the last position (nothing is written then).
 void write_ply(const std::string& path, const PointSet& points,
                const PlyWriteOptions& options = {});
+
+// A binary little-endian PLY of `count` points written batch by batch, in constant memory: the
+// header (properties, comments, origin and up of `layout`, whose point count does not matter)
+// first, then each batch's vertices, which must have the layout's properties. The file appears
+// only when commit() finds all `count` points written (atomically, as write_ply). Throws Error
+// for a batch that does not fit, IoError when writing fails.
+class PlyPointWriter {
+ public:
+  PlyPointWriter(const std::string& path, const PointSet& layout, std::uint64_t count);
+  ~PlyPointWriter();
+  PlyPointWriter(const PlyPointWriter&) = delete;
+  PlyPointWriter& operator=(const PlyPointWriter&) = delete;
+  void write(const PointSet& batch);
+  void commit();
+
+ private:
+  std::unique_ptr<AtomicFile> file_;
+  std::string path_;
+  std::uint64_t count_, written_ = 0;
+  bool normals_, colors_, radii_;
+};
 
 }  // namespace pointillist
