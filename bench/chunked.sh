@@ -7,7 +7,7 @@
 # should not).
 #
 #   bash bench/chunked.sh [--bin PATH] [--work DIR] [--points N] [--memory SIZE[,SIZE...]]
-#                         [--no-whole]
+#                         [--no-whole] [--colors] [--mpi]
 #
 #   --points N     points of the generated cloud (default 10000000). 100000000 takes about
 #                  25 s to generate (1.2 GB), minutes to convert, and 17 GB in one piece.
@@ -15,6 +15,9 @@
 #                  piece runs in one piece)
 #   --no-whole     skip the one-piece run (inputs too large for this machine's memory); ratios
 #                  are then left out
+#   --colors       the cloud has colours (generate --colors): 15 bytes a point
+#   --mpi          also run each budget under `mpirun -n 2 --oversubscribe` (one thread a rank)
+#                  and check that it writes the single process's file byte for byte
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bin="${POINTILLIST_BIN:-build/release/pointillist}"
@@ -22,6 +25,8 @@ work="${CHUNKED_BENCH_WORK:-/tmp/pointillist-bench-chunked}"
 points=10000000
 memory="1G,512M"
 whole=1
+colors=""
+mpi=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --bin) bin="$2"; shift 2 ;;
@@ -29,24 +34,32 @@ while [ $# -gt 0 ]; do
     --points) points="$2"; shift 2 ;;
     --memory) memory="$2"; shift 2 ;;
     --no-whole) whole=0; shift ;;
+    --colors) colors="--colors"; shift ;;
+    --mpi) mpi=1; shift ;;
     *) echo "chunked.sh: unknown option $1" >&2; exit 2 ;;
   esac
 done
 [ -x "$bin" ] || { echo "chunked.sh: no binary at $bin (make build)" >&2; exit 1; }
 mkdir -p "$work"
-cloud="$work/cloud-$points.ply"
+cloud="$work/cloud-$points${colors:+-rgb}.ply"
 if [ ! -f "$cloud" ]; then
   need=$(( points * 12 + 1000000 ))
   free=$(df --output=avail -B1 "$work" | tail -1)
   [ "$free" -gt $(( need * 4 )) ] || { echo "chunked.sh: $work needs about $(( need * 4 / 1000000000 )) GB free" >&2; exit 1; }
-  "$bin" generate -o "$cloud" --points "$points" -q
+  "$bin" generate -o "$cloud" --points "$points" $colors -q
 fi
 
-# run NAME ARGS...: one conversion; prints "NAME wall cpu peak_kb chunks".
+# run NAME ARGS...: one conversion; prints "NAME wall cpu peak_kb chunks". Under mpirun the
+# peak is the largest rank's.
 run() {
   local name="$1"; shift
-  local out="$work/$name.ptl" log="$work/$name.log"
-  /usr/bin/time -f "%e %U %S %M" -o "$work/$name.time" "$bin" convert "$cloud" -o "$out" "$@" > "$log"
+  local out="$work/$name.ptl" log="$work/$name.log" launcher=()
+  case "$name" in
+    mpi-*) launcher=(env OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+                     mpirun -n 2 --oversubscribe) ;;
+  esac
+  /usr/bin/time -f "%e %U %S %M" -o "$work/$name.time" "${launcher[@]}" "$bin" convert "$cloud" \
+    -o "$out" "$@" > "$log"
   read -r wall user sys peak < "$work/$name.time"
   local chunks
   chunks=$(sed -n 's/^in \([0-9]*\) chunks.*/\1/p' "$log")
@@ -57,7 +70,15 @@ echo "cloud: $points points ($cloud)"
 results=()
 if [ "$whole" = 1 ]; then results+=("$(run whole)"); fi
 IFS=',' read -ra budgets <<< "$memory"
-for m in "${budgets[@]}"; do results+=("$(run "chunked-$m" --memory "$m")"); done
+for m in "${budgets[@]}"; do
+  results+=("$(run "chunked-$m" --memory "$m")")
+  if [ "$mpi" = 1 ]; then
+    results+=("$(run "mpi-$m" --memory "$m" --threads 1)")
+    cmp -s "$work/chunked-$m.ptl" "$work/mpi-$m.ptl" \
+      && echo "mpi-$m: the same file, byte for byte, as one process" >&2 \
+      || echo "mpi-$m: a different file from one process" >&2
+  fi
+done
 
 printf '%-14s %8s %8s %8s %10s %10s %7s %8s %8s\n' run wall_s cpu_s cpu/wall Mpoints/s peak_MB chunks wall/1 peak/1
 base_wall="" base_peak=""
@@ -76,6 +97,7 @@ if [ "$whole" = 1 ]; then
   "$bin" render "$work/whole.ptl" -o "$work/whole.png" --view 30,20 -q
   for r in "${results[@]:1}"; do
     read -r name _ <<< "$r"
+    case "$name" in mpi-*) continue ;; esac
     "$bin" render "$work/$name.ptl" -o "$work/$name.png" --view 30,20 -q
     cmp -s "$work/whole.png" "$work/$name.png" \
       && echo "$name: renders the same image, byte for byte, as the one-piece file" \
