@@ -4,7 +4,6 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
-#include <cstdlib>
 #include <memory>
 #include <new>
 #include <string>
@@ -34,8 +33,7 @@ int main(int argc, char** argv) {
   // Under mpirun with several processes, `convert` shares its chunk jobs among them; the other
   // commands would only repeat each other's work and race on their outputs.
   std::unique_ptr<pointillist::ChunkJobs> job;
-  const char* world = std::getenv("OMPI_COMM_WORLD_SIZE");
-  if (pointillist::started_by_mpirun() && !(world && std::string(world) == "1")) {
+  if (pointillist::started_by_mpirun()) {
     if (!pointillist::mpi_built()) {
       std::fprintf(stderr, "pointillist: error: started by mpirun, but this build has no MPI; "
                            "install OpenMPI (scripts/setup.sh) and rebuild, or run without "

@@ -154,8 +154,8 @@ bool mpi_built() {
 }
 
 bool started_by_mpirun() {
-  return std::getenv("OMPI_COMM_WORLD_SIZE") != nullptr || std::getenv("PMIX_RANK") != nullptr ||
-         std::getenv("PMI_RANK") != nullptr;
+  if (const char* size = std::getenv("OMPI_COMM_WORLD_SIZE")) return std::string(size) != "1";
+  return std::getenv("PMIX_RANK") != nullptr || std::getenv("PMI_RANK") != nullptr;
 }
 
 std::unique_ptr<ChunkJobs> join_mpi_job([[maybe_unused]] int* argc,

@@ -196,8 +196,9 @@ void scan_plan_distribute(MergedInputs& in, const WorkFolder& folder, const Conv
   // written.
   {
     const double halo_share = 0.1;  // a generous bound: chunks of 1 M points have about 2 %
+    const RecordLayout records{in.has_normals(), in.has_radii()};  // at most, before the scan
     const double per_point = std::max({plan_on_disk ? 12.0 : 0.0,
-                                       double(sh.layout.size()) * (1 + halo_share), 43.0,
+                                       double(records.size()) * (1 + halo_share), 43.0,
                                        31.0 + 12});
     const std::uint64_t chunk = n >> levels;
     const auto need = std::uint64_t(double(n) * per_point + double(chunk) * 43);
@@ -335,7 +336,6 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
     if (!root) return;
     in.emplace(inputs, o.columns);
     sh.n = in->count();
-    sh.layout = {in->has_normals(), in->has_radii()};
     sh.colors = in->has_colors();
     overall.emplace(outer_progress, sh.n);
     progress_ptr = &*overall;

@@ -41,7 +41,8 @@ class ChunkJobs {
 
 // Whether this build can run chunk jobs on MPI ranks (CMake's POINTILLIST_MPI with OpenMPI).
 bool mpi_built();
-// Whether this process was started by mpirun (its environment says so).
+// Whether this process was started by mpirun in a job of several processes (its environment
+// says so; a job of one process runs as if alone).
 bool started_by_mpirun();
 // Joins the MPI job this process was started in (MPI_Init; MPI_Finalize when destroyed). Throws
 // Error when this build has no MPI.
