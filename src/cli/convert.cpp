@@ -61,6 +61,16 @@ int run_convert(const ConvertCommandOptions& o) {
       std::printf("in one piece, peak memory %s (%.0f bytes/point)\n", human_bytes(peak).c_str(),
                   n ? peak / double(n) : 0.0);
     }
+    if (!r.phase_seconds.empty()) {
+      std::string line = "phases:";
+      for (std::size_t i = 0; i < r.phase_seconds.size(); ++i) {
+        char part[64];
+        std::snprintf(part, sizeof part, "%s %s %.1f s", i ? "," : "",
+                      r.phase_seconds[i].first.c_str(), r.phase_seconds[i].second);
+        line += part;
+      }
+      std::printf("%s\n", line.c_str());
+    }
   }
   return 0;
 }

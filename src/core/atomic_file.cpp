@@ -158,7 +158,7 @@ void AtomicFile::write(const void* data, std::size_t size) {
 }
 
 void AtomicFile::write_at(std::uint64_t offset, const void* data, std::size_t size) {
-  flush();
+  if (used_ > 0) flush();
   const char* bytes = static_cast<const char*>(data);
   while (size > 0) {
     const ssize_t n = ::pwrite(fd_, bytes, size, static_cast<off_t>(offset));

@@ -73,7 +73,8 @@ struct PtlV2PartWriter::State {
   EncodedTree top_codes;
   std::vector<PtlV2PageInfo> table;         // the whole file's
   std::vector<std::uint32_t> first_page;    // table index of each subtree's first page
-  std::vector<bool> written;
+  std::vector<std::uint8_t> written;  // bytes, not bits: subtrees are written concurrently
+  std::vector<EncodeStats> subtree_stats;  // merged in order by finish()
   std::uint64_t metadata_offset = 0;
   std::uint64_t node_count = 0, leaf_count = 0;
   std::uint32_t depth = 0;
@@ -195,7 +196,8 @@ PtlV2PartWriter::PtlV2PartWriter(const std::string& path,
   }
   if (st.node_count > 0xfffffffeu) throw Error("cannot write " + path + ": more than 2^32 - 2 nodes");
   st.metadata_offset = offset;
-  st.written.assign(count, false);
+  st.written.assign(count, 0);
+  st.subtree_stats.resize(count);
   st.file.emplace(path);
 }
 
@@ -211,15 +213,16 @@ void PtlV2PartWriter::write_subtree(std::size_t k, const SphereTree& tree, Threa
     throw Error("cannot write " + st.path + ": subtree " + std::to_string(k) +
                 " is not the one summarized (its root or node count differs)");
   }
-  st.written[k] = true;
+  st.written[k] = 1;
   if (s.pages.empty()) return;  // a single leaf: its record is in the top
   std::uint64_t leaves = 0;
   std::uint32_t depth = 0;
   const std::vector<std::uint32_t> parent = check_tree(st.path, tree.nodes, leaves, depth);
   const Sphere& decoded_root = st.top_codes.decoded[st.first_root + k];
+  EncodeStats& stats = st.subtree_stats[k];
   const EncodedTree enc = encode_tree(tree.nodes, parent, nullptr, &decoded_root,
-                                      st.options.leaf_trim, st.colors, pool, st.stats);
-  --st.stats.cone_codes[s.cone_code];  // the root's cone is counted with the top
+                                      st.options.leaf_trim, st.colors, pool, stats);
+  --stats.cone_codes[s.cone_code];  // the root's cone is counted with the top
   const std::vector<PagePlan> plan =
       plan_pages(tree.nodes, st.record_size, st.options.page_bytes, true);
   std::vector<std::uint8_t> bytes;
@@ -246,6 +249,13 @@ PtlV2WriteReport PtlV2PartWriter::finish(const Aabb& bounds, const Sphere& view_
       throw Error("cannot write " + st.path + ": subtree " + std::to_string(k) +
                   " of " + std::to_string(st.written.size()) + " was not written");
     }
+  }
+  for (const EncodeStats& t : st.subtree_stats) {
+    st.stats.spheres_enlarged += t.spheres_enlarged;
+    st.stats.parent_fallbacks += t.parent_fallbacks;
+    st.stats.leaf_ratio_sum += t.leaf_ratio_sum;
+    st.stats.leaf_ratio_count += t.leaf_ratio_count;
+    for (int c = 0; c < 4; ++c) st.stats.cone_codes[c] += t.cone_codes[c];
   }
   HeaderFields f;
   f.colors = st.colors;

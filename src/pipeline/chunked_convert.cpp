@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <cstdio>
@@ -66,6 +67,10 @@ class OverallProgress final : public Progress {
     for (std::size_t i = 0; i < kPhases.size(); ++i) {
       if (name == kPhases[i].name) phase_ = i;
     }
+    if (depth_++ == 0) {
+      top_ = phase_;
+      started_ = std::chrono::steady_clock::now();
+    }
     total_ = total;
     done_ = 0;
     report();
@@ -76,12 +81,19 @@ class OverallProgress final : public Progress {
     report();
   }
   void end_phase() override {
+    if (depth_ == 1 && top_ < kPhases.size()) {
+      const std::chrono::duration<double> took = std::chrono::steady_clock::now() - started_;
+      seconds_.emplace_back(std::string(kPhases[top_].name), took.count());
+    }
+    depth_ = depth_ > 0 ? depth_ - 1 : 0;
     if (phase_ < kPhases.size()) finished_ += kPhases[phase_].share;
     phase_ = kPhases.size();
     inner_.end_phase();
     report();
   }
   void detail(std::string_view text) override { inner_.detail(text); }
+  // The wall time of each top-level phase that ended, in order.
+  const std::vector<std::pair<std::string, double>>& phase_seconds() const { return seconds_; }
 
  private:
   struct Phase {
@@ -108,6 +120,10 @@ class OverallProgress final : public Progress {
   std::uint64_t total_ = 0;
   std::atomic<std::uint64_t> done_{0};
   double finished_ = 0;
+  int depth_ = 0;             // nesting of phases (a plan on disk has its own)
+  std::size_t top_ = kPhases.size();  // the outermost phase
+  std::chrono::steady_clock::time_point started_;
+  std::vector<std::pair<std::string, double>> seconds_;
 };
 
 // Calls fn(chunk, pool) for each of `chunks`, `workers` chunks at a time, each worker with a
@@ -571,23 +587,31 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
     ProgressPhase phase(progress, "write", n);
     PtlV2PartWriter writer(output, summaries, colors, v2);
     const Vec3f centre = bounds.center();
-    float far2 = 0;
-    for (std::size_t c = 0; c < chunks; ++c) {
+    // Subtrees are encoded and written in place a few at a time (as many as the chunks
+    // prepared at once).
+    std::vector<float> far2(chunks, 0.0f);
+    std::vector<std::size_t> all(chunks);
+    for (std::size_t c = 0; c < chunks; ++c) all[c] = c;
+    for_each_chunk(all, pool, [&](std::size_t c, ThreadPool& chunk_pool) {
       const std::string path = folder->file(ChunkFiles::name("chunk", c) + ".splats");
       const Splats s = read_splats(path, summaries[c].leaf_count, colors, false, false);
       std::filesystem::remove(path);
       const SphereTree tree =
-          build_sphere_tree(s.points, pool, Progress::none(), {.presorted = true});
-      for (const Vec3f& p : s.points.positions) far2 = std::max(far2, length_squared(p - centre));
-      writer.write_subtree(c, tree, pool);
+          build_sphere_tree(s.points, chunk_pool, Progress::none(), {.presorted = true});
+      for (const Vec3f& p : s.points.positions) {
+        far2[c] = std::max(far2[c], length_squared(p - centre));
+      }
+      writer.write_subtree(c, tree, chunk_pool);
       phase.advance(plan.counts[c]);
-    }
+    });
+    const float view_radius = std::sqrt(*std::max_element(far2.begin(), far2.end()));
     std::ostringstream meta;
     meta << metadata_head;
     for (const std::string& comment : in->comments()) meta << "comment: " << comment << "\n";
-    writer.finish(bounds, {centre, std::sqrt(far2)}, in->origin(), in->up(), meta.str());
+    writer.finish(bounds, {centre, view_radius}, in->origin(), in->up(), meta.str());
   });
   result.output_points = n;
+  if (overall) result.phase_seconds = overall->phase_seconds();
   return result;
 }
 

@@ -26,7 +26,8 @@ class AtomicFile {
   void write(const void* data, std::size_t size);
   void write(const std::string& text) { write(text.data(), text.size()); }
   // Writes at byte `offset` of the file (after flushing what write() buffered); the sequential
-  // write position is not moved. For files laid out before they are filled. Throws IoError.
+  // write position is not moved. For files laid out before they are filled. Several threads may
+  // call it at once on disjoint ranges while nothing is buffered. Throws IoError.
   void write_at(std::uint64_t offset, const void* data, std::size_t size);
   // Flushes, closes and renames into place. Throws IoError.
   void commit();

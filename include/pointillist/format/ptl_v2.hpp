@@ -114,7 +114,8 @@ PtlV2WriteReport write_ptl_v2(const std::string& path, const SphereTree& tree,
 //      the roots (build_top_tree), encodes it and lays out the file: header, page table, the top
 //      page, then each subtree's pages in turn, then the metadata.
 //   3. write_subtree(k, tree) encodes subtree k below its root's decoded sphere and writes its
-//      pages in place; subtrees may come in any order, one call at a time.
+//      pages in place; subtrees may come in any order, different subtrees on several threads at
+//      once.
 //   4. finish() writes the header, the table, the top page and the metadata, and renames the
 //      file into place.
 // The file is an ordinary version 2 file; the same subtrees give the same bytes.

@@ -51,6 +51,8 @@ struct ConvertResult {
   std::vector<std::string> warnings;
   std::size_t chunks = 0;           // chunks of a chunked conversion (0: in one piece)
   std::uint64_t halo_points = 0;    // points copied into other chunks' halos
+  // Wall time of each phase of a chunked conversion, in order (rank 0's view under MPI).
+  std::vector<std::pair<std::string, double>> phase_seconds;
 };
 
 // Half of the physical memory: the default ConvertOptions::memory_budget.
