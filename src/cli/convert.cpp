@@ -21,6 +21,7 @@ ChunkJobs*& mpi_job() {
 }
 
 int run_convert(const ConvertCommandOptions& o) {
+  keep_freed_memory();
   const auto start = std::chrono::steady_clock::now();
   ThreadPool pool(o.threads);
   ConvertOptions options = o.convert;

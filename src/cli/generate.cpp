@@ -139,6 +139,7 @@ void check_options(const GenerateOptions& o) {
 }  // namespace
 
 int run_generate(const GenerateOptions& o) {
+  keep_freed_memory();
   check_options(o);
   for (const std::string& w : o.warnings) {
     std::fprintf(stderr, "pointillist generate: warning: %s\n", w.c_str());

@@ -1,9 +1,17 @@
 #include "util.hpp"
 
+#include <malloc.h>
+
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 
 namespace pointillist::cli {
+
+void keep_freed_memory() {
+  ::mallopt(M_MMAP_MAX, 0);
+  ::mallopt(M_TRIM_THRESHOLD, std::numeric_limits<int>::max());
+}
 
 std::string human_bytes(double bytes) {
   const char* units[] = {"B", "KB", "MB", "GB", "TB"};

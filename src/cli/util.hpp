@@ -15,6 +15,14 @@ std::string human_bytes(double bytes);
 // `file_names`), then "and N more".
 std::string input_names(std::span<const std::string> inputs, bool file_names = false);
 
+// For batch commands (convert, generate): freed memory stays with the process for reuse
+// instead of going back to the system (no mmap for large blocks, no trimming). Memory the
+// system hands out is zeroed page by page on first touch, which costs about 3.5 s a GB on
+// this kind of virtual machine; a chunked conversion frees and reallocates the same buffers for
+// every chunk (measured: 10 M points in chunks 30.6 s -> 23.6 s, system time 10.8 s -> 3.8 s,
+// the same peak). The peak resident memory is unchanged; it is simply not given back early.
+void keep_freed_memory();
+
 // Eight well-separated face colours (spec §4.1), so that any blending of two faces shows:
 // `generate --scene T*` colours face label l with kLabelPalette[l % 8], samples and --reference
 // image alike, and `compare --labels` reads the labels back from them.

@@ -11,8 +11,7 @@
 namespace pointillist {
 namespace {
 
-constexpr int kBitsPerAxis = 21;
-constexpr std::uint32_t kMaxCell = (1u << kBitsPerAxis) - 1;
+constexpr int kBitsPerAxis = MortonFrame::kBits;
 constexpr int kBucketBits = 12;  // the top 4 octree levels
 constexpr std::size_t kBucketCount = std::size_t{1} << kBucketBits;
 constexpr std::size_t kGrain = 1 << 16;
@@ -27,22 +26,9 @@ inline bool operator<(const Keyed& a, const Keyed& b) {
   return a.code < b.code || (a.code == b.code && a.index < b.index);
 }
 
-// Cell of coordinate v in [0, kMaxCell]; NaN and out-of-range values are clamped.
-inline std::uint32_t cell(float v, float lo, float scale) {
-  const float c = (v - lo) * scale;
-  if (!(c >= 0.0f)) return 0;
-  if (!(c < static_cast<float>(kMaxCell))) return kMaxCell;
-  return static_cast<std::uint32_t>(c);
-}
-
 }  // namespace
 
-std::vector<std::uint32_t> morton_order(std::span<const Vec3f> points, ThreadPool& pool) {
-  const std::size_t n = points.size();
-  assert(n <= std::size_t{UINT32_MAX});
-  std::vector<std::uint32_t> order(n);
-  if (n == 0) return order;
-
+MortonFrame MortonFrame::of(std::span<const Vec3f> points) {
   // Finite points only, so one stray NaN or inf cannot collapse every other code to 0.
   Aabb box;
   for (const Vec3f& p : points) {
@@ -51,16 +37,26 @@ std::vector<std::uint32_t> morton_order(std::span<const Vec3f> points, ThreadPoo
   if (box.empty()) box.extend(Vec3f{});
   const Vec3f extent = box.extent();
   const float longest = std::max({extent.x, extent.y, extent.z});
+  MortonFrame f;
+  f.lo = box.lo;
   // One scale for all axes keeps cells cubic, so Z-order neighbours are spatial neighbours.
-  const float scale = longest > 0.0f ? static_cast<float>(kMaxCell) / longest : 0.0f;
+  f.scale = longest > 0.0f ? static_cast<float>(kMaxCell) / longest : 0.0f;
+  return f;
+}
+
+std::vector<std::uint32_t> morton_order(std::span<const Vec3f> points, ThreadPool& pool) {
+  const std::size_t n = points.size();
+  assert(n <= std::size_t{UINT32_MAX});
+  std::vector<std::uint32_t> order(n);
+  if (n == 0) return order;
+
+  const MortonFrame frame = MortonFrame::of(points);
 
   std::vector<Keyed> keyed(n);
   parallel_for(pool, n, kGrain, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       const Vec3f p = points[i];
-      keyed[i] = {morton_code(cell(p.x, box.lo.x, scale), cell(p.y, box.lo.y, scale),
-                              cell(p.z, box.lo.z, scale)),
-                  static_cast<std::uint32_t>(i)};
+      keyed[i] = {frame.code(p), static_cast<std::uint32_t>(i)};
     }
   });
 

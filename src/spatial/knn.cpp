@@ -1,9 +1,15 @@
-// k nearest neighbours with a nanoflann kd-tree, queried in Morton order for memory locality.
+// k nearest neighbours over spatially ordered points. Most queries are answered from a grid of
+// Morton cells (the cells of morton_order, grouped 2^level a side): the points of a cell's
+// 3x3x3 block are gathered once and searched for every point of the cell, and a query whose
+// k-th distance could reach past its block is asked again of a nanoflann kd-tree. Both give the
+// exact answer, so which one answers a query never shows.
 #include "pointillist/spatial/knn.hpp"
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cassert>
+#include <cmath>
 #include <limits>
 #include <nanoflann.hpp>
 
@@ -14,6 +20,12 @@ namespace {
 constexpr std::size_t kQueryGrain = 4096;
 // Leaf size of the kd-tree; 16 measured faster than nanoflann's default 10 for k = 16 here.
 constexpr std::size_t kLeafSize = 16;
+// The grid's cells hold about this many points on average (its level is chosen so).
+constexpr double kCellPoints = 8;
+// A block with more candidates than this leaves its queries to the kd-tree (piles of copies).
+constexpr std::size_t kMaxCandidates = 4096;
+// Below this many points the kd-tree answers every query.
+constexpr std::size_t kGridMinPoints = 64;
 
 struct CloudAdaptor {
   std::span<const Vec3f> points;
@@ -30,8 +42,263 @@ using KdTree = nanoflann::KDTreeSingleIndexAdaptor<Metric, CloudAdaptor, 3, std:
 
 struct Neighbour {
   float d2;
-  std::uint32_t index;
+  std::uint32_t index;  // in the caller's order
 };
+
+// The squared distance as the kd-tree's metric sums it (x, then y, then z), so both paths give
+// the same bits (this file is compiled without floating-point contraction).
+inline float squared_distance(const Vec3f& q, float x, float y, float z) {
+  float r = 0.0f;
+  float d = q.x - x;
+  r += d * d;
+  d = q.y - y;
+  r += d * d;
+  d = q.z - z;
+  r += d * d;
+  return r;
+}
+
+// Finishes a row sorted by distance that holds every point tied with its k-th: equal distances
+// at the k-th place go to the lowest positions (x, then y, then z), then equal distances are
+// ordered by index; writes the row (padded by its last entry, or the point itself) to out.
+void finish_row(std::vector<Neighbour>& row, std::size_t k, std::span<const Vec3f> points,
+                std::uint32_t self, std::uint32_t* out, float* out_d2) {
+  if (row.size() > k) {
+    const float cut = row[k - 1].d2;
+    std::size_t first = k - 1, last = k;
+    while (first > 0 && row[first - 1].d2 == cut) --first;
+    while (last < row.size() && row[last].d2 == cut) ++last;
+    if (last > k) {
+      const auto position = [&](const Neighbour& nb) {
+        const Vec3f p = points[nb.index];
+        return std::array<float, 3>{p.x, p.y, p.z};
+      };
+      std::sort(row.begin() + std::ptrdiff_t(first), row.begin() + std::ptrdiff_t(last),
+                [&](const Neighbour& a, const Neighbour& b) {
+                  const auto pa = position(a), pb = position(b);
+                  return pa < pb || (pa == pb && a.index < b.index);
+                });
+    }
+    row.resize(k);
+  }
+  // Order equal distances by index (insertion sort, ~linear).
+  for (std::size_t i = 1; i < row.size(); ++i) {
+    const Neighbour x = row[i];
+    std::size_t m = i;
+    for (; m > 0 && row[m - 1].d2 == x.d2 && row[m - 1].index > x.index; --m) row[m] = row[m - 1];
+    row[m] = x;
+  }
+  const Neighbour pad = row.empty() ? Neighbour{0.0f, self} : row.back();
+  for (std::size_t i = 0; i < k; ++i) {
+    const Neighbour& nb = i < row.size() ? row[i] : pad;
+    out[i] = nb.index;
+    if (out_d2) out_d2[i] = nb.d2;
+  }
+}
+
+// The grid: Morton cells of one level over spatially ordered points, each a run of them.
+struct CellGrid {
+  MortonFrame frame;
+  int level = 0;                        // cells of 2^level Morton cells a side
+  std::vector<std::uint64_t> key;       // each cell's Morton code at its level, ascending
+  std::vector<std::uint32_t> begin;     // each cell's first point; one more entry: n
+  std::vector<std::uint32_t> table;     // open addressing: cell index + 1, or 0
+  std::uint64_t mask = 0;
+
+  std::uint32_t find(std::uint64_t k) const {  // cell index + 1, or 0
+    for (std::uint64_t h = (k * 0x9E3779B97F4A7C15ULL) >> 20 & mask;; h = (h + 1) & mask) {
+      const std::uint32_t c = table[h];
+      if (c == 0 || key[c - 1] == k) return c;
+    }
+  }
+};
+
+// Builds the grid when the points are in Morton order (false otherwise): the level at which
+// cells hold about kCellPoints points on average.
+bool build_grid(std::span<const Vec3f> points, CellGrid& g) {
+  const std::size_t n = points.size();
+  g.frame = MortonFrame::of(points);
+  std::vector<std::uint64_t> code(n);
+  for (std::size_t i = 0; i < n; ++i) code[i] = g.frame.code(points[i]);
+  // Cells at level m differ between neighbours in the order whose codes differ above bit 3m.
+  std::array<std::size_t, MortonFrame::kBits + 1> differ{};
+  for (std::size_t i = 1; i < n; ++i) {
+    const std::uint64_t x = code[i] ^ code[i - 1];
+    if (code[i] < code[i - 1]) return false;
+    if (x != 0) ++differ[std::size_t(63 - std::countl_zero(x)) / 3];
+  }
+  std::size_t cells = 1;
+  for (std::size_t m = 0; m <= MortonFrame::kBits; ++m) cells += differ[m];
+  g.level = 0;
+  for (int m = 0; m <= MortonFrame::kBits; ++m) {
+    if (double(n) / double(cells) >= kCellPoints) break;
+    cells -= differ[std::size_t(m)];
+    g.level = m + 1;
+  }
+  const int shift = 3 * g.level;
+  g.key.clear();
+  g.begin.clear();
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint64_t k = shift >= 64 ? 0 : code[i] >> shift;
+    if (g.key.empty() || g.key.back() != k) {
+      g.key.push_back(k);
+      g.begin.push_back(std::uint32_t(i));
+    }
+  }
+  g.begin.push_back(std::uint32_t(n));
+  const std::size_t capacity = std::bit_ceil(std::max<std::size_t>(2 * g.key.size(), 16));
+  g.mask = capacity - 1;
+  g.table.assign(capacity, 0);
+  for (std::size_t c = 0; c < g.key.size(); ++c) {
+    std::uint64_t h = (g.key[c] * 0x9E3779B97F4A7C15ULL) >> 20 & g.mask;
+    while (g.table[h] != 0) h = (h + 1) & g.mask;
+    g.table[h] = std::uint32_t(c + 1);
+  }
+  return true;
+}
+
+// Decodes the three coordinates interleaved in a Morton code (inverse of morton_code).
+std::uint32_t compact_bits_21(std::uint64_t v) {
+  v &= 0x1249249249249249ULL;
+  v = (v | (v >> 2)) & 0x10c30c30c30c30c3ULL;
+  v = (v | (v >> 4)) & 0x100f00f00f00f00fULL;
+  v = (v | (v >> 8)) & 0x1f0000ff0000ffULL;
+  v = (v | (v >> 16)) & 0x1f00000000ffffULL;
+  v = (v | (v >> 32)) & 0x1fffffULL;
+  return std::uint32_t(v);
+}
+
+// Answers the queries of cells [cell_begin, cell_end) from their blocks; queries whose answer
+// the block cannot vouch for go to `missed`.
+void grid_queries(const CellGrid& g, std::size_t cell_begin, std::size_t cell_end,
+                  std::span<const Vec3f> tree_points, std::span<const Vec3f> points,
+                  const std::uint32_t* order, std::size_t k, std::uint32_t* result,
+                  float* result_d2, std::vector<std::uint32_t>& missed) {
+  struct Run {
+    std::uint32_t begin, end;  // candidates of one cell
+    float cell[3];             // its coordinates at the grid's level
+    double gap2 = 0;
+  };
+  std::vector<Run> runs;
+  float guess = 0;  // a squared distance that k candidates are expected to be within
+  std::vector<float> cx, cy, cz;
+  std::vector<std::uint32_t> cj;
+  std::vector<Neighbour> near, row;
+  const auto original = [&](std::uint32_t j) { return order ? order[j] : j; };
+  const std::uint32_t side = MortonFrame::kMaxCell >> g.level;  // the last cell on each axis
+  const float cell_units = float(1u << g.level);
+  for (std::size_t c = cell_begin; c < cell_end; ++c) {
+    const std::uint32_t a[3] = {compact_bits_21(g.key[c]), compact_bits_21(g.key[c] >> 1),
+                                compact_bits_21(g.key[c] >> 2)};
+    // Gather the block: the cell itself first (its points are the likeliest neighbours), each
+    // cell's candidates a run with the cell's coordinates.
+    cx.clear(), cy.clear(), cz.clear(), cj.clear();
+    runs.clear();
+    const auto gather = [&](std::size_t cell, std::int64_t x, std::int64_t y, std::int64_t z) {
+      const auto first = std::uint32_t(cj.size());
+      for (std::uint32_t j = g.begin[cell]; j < g.begin[cell + 1]; ++j) {
+        const Vec3f p = tree_points[j];
+        cx.push_back(p.x), cy.push_back(p.y), cz.push_back(p.z), cj.push_back(j);
+      }
+      runs.push_back({first, std::uint32_t(cj.size()), {float(x), float(y), float(z)}});
+    };
+    gather(c, a[0], a[1], a[2]);
+    for (int dz = -1; dz <= 1; ++dz) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          if (dx == 0 && dy == 0 && dz == 0) continue;
+          const std::int64_t b[3] = {std::int64_t(a[0]) + dx, std::int64_t(a[1]) + dy,
+                                     std::int64_t(a[2]) + dz};
+          if (b[0] < 0 || b[1] < 0 || b[2] < 0 || b[0] > side || b[1] > side || b[2] > side) {
+            continue;
+          }
+          const std::uint32_t found = g.find(
+              morton_code(std::uint32_t(b[0]), std::uint32_t(b[1]), std::uint32_t(b[2])));
+          if (found) gather(found - 1, b[0], b[1], b[2]);
+        }
+      }
+    }
+    const std::size_t m = cj.size();
+    if (m > kMaxCandidates || m <= k) {
+      for (std::uint32_t j = g.begin[c]; j < g.begin[c + 1]; ++j) missed.push_back(j);
+      continue;
+    }
+    near.resize(m);
+    const double scale = g.frame.scale;
+    for (std::uint32_t j = g.begin[c]; j < g.begin[c + 1]; ++j) {
+      const Vec3f q = tree_points[j];
+      const float u[3] = {(q.x - g.frame.lo.x) * g.frame.scale,
+                          (q.y - g.frame.lo.y) * g.frame.scale,
+                          (q.z - g.frame.lo.z) * g.frame.scale};
+      // Each run's cell lies at least this far from q (squared, in units of length; 2 Morton
+      // cells less on each axis for the rounding of both cell assignments).
+      for (Run& r : runs) {
+        double gap2 = 0;
+        for (int axis = 0; axis < 3; ++axis) {
+          const double lo = double(r.cell[axis]) * cell_units;
+          const double gap = std::max(lo - double(u[axis]), double(u[axis]) - lo - cell_units) - 2;
+          if (gap > 0) gap2 += gap * gap;
+        }
+        r.gap2 = gap2 / (scale * scale) * (1 - 1e-5);
+      }
+      // The candidates within a limit (the last query's k-th distance, grown), but the point
+      // itself: when they are k or more, they hold the k nearest and all tied with the k-th.
+      // Else the limit grows until they do (all m - 1 of them at the end).
+      std::size_t count = 0;
+      for (float limit = guess > 0 ? guess * 1.5f : std::numeric_limits<float>::infinity();;
+           limit = limit * 4) {
+        count = 0;
+        for (const Run& r : runs) {
+          if (r.gap2 > double(limit)) continue;
+          for (std::uint32_t i = r.begin; i < r.end; ++i) {
+            const float d = squared_distance(q, cx[i], cy[i], cz[i]);
+            near[count] = Neighbour{d, i};
+            count += (d <= limit) & (cj[i] != j);
+          }
+        }
+        if (count >= k || !(limit < std::numeric_limits<float>::max())) break;
+        if (!(limit > 0)) limit = std::numeric_limits<float>::min();
+      }
+      // In order of distance, then index (insertion sort: a few dozen entries).
+      for (std::size_t t = 0; t < count; ++t) {
+        Neighbour x{near[t].d2, original(cj[near[t].index])};
+        std::size_t at = t;
+        for (; at > 0 && (near[at - 1].d2 > x.d2 ||
+                          (near[at - 1].d2 == x.d2 && near[at - 1].index > x.index));
+             --at) {
+          near[at] = near[at - 1];
+        }
+        near[at] = x;
+      }
+      const float cut = near[k - 1].d2;
+      guess = cut;
+
+      // Every point outside the block lies at least this far from q, in cells of the Morton
+      // grid (less 2 for the rounding of both cell assignments); sides at the grid's edge
+      // have no points beyond them.
+      double reach = std::numeric_limits<double>::infinity();
+      for (int axis = 0; axis < 3; ++axis) {
+        if (a[axis] > 0) {
+          reach = std::min(reach, double(u[axis]) - (double(a[axis]) - 1) * cell_units);
+        }
+        if (a[axis] < side) {
+          reach = std::min(reach, (double(a[axis]) + 2) * cell_units - double(u[axis]));
+        }
+      }
+      reach = reach - 2;
+      if (!(reach > 0) ||
+          !(double(cut) * scale * scale < reach * reach * (1 - 1e-5))) {
+        missed.push_back(j);
+        continue;
+      }
+      row.clear();
+      for (std::size_t i = 0; i < count && near[i].d2 <= cut; ++i) row.push_back(near[i]);
+      const std::uint32_t self = original(j);
+      finish_row(row, k, points, self, &result[std::size_t(self) * k],
+                 result_d2 ? &result_d2[std::size_t(self) * k] : nullptr);
+    }
+  }
+}
 
 }  // namespace
 
@@ -46,8 +313,9 @@ std::vector<std::uint32_t> k_nearest_neighbours(std::span<const Vec3f> points, T
   std::vector<std::uint32_t> result(n * k);
   if (squared_distances) squared_distances->assign(n * k, 0.0f);
   if (n == 0 || k == 0) return result;
+  float* result_d2 = squared_distances ? squared_distances->data() : nullptr;
 
-  // Queries and the tree both run over spatially ordered points; `order` maps back.
+  // Queries, the grid and the tree all run over spatially ordered points; `order` maps back.
   std::vector<std::uint32_t> order;
   std::vector<Vec3f> ordered_points;
   std::span<const Vec3f> tree_points = points;
@@ -59,7 +327,29 @@ std::vector<std::uint32_t> k_nearest_neighbours(std::span<const Vec3f> points, T
     });
     tree_points = ordered_points;
   }
+  const std::uint32_t* order_map = order.empty() ? nullptr : order.data();
   const auto original = [&](std::uint32_t j) { return order.empty() ? j : order[j]; };
+
+  // The grid answers what it can; `missed` lists the rest (ascending).
+  std::vector<std::uint32_t> missed;
+  CellGrid grid;
+  if (n >= kGridMinPoints && n > k + 1 && build_grid(tree_points, grid)) {
+    const std::size_t cells = grid.key.size();
+    const std::size_t grain = std::max<std::size_t>(1, cells * kQueryGrain / n);
+    const std::size_t tasks = (cells + grain - 1) / grain;
+    std::vector<std::vector<std::uint32_t>> task_missed(tasks);
+    pool.run(tasks, [&](std::size_t t) {
+      const std::size_t begin = t * grain, end = std::min(cells, begin + grain);
+      grid_queries(grid, begin, end, tree_points, points, order_map, k, result.data(), result_d2,
+                   task_missed[t]);
+      phase.advance(grid.begin[end] - grid.begin[begin] - task_missed[t].size());
+    });
+    for (const auto& t : task_missed) missed.insert(missed.end(), t.begin(), t.end());
+  } else {
+    missed.resize(n);
+    for (std::size_t j = 0; j < n; ++j) missed[j] = std::uint32_t(j);
+  }
+  if (missed.empty()) return result;
 
   const CloudAdaptor adaptor{tree_points};
   const KdTree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(kLeafSize));
@@ -67,18 +357,19 @@ std::vector<std::uint32_t> k_nearest_neighbours(std::span<const Vec3f> points, T
   // Ask for one more than k (the query point finds itself and is then dropped), and one more to
   // see whether points at the same distance straddle the k-th place: which of them the tree
   // returns depends on the tree, so such a query is asked again for kTieSlack more, and the cut
-  // among the tied points is made here by their positions. The same neighbours are then found in
-  // any subset of the points that holds them (a chunk and its halo, pipeline/chunked_convert.cpp)
-  // as long as at most kTieSlack + 1 points tie at the cut.
+  // among the tied points is made by their positions (finish_row). The same neighbours are then
+  // found in any subset of the points that holds them (a chunk and its halo,
+  // pipeline/chunked_convert.cpp) as long as at most kTieSlack + 1 points tie at the cut.
   constexpr std::size_t kTieSlack = 8;
   const std::size_t wanted = std::min(k + 2, n);
   const std::size_t wanted_tied = std::min(k + 1 + kTieSlack, n);
-  parallel_for(pool, n, kQueryGrain, [&](std::size_t begin, std::size_t end) {
+  parallel_for(pool, missed.size(), kQueryGrain, [&](std::size_t begin, std::size_t end) {
     std::vector<std::uint32_t> found_index(wanted_tied);
     std::vector<float> found_d2(wanted_tied);
     std::vector<Neighbour> row;
     row.reserve(wanted_tied);
-    for (std::size_t j = begin; j < end; ++j) {
+    for (std::size_t at = begin; at < end; ++at) {
+      const std::uint32_t j = missed[at];
       const Vec3f q = tree_points[j];
       const float query[3] = {q.x, q.y, q.z};
       const auto query_row = [&](std::size_t count) {
@@ -100,47 +391,11 @@ std::vector<std::uint32_t> k_nearest_neighbours(std::span<const Vec3f> points, T
       if (row.size() > k && row[k].d2 == row[k - 1].d2 && wanted_tied > wanted) {
         query_row(wanted_tied);
       }
-      // Rows come sorted by distance. Equal distances at the cut: the lowest positions (x, then
-      // y, then z) make it. (Many copies of the query point can crowd it out of its own list;
-      // then the farthest is dropped.)
-      if (row.size() > k) {
-        const float cut = row[k - 1].d2;
-        std::size_t first = k - 1, last = k;
-        while (first > 0 && row[first - 1].d2 == cut) --first;
-        while (last < row.size() && row[last].d2 == cut) ++last;
-        if (last > k) {
-          const auto position = [&](const Neighbour& nb) {
-            const Vec3f p = points[nb.index];
-            return std::array<float, 3>{p.x, p.y, p.z};
-          };
-          std::sort(row.begin() + std::ptrdiff_t(first), row.begin() + std::ptrdiff_t(last),
-                    [&](const Neighbour& a, const Neighbour& b) {
-                      const auto pa = position(a), pb = position(b);
-                      return pa < pb || (pa == pb && a.index < b.index);
-                    });
-        }
-        row.resize(k);
-      }
-      // Order equal distances by index (insertion sort, ~linear).
-      for (std::size_t i = 1; i < row.size(); ++i) {
-        const Neighbour x = row[i];
-        std::size_t m = i;
-        for (; m > 0 && row[m - 1].d2 == x.d2 && row[m - 1].index > x.index; --m) {
-          row[m] = row[m - 1];
-        }
-        row[m] = x;
-      }
-
-      const std::size_t self = original(static_cast<std::uint32_t>(j));
-      std::uint32_t* out = &result[self * k];
-      float* out_d2 = squared_distances ? &(*squared_distances)[self * k] : nullptr;
-      const Neighbour pad =
-          row.empty() ? Neighbour{0.0f, static_cast<std::uint32_t>(self)} : row.back();
-      for (std::size_t i = 0; i < k; ++i) {
-        const Neighbour& nb = i < row.size() ? row[i] : pad;
-        out[i] = nb.index;
-        if (out_d2) out_d2[i] = nb.d2;
-      }
+      // Many copies of the query point can crowd it out of its own list; then the farthest is
+      // dropped.
+      const std::uint32_t self = original(j);
+      finish_row(row, k, points, self, &result[std::size_t(self) * k],
+                 result_d2 ? &result_d2[std::size_t(self) * k] : nullptr);
     }
     phase.advance(end - begin);
   });

@@ -177,6 +177,50 @@ TEST(KNearestNeighbours, DuplicatePointsAreNeighboursAtDistanceZero) {
   EXPECT_EQ(std::vector<float>(d2.begin() + 15, d2.begin() + 18), (std::vector<float>{1, 1, 1}));
 }
 
+// A dense surface with stray points far from it: the surface's queries are answered from the
+// grid's cell blocks, the strays' (whose neighbours lie beyond their blocks) by the kd-tree; both
+// must be the exact k nearest.
+TEST(KNearestNeighbours, MatchesBruteForceOnASurfaceWithStrayPoints) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  std::vector<Vec3f> p;
+  for (int i = 0; i < 5000; ++i) {
+    const float a = u(rng) * 6.2831853f, z = 2 * u(rng) - 1, r = std::sqrt(1 - z * z);
+    p.push_back({r * std::cos(a), r * std::sin(a), z});
+  }
+  for (int i = 0; i < 60; ++i) p.push_back({8 * u(rng) - 4, 8 * u(rng) - 4, 8 * u(rng) - 4});
+  std::shuffle(p.begin(), p.end(), rng);
+  expect_matches_brute_force(p, 16, 2);
+}
+
+// Forty copies of one point among others: each copy's 16 neighbours are 16 other copies, those
+// with the lowest indices (all tie at distance 0 and at the same position), however many tie.
+TEST(KNearestNeighbours, ManyCopiesTiedAtTheCutGoToTheLowestIndices) {
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<Vec3f> p;
+  for (int i = 0; i < 200; ++i) p.push_back({u(rng), u(rng), u(rng)});
+  std::vector<std::uint32_t> copies;
+  for (int i = 0; i < 40; ++i) {
+    copies.push_back(std::uint32_t(p.size()));
+    p.push_back({0.25f, 0.25f, 0.25f});
+    for (int j = 0; j < 3; ++j) p.push_back({u(rng), u(rng), u(rng)});
+  }
+  ThreadPool pool(2);
+  const std::uint32_t k = 16;
+  const auto nb = k_nearest_neighbours(p, pool, {.k = k});
+  for (const std::uint32_t c : copies) {
+    std::vector<std::uint32_t> expected;
+    for (const std::uint32_t o : copies) {
+      if (o != c && expected.size() < k) expected.push_back(o);
+    }
+    EXPECT_EQ(std::vector<std::uint32_t>(nb.begin() + std::size_t(c) * k,
+                                         nb.begin() + std::size_t(c) * k + k),
+              expected)
+        << "copy " << c;
+  }
+}
+
 TEST(MortonOrder, IsAPermutation) {
   ThreadPool pool(2);
   for (std::size_t n : {std::size_t{0}, std::size_t{1}, std::size_t{1000}, std::size_t{150'000}}) {

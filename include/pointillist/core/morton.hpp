@@ -30,6 +30,26 @@ constexpr std::uint64_t morton_code(std::uint32_t a, std::uint32_t b, std::uint3
   return spread_bits_21(a) | spread_bits_21(b) << 1 | spread_bits_21(c) << 2;
 }
 
+// The grid of morton_order: 2^21 cubic cells a side over the bounding box of the finite points
+// (one scale for all axes). cell() is a coordinate's cell; NaN and values outside the box are
+// clamped to it.
+struct MortonFrame {
+  static constexpr int kBits = 21;
+  static constexpr std::uint32_t kMaxCell = (1u << kBits) - 1;
+  Vec3f lo;
+  float scale = 0;  // cells per unit of length
+  static MortonFrame of(std::span<const Vec3f> points);
+  std::uint32_t cell(float v, float lo_v) const {
+    const float c = (v - lo_v) * scale;
+    if (!(c >= 0.0f)) return 0;
+    if (!(c < static_cast<float>(kMaxCell))) return kMaxCell;
+    return static_cast<std::uint32_t>(c);
+  }
+  std::uint64_t code(Vec3f p) const {
+    return morton_code(cell(p.x, lo.x), cell(p.y, lo.y), cell(p.z, lo.z));
+  }
+};
+
 // Permutation that sorts points along a Morton (Z-order) curve over their bounding box (21 bits
 // per axis, one scale for all three axes, x in the lowest bit): entry j is the index of the j-th
 // point along the curve. Points in the same cell keep their index order; non-finite coordinates

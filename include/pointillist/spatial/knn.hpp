@@ -1,4 +1,5 @@
-// k-nearest-neighbour queries over a point set (nanoflann kd-tree).
+// k-nearest-neighbour queries over a point set (a grid of Morton cells, a nanoflann kd-tree for
+// what the grid cannot answer).
 #pragma once
 
 #include <cstdint>
@@ -27,12 +28,14 @@ struct KnnOptions {
 // or the point itself when n == 1. `squared_distances`, when not null, receives the matching
 // squared Euclidean distances (n*k entries).
 // Equal distances: of several equidistant points at the k-th place, those with the lowest
-// positions (x, then y, then z) make the cut (up to 9 tied there; more are cut as the kd-tree
-// finds them), so the same neighbours are found in any subset of the points that holds them;
-// within a row, equal distances are ordered by index. Copies of a point (distance 0) are
-// neighbours like any other point. Parallel over points (progress phase "neighbours"); the result
-// does not depend on the thread count. Positions must be finite. Memory: the result plus about
-// 40 bytes per point while the kd-tree lives.
+// positions (x, then y, then z) make the cut, so the same neighbours are found in any subset of
+// the points that holds them; within a row, equal distances are ordered by index. (Queries are
+// answered from a grid of cells over the ordered points; a query whose k nearest could reach
+// beyond its cell's 3x3x3 block, a stray point in a sparse region, goes to a kd-tree, which
+// finds up to 9 points tied at the cut and cuts more as it finds them.) Copies of a point
+// (distance 0) are neighbours like any other point. Parallel over points (progress phase
+// "neighbours"); the result does not depend on the thread count. Positions must be finite.
+// Memory: the result plus about 30 bytes per point for the grid (40 more while a kd-tree lives).
 std::vector<std::uint32_t> k_nearest_neighbours(std::span<const Vec3f> points, ThreadPool& pool,
                                                 const KnnOptions& options,
                                                 std::vector<float>* squared_distances = nullptr,
