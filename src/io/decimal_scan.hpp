@@ -67,25 +67,30 @@ const char* scan_integer(const char* p, const char* end, std::int64_t& out, Ends
   return p;
 }
 
-// Normalizes in place; a zero or non-finite normal becomes (0, 0, 1). When no normal is usable
-// the file had none in substance, and the array is dropped.
-inline void finish_normals(std::vector<Vec3f>& normals) {
+// Unit normals as finish_normals leaves them, a window of a streamed file at a time: a zero or
+// non-finite normal becomes (0, 0, 1). Returns whether any was usable. (The readers drop the
+// normals of a file where none is usable; a streamed file's caller asks
+// PointStream::saw_usable_normals() after its first pass for the same rule.)
+inline bool normalize_normals_window(std::vector<Vec3f>& normals) {
   bool any = false;
   for (Vec3f& n : normals) {
     const float length2 = dot(n, n);
-    // Already unit (what most writers store): nothing to do, and no square root.
     if (length2 > 0.99999f && length2 < 1.00001f) {
       any = true;
-      continue;
-    }
-    if (length2 > 0.0f && std::isfinite(length2)) {
+    } else if (length2 > 0.0f && std::isfinite(length2)) {
       n = n / std::sqrt(length2);
       any = true;
     } else {
       n = {0, 0, 1};
     }
   }
-  if (!any) {
+  return any;
+}
+
+// Normalizes in place; a zero or non-finite normal becomes (0, 0, 1). When no normal is usable
+// the file had none in substance, and the array is dropped.
+inline void finish_normals(std::vector<Vec3f>& normals) {
+  if (!normalize_normals_window(normals)) {
     normals.clear();
     normals.shrink_to_fit();
   }

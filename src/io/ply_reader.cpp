@@ -405,24 +405,6 @@ namespace {
 
 using namespace ply;
 
-// Unit normals as finish_normals leaves them, a window at a time: a zero or non-finite normal
-// becomes (0, 0, 1). (read_ply drops the normals of a file where none is usable; the chunked
-// conversion asks saw_usable_normals() after its first pass for the same rule.)
-bool normalize_window(std::vector<Vec3f>& normals) {
-  bool any = false;
-  for (Vec3f& n : normals) {
-    const float length2 = dot(n, n);
-    if (length2 > 0.99999f && length2 < 1.00001f) {
-      any = true;
-    } else if (length2 > 0.0f && std::isfinite(length2)) {
-      n = n / std::sqrt(length2);
-      any = true;
-    } else {
-      n = {0, 0, 1};
-    }
-  }
-  return any;
-}
 
 class PlyStream final : public PointStream {
  public:
@@ -467,7 +449,7 @@ class PlyStream final : public PointStream {
     ctx_.index_total = info_.point_count;
     std::vector<Triangle> none;
     decode_binary_body(ctx_, none);
-    if (vp_.normals && normalize_window(batch.normals)) usable_normals_ = true;
+    if (vp_.normals && normalize_normals_window(batch.normals)) usable_normals_ = true;
     next_ += n;
     return n;
   }

@@ -23,6 +23,12 @@ std::unique_ptr<PointStream> open_ply_stream(const std::string& path,
 std::unique_ptr<PointStream> open_las_stream(const std::string& path,
                                              const PointReadOptions& options);
 
+// A text point file (XYZ, PTS, CSV, TXT; gzip too), read a window of lines at a time after one
+// pass over all of them at open (the point count, and the values' statistics that read_xyz uses
+// to tell normals from colours and a colour scale). Throws what read_xyz throws.
+std::unique_ptr<PointStream> open_xyz_stream(const std::string& path,
+                                             const PointReadOptions& options);
+
 // The point count a LAS file's header states (checked as read_las checks it: every record must
 // be in the file); nothing for a gzip file. Throws what read_las throws for a bad header.
 std::optional<std::uint64_t> las_header_point_count(const std::string& path);

@@ -5,6 +5,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <sstream>
 
@@ -117,9 +118,9 @@ ConvertResult convert(std::span<const std::string> inputs, const std::string& ou
   if (to_v2 && (o.chunk_points != 0 || over || ranks)) {
     const std::uint64_t chunk_points =
         o.chunk_points ? o.chunk_points
-                       : std::max<std::uint64_t>(budget / chunking::kChunkBytesPerPoint /
-                                                     pool.thread_count(),
-                                                 1024);
+                       : std::clamp<std::uint64_t>(budget / chunking::kChunkBytesPerPoint /
+                                                       pool.thread_count(),
+                                                   1024, chunking::kMaxChunkPoints);
     return chunking::convert_chunked(inputs, output, o, metadata_head(inputs, o), chunk_points,
                                      pool, progress);
   }

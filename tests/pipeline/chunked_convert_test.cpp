@@ -56,6 +56,15 @@ Converted convert_both(const TempDir& dir, const std::string& input,
   return c;
 }
 
+// Nodes of the chunked conversion's hierarchy that differ from the one-piece one's (same count).
+std::size_t differing_nodes(const Converted& c) {
+  std::size_t differing = 0;
+  for (std::size_t i = 0; i < c.whole.nodes.size(); ++i) {
+    differing += std::memcmp(&c.whole.nodes[i], &c.parts.nodes[i], sizeof(SphereNode)) != 0;
+  }
+  return differing;
+}
+
 TEST(ChunkedConvert, ManySmallChunksGiveTheOnePieceHierarchy) {
   TempDir dir;
   const std::string input = write_cloud(dir, 60000, "scene.ply");
@@ -110,12 +119,30 @@ TEST(ChunkedConvert, APlanOnDiskGivesTheOnePieceHierarchy) {
   const Converted c = convert_both(dir, input, {.memory_budget = 100000, .chunk_points = 2000});
   EXPECT_GE(c.parts_result.chunks, 8u);
   ASSERT_EQ(c.parts.nodes.size(), c.whole.nodes.size());
-  std::size_t differing = 0;
-  for (std::size_t i = 0; i < c.whole.nodes.size(); ++i) {
-    differing += std::memcmp(&c.whole.nodes[i], &c.parts.nodes[i], sizeof(SphereNode)) != 0;
-  }
-  EXPECT_EQ(differing, 0u);
+  EXPECT_EQ(differing_nodes(c), 0u);
   EXPECT_FALSE(std::filesystem::exists(dir.file("parts.ptl.chunks")));
+}
+
+// A text file (gzip, georeferenced coordinates, colours) is streamed in chunks: the same
+// hierarchy as the conversion in one piece.
+TEST(ChunkedConvert, AGzipTextFileGivesTheOnePieceHierarchy) {
+  TempDir dir;
+  const PointSet p = sample_scene(demo_scene(), 20000, 5).points;
+  std::string text = "// X Y Z R G B\n";
+  char line[160];
+  for (const Vec3f& x : p.positions) {
+    std::snprintf(line, sizeof line, "%.4f %.4f %.4f %d %d %d\n", 651000.0 + x.x * 10,
+                  5400000.0 + x.y * 10, 100.0 + x.z * 10, int(128 + 60 * x.x),
+                  int(128 + 60 * x.y), int(128 + 60 * x.z));
+    text += line;
+  }
+  const std::string input = dir.file("scan.xyz.gz");
+  testing::write_file(input, testing::gzip(text));
+  const Converted c = convert_both(dir, input, {.chunk_points = 1500});
+  EXPECT_GE(c.parts_result.chunks, 8u);
+  ASSERT_EQ(c.parts.nodes.size(), c.whole.nodes.size());
+  EXPECT_EQ(differing_nodes(c), 0u);
+  EXPECT_TRUE(c.parts.has_colors);
 }
 
 // Two georeferenced LAS tiles of one survey, side by side, one without colours: merged by the

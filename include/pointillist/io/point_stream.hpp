@@ -25,7 +25,7 @@ struct PointStreamInfo {
   // chunked conversion takes point clouds only.
   bool is_mesh = false;
   // Read in windows of the file, so memory does not grow with the file. False: the reader has
-  // no streaming form for this file (text, OBJ, ASCII PLY and compressed files are read whole
+  // no streaming form for this file (OBJ, ASCII PLY, gzip PLY and gzip LAS files are read whole
   // when the stream opens) and `resident_bytes` says what it holds.
   bool streamed = true;
   std::uint64_t resident_bytes = 0;
@@ -59,9 +59,11 @@ class PointStream {
 };
 
 // Opens `path` as read_point_file would read it (the reader chosen by the extension). Binary
-// PLY (a vertex element of fixed-size records) and LAS are streamed; LAS runs one pass over the
-// records at open to find the origin and colour scale read_las uses. Other files are read whole
-// at open (info().streamed false). Throws what read_point_file throws for a bad file, and
+// PLY (a vertex element of fixed-size records), LAS and text files (XYZ, PTS, CSV, TXT, gzip
+// too) are streamed; LAS and text run one pass over the file at open (LAS: the origin and
+// colour scale read_las uses; text: the point count, and the statistics that tell normals from
+// colours when the columns leave it open). Other files are read whole at open
+// (info().streamed false). Throws what read_point_file throws for a bad file, and
 // IoError for a missing one.
 std::unique_ptr<PointStream> open_point_stream(const std::string& path,
                                                const PointReadOptions& options = {});

@@ -34,7 +34,8 @@ struct ConvertOptions {
   // fit; other outputs and meshes that do not fit are refused before any work.
   std::uint64_t memory_budget = 0;
   // Force the chunked conversion (.ptl v2) with chunks of at most this many points (rounded down
-  // to the hierarchy's levels); 0: only when the budget asks for it.
+  // to the hierarchy's levels); 0: only when the budget asks for it, in chunks of what the
+  // budget holds on each thread, at most 2 M points.
   std::uint64_t chunk_points = 0;
   // The processes sharing a chunked conversion (chunk_jobs.hpp): null for this process alone.
   // With more than one, a .ptl v2 output is always converted in chunks (the same file bytes as
