@@ -75,9 +75,19 @@ struct ChunkPlan {
   }
 };
 
-// The plan with `levels` binary levels over `positions` (input order = index order). Chunk
-// members: `members` (when not null) gets each chunk's input indices, increasing. Parallel; the
-// same plan for any thread count.
+// A point of the plan: its position and input index.
+struct PlanPoint {
+  Vec3f position;
+  std::uint32_t index;
+};
+
+// The plan with `levels` binary levels over `points` (each with its input index; their order
+// does not matter), which it reorders: the selections move the points themselves, so they read
+// memory in order. Chunk members: `members` (when not null) gets each chunk's input indices,
+// increasing. Parallel; the same plan for any thread count.
+ChunkPlan plan_chunks(std::vector<PlanPoint> points, std::uint32_t levels, ThreadPool& pool,
+                      std::vector<std::vector<std::uint32_t>>* members = nullptr);
+// The same over `positions` in input order.
 ChunkPlan plan_chunks(std::span<const Vec3f> positions, std::uint32_t levels, ThreadPool& pool,
                       std::vector<std::vector<std::uint32_t>>* members = nullptr);
 

@@ -230,7 +230,7 @@ void scan_plan_distribute(MergedInputs& in, const WorkFolder& folder, const Conv
   }
 
   // 1. Positions, their box and centroid.
-  std::vector<Vec3f> positions;
+  std::vector<PlanPoint> positions;
   std::optional<ChunkFiles> position_file;
   if (plan_on_disk) {
     position_file.emplace(folder, 1, "positions", std::size_t{1} << 22);
@@ -248,12 +248,12 @@ void scan_plan_distribute(MergedInputs& in, const WorkFolder& folder, const Conv
           throw Error(sh.input_name + ": vertex " + std::to_string(seen) +
                       " has a non-finite position; remove it from the file");
         }
-        ++seen;
         if (plan_on_disk) {
           position_file->append(0, &p, sizeof p);
         } else {
-          positions.push_back(p);
+          positions.push_back({p, static_cast<std::uint32_t>(seen)});
         }
+        ++seen;
         box.extend(p);
         sum[0] += p.x;
         sum[1] += p.y;
@@ -277,11 +277,11 @@ void scan_plan_distribute(MergedInputs& in, const WorkFolder& folder, const Conv
       sh.plan = plan_chunks_on_disk(path, n, box, levels, candidates, pool, progress);
       std::filesystem::remove(path);
     } else {
-      sh.plan = plan_chunks(positions, levels, pool);
+      sh.plan = plan_chunks(std::move(positions), levels, pool);
       phase.advance(n);
     }
   }
-  std::vector<Vec3f>().swap(positions);
+  std::vector<PlanPoint>().swap(positions);
   const ChunkPlan& plan = sh.plan;
   const std::size_t chunks = plan.chunk_count();
   // Halo reach: a multiple of the chunk's point spacing (its box's two largest extents over its
