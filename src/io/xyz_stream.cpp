@@ -28,27 +28,35 @@ constexpr std::size_t kPreambleBytes = std::size_t{16} << 20;
 // A file read from the start in windows of whole lines (zlib reads plain files as they are).
 class LineWindow {
  public:
-  explicit LineWindow(const std::string& path) : path_(path) {
-    file_ = gzopen(path.c_str(), "rb");
-    if (!file_) {
-      throw IoError(path + ": cannot open for reading: " + std::strerror(errno) +
-                    " (check the path and its permissions)");
-    }
-    gzbuffer(file_, 1 << 20);
+  explicit LineWindow(const std::string& path) : path_(path) { open(); }
+  ~LineWindow() {
+    if (file_) gzclose(file_);
   }
-  ~LineWindow() { gzclose(file_); }
   LineWindow(const LineWindow&) = delete;
   LineWindow& operator=(const LineWindow&) = delete;
 
   void rewind() {
+    if (!file_) open();
     if (gzrewind(file_) != 0) fail("cannot rewind");
     begin_ = end_ = 0;
     eof_ = false;
     lines_before_ = 0;
   }
+  // Closes the file and frees the window until the next rewind (many inputs may be open at
+  // once; each holds memory and a file only while it is read).
+  void release() {
+    done_when_released_ = bytes_done();
+    if (file_) gzclose(file_);
+    file_ = nullptr;
+    std::vector<char>().swap(buffer_);
+    begin_ = end_ = 0;
+    eof_ = true;
+  }
   // The next line [start, end) without its '\n', false at the end of the file. The pointers
   // hold until the next call.
   bool next_line(const char*& start, const char*& end) {
+    if (!file_) return false;  // released
+    if (buffer_.empty()) refill();
     for (;;) {
       const char* p = buffer_.data() + begin_;
       const char* stop = buffer_.data() + end_;
@@ -68,6 +76,7 @@ class LineWindow {
   std::size_t lines_before() const { return lines_before_; }
   // Compressed bytes consumed (the file's bytes for a plain file).
   std::uint64_t bytes_done() const {
+    if (!file_) return done_when_released_;
     const z_off_t at = gzoffset(file_);
     return at < 0 ? 0 : std::uint64_t(at);
   }
@@ -87,13 +96,21 @@ class LineWindow {
   }
 
  private:
+  void open() {
+    file_ = gzopen(path_.c_str(), "rb");
+    if (!file_) {
+      throw IoError(path_ + ": cannot open for reading: " + std::strerror(errno) +
+                    " (check the path and its permissions)");
+    }
+    gzbuffer(file_, 1 << 20);
+  }
   // Moves the unread bytes to the front and reads more after them.
   void refill() {
+    if (buffer_.size() < kTextWindowBytes) buffer_.resize(kTextWindowBytes);
     lines_before_ += std::size_t(std::count(buffer_.data(), buffer_.data() + begin_, '\n'));
-    std::memmove(buffer_.data(), buffer_.data() + begin_, end_ - begin_);
+    if (end_ > begin_) std::memmove(buffer_.data(), buffer_.data() + begin_, end_ - begin_);
     end_ -= begin_;
     begin_ = 0;
-    if (buffer_.size() < kTextWindowBytes) buffer_.resize(kTextWindowBytes);
     if (end_ == buffer_.size()) {
       throw FormatError(path_ + ": line " + std::to_string(lines_before_ + 1) +
                         ": longer than " + std::to_string(kTextWindowBytes >> 20) +
@@ -118,6 +135,7 @@ class LineWindow {
   std::size_t begin_ = 0, end_ = 0;
   bool eof_ = false;
   std::size_t lines_before_ = 0;  // lines before buffer_[0]
+  std::uint64_t done_when_released_ = 0;
 };
 
 class XyzStream final : public PointStream {
@@ -177,7 +195,8 @@ class XyzStream final : public PointStream {
     info_.origin = origin_;
     info_.comments.push_back("columns: " + columns_text(pre_.layout, pre_.first_count) +
                              " (from " + pre_.layout_source + ")");
-    start_body();
+    window_.release();
+    pending_start_ = true;
   }
 
   std::size_t read(PointSet& batch, std::size_t max) override {
@@ -187,6 +206,8 @@ class XyzStream final : public PointStream {
     batch.radii.clear();
     batch.triangles.clear();
     batch.comments.clear();
+    if (pending_start_) start_body();
+    pending_start_ = false;
     GroupStats unused[2];
     const char* t;
     const char* le;
@@ -210,10 +231,11 @@ class XyzStream final : public PointStream {
       ++n;
     }
     if (normalize_normals_window(batch.normals)) usable_normals_ = true;
+    if (n < max) window_.release();  // the end: free the window until a rewind
     return n;
   }
-  void rewind() override { start_body(); }
-  std::uint64_t bytes_done() const override { return window_.bytes_done(); }
+  void rewind() override { pending_start_ = true; }
+  std::uint64_t bytes_done() const override { return pending_start_ ? 0 : window_.bytes_done(); }
   bool saw_usable_normals() const override { return usable_normals_; }
 
  private:
@@ -256,6 +278,7 @@ class XyzStream final : public PointStream {
   Group kind_[2] = {Group::None, Group::None};
   ply::ColorScale scale_[2] = {ply::ColorScale::Byte, ply::ColorScale::Byte};
   bool usable_normals_ = false;
+  bool pending_start_ = true;  // the window goes to the first point line at the next read
   const char* window_data_ = nullptr;
   std::size_t window_size_ = 0, window_lines_ = 0;
 };
