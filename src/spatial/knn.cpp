@@ -105,8 +105,9 @@ struct CellGrid {
   std::vector<std::uint32_t> table;     // open addressing: cell index + 1, or 0
   std::uint64_t mask = 0;
 
+  std::uint64_t slot(std::uint64_t k) const { return (k * 0x9E3779B97F4A7C15ULL) >> 20 & mask; }
   std::uint32_t find(std::uint64_t k) const {  // cell index + 1, or 0
-    for (std::uint64_t h = (k * 0x9E3779B97F4A7C15ULL) >> 20 & mask;; h = (h + 1) & mask) {
+    for (std::uint64_t h = slot(k);; h = (h + 1) & mask) {
       const std::uint32_t c = table[h];
       if (c == 0 || key[c - 1] == k) return c;
     }
@@ -150,22 +151,11 @@ bool build_grid(std::span<const Vec3f> points, CellGrid& g) {
   g.mask = capacity - 1;
   g.table.assign(capacity, 0);
   for (std::size_t c = 0; c < g.key.size(); ++c) {
-    std::uint64_t h = (g.key[c] * 0x9E3779B97F4A7C15ULL) >> 20 & g.mask;
+    std::uint64_t h = g.slot(g.key[c]);
     while (g.table[h] != 0) h = (h + 1) & g.mask;
     g.table[h] = std::uint32_t(c + 1);
   }
   return true;
-}
-
-// Decodes the three coordinates interleaved in a Morton code (inverse of morton_code).
-std::uint32_t compact_bits_21(std::uint64_t v) {
-  v &= 0x1249249249249249ULL;
-  v = (v | (v >> 2)) & 0x10c30c30c30c30c3ULL;
-  v = (v | (v >> 4)) & 0x100f00f00f00f00fULL;
-  v = (v | (v >> 8)) & 0x1f0000ff0000ffULL;
-  v = (v | (v >> 16)) & 0x1f00000000ffffULL;
-  v = (v | (v >> 32)) & 0x1fffffULL;
-  return std::uint32_t(v);
 }
 
 // Answers the queries of cells [cell_begin, cell_end) from their blocks; queries whose answer

@@ -24,11 +24,23 @@ constexpr std::uint64_t spread_bits_21(std::uint64_t v) {
   return v;
 }
 
+// The inverse of spread_bits_21: the bits of v at every third place, from the lowest.
+constexpr std::uint32_t compact_bits_21(std::uint64_t v) {
+  v &= 0x1249249249249249ULL;
+  v = (v | (v >> 2)) & 0x10c30c30c30c30c3ULL;
+  v = (v | (v >> 4)) & 0x100f00f00f00f00fULL;
+  v = (v | (v >> 8)) & 0x1f0000ff0000ffULL;
+  v = (v | (v >> 16)) & 0x1f00000000ffffULL;
+  v = (v | (v >> 32)) & 0x1fffffULL;
+  return static_cast<std::uint32_t>(v);
+}
+
 // The 63-bit Morton code of cell (a, b, c), 21 bits each: a takes the lowest bit of every
 // triple, c the highest. Which axis goes where is the caller's convention.
 constexpr std::uint64_t morton_code(std::uint32_t a, std::uint32_t b, std::uint32_t c) {
   return spread_bits_21(a) | spread_bits_21(b) << 1 | spread_bits_21(c) << 2;
 }
+static_assert(compact_bits_21(morton_code(5, 9, 1u << 20) >> 1) == 9);
 
 // The grid of morton_order: 2^21 cubic cells a side over the bounding box of the finite points
 // (one scale for all axes). cell() is a coordinate's cell; NaN and values outside the box are
