@@ -46,6 +46,21 @@ constexpr auto kNearest6 = nearest_channel_table<6>();
 
 }  // namespace
 
+namespace {
+
+// How far (parent units) the search's lattice estimate of a candidate's centre distance can be
+// from the distance of its decoded float centre: each coordinate, centre + radius * offset with
+// |offset| <= 1, rounds twice (at most one float epsilon of |centre| + radius in all), and the
+// double arithmetic adds about 1e-15. Generous by a factor of 4, plus 1e-6.
+double estimate_margin(const Sphere& parent) {
+  const double c = std::max({std::fabs(double(parent.center.x)), std::fabs(double(parent.center.y)),
+                             std::fabs(double(parent.center.z))});
+  return 1e-6 + 4 * std::sqrt(3.0) * std::numeric_limits<float>::epsilon() *
+                    (c / parent.radius + 1);
+}
+
+}  // namespace
+
 bool encloses(const Sphere& outer, const Sphere& inner) {
   return std::sqrt(distance_squared(outer.center, inner.center)) + double(inner.radius) <=
          double(outer.radius);
@@ -55,13 +70,17 @@ namespace {
 
 // The search of encode_enclosing_sphere and encode_enclosing_leaf: for each cube size m from
 // the smallest that can hold `target`, every code whose decoded sphere holds `target` and lies
-// inside `parent` is offered to `offer(code, decoded, m)`, which returns false to stop. Only
+// inside `parent` is offered to `offer(code, decoded, m, squared distance of the centres)`,
+// which returns false to stop; so
+// does `go_on(m, radius)` before each size (radius m/13 in parent units, double). Within
+// one size the cell nearest the target comes first, then the others in code order, so offers
+// keep the least (value, code) explicitly. Only
 // centres within `max_distance()` of the target's (parent units; asked at each size) are
 // considered, and codes for which `wanted(distance, radius)` (the candidate's centre distance
 // to the target's and its radius, parent units, double) is false are skipped undecoded.
-template <class MaxDistance, class Wanted, class Offer>
-void search_enclosing(const Sphere& parent, const Sphere& target, MaxDistance&& max_distance,
-                      Wanted&& wanted, Offer&& offer) {
+template <class GoOn, class MaxDistance, class Wanted, class Offer>
+void search_enclosing(const Sphere& parent, const Sphere& target, GoOn&& go_on,
+                      MaxDistance&& max_distance, Wanted&& wanted, Offer&& offer) {
   const double rho = parent.radius;
   // Target in parent units; a candidate of size m has radius R = m/13 and centre coordinates
   // X = (m + 2x)/13 - 1 (spec §4.1). It can only qualify when every |X - t| <= R - s (encloses)
@@ -74,6 +93,7 @@ void search_enclosing(const Sphere& parent, const Sphere& target, MaxDistance&& 
   const int m_first = std::clamp(int(std::floor(kSphereGrid * s)), 1, kSphereGrid);
   for (int m = m_first; m <= kSphereGrid; ++m) {
     const double radius = double(m) / kSphereGrid;
+    if (!go_on(m, radius)) return;
     const double reach = std::min(radius - s, max_distance()) + kSlack;
     const double room = 1 - radius + kSlack;
     if (reach < 0) continue;
@@ -87,21 +107,38 @@ void search_enclosing(const Sphere& parent, const Sphere& target, MaxDistance&& 
       empty = x_lo > x_hi || lo[a] > hi[a];
     }
     if (empty) continue;
+    constexpr double kCell = 1.0 / kSphereGrid;
     const auto offset = [&](int a, int cell) {  // candidate centre minus target, axis a
-      return (m + 2.0 * cell) / kSphereGrid - 1 - t[a];
+      return (m + 2.0 * cell) * kCell - 1 - t[a];
     };
+    const auto visit = [&](int x, int y, int z, double ex, double ey, double ez) {
+      if (!wanted(std::sqrt(ex * ex + ey * ey + ez * ez), radius)) return true;
+      const int code = qs_detail::sphere_code(m, x, y, z);
+      if (code < 0) return true;
+      const Sphere d = qs_detail::decode_sphere(parent, std::uint32_t(code));
+      // encloses(d, target), keeping the squared centre distance for `offer`
+      const double dist2 = distance_squared(d.center, target.center);
+      if (!(std::sqrt(dist2) + double(target.radius) <= double(d.radius))) return true;
+      if (!encloses(parent, d)) return true;
+      return offer(std::uint32_t(code), d, m, dist2);
+    };
+    // The cell nearest the target first: it is usually the answer, and the bounds it sets let
+    // `wanted` skip most of the box undecoded.
+    int near[3];
+    for (int a = 0; a < 3; ++a) {
+      near[a] = std::clamp(int(std::lround((kSphereGrid * (t[a] + 1) - m) / 2)), lo[a], hi[a]);
+    }
+    if (!visit(near[0], near[1], near[2], offset(0, near[0]), offset(1, near[1]),
+               offset(2, near[2]))) {
+      return;
+    }
     for (int x = lo[0]; x <= hi[0]; ++x) {
       const double ex = offset(0, x);
       for (int y = lo[1]; y <= hi[1]; ++y) {
         const double ey = offset(1, y);
         for (int z = lo[2]; z <= hi[2]; ++z) {
-          const double ez = offset(2, z);
-          if (!wanted(std::sqrt(ex * ex + ey * ey + ez * ez), radius)) continue;
-          const int code = qs_detail::sphere_code(m, x, y, z);
-          if (code < 0) continue;
-          const Sphere d = qs_detail::decode_sphere(parent, std::uint32_t(code));
-          if (!encloses(d, target) || !encloses(parent, d)) continue;
-          if (!offer(std::uint32_t(code), d, m)) return;
+          if (x == near[0] && y == near[1] && z == near[2]) continue;
+          if (!visit(x, y, z, ex, ey, offset(2, z))) return;
         }
       }
     }
@@ -119,12 +156,20 @@ std::uint32_t encode_enclosing_sphere(const Sphere& parent, const Sphere& target
   // the lower code, the order of the search).
   int best = -1, best_m = 0;
   double best_distance = std::numeric_limits<double>::infinity();
-  const auto any = [](double, double) { return true; };
-  const auto unlimited = [] { return std::numeric_limits<double>::infinity(); };
-  search_enclosing(parent, target, unlimited, any, [&](std::uint32_t code, const Sphere& d, int m) {
+  // Once a code qualifies, only centres about as near as its can still win: the lattice
+  // distance in double differs from the decoded floats' by their rounding (parent units).
+  const double margin = estimate_margin(parent);
+  double near_enough = std::numeric_limits<double>::infinity();
+  const auto nearer = [&](double distance, double) { return distance <= near_enough; };
+  const auto go_on = [&](int m, double) { return best < 0 || m <= best_m; };
+  const auto reach = [&] { return near_enough; };
+  search_enclosing(parent, target, go_on, reach, nearer, [&](std::uint32_t code, const Sphere&,
+                                                             int m, double dist) {
     if (best >= 0 && m > best_m) return false;
-    const double dist = distance_squared(d.center, target.center);
-    if (dist < best_distance) best = int(code), best_m = m, best_distance = dist;
+    if (dist < best_distance || (dist == best_distance && int(code) < best)) {
+      best = int(code), best_m = m, best_distance = dist;
+      near_enough = std::sqrt(dist) / parent.radius + margin;
+    }
     return true;
   });
   if (best >= 0) {
@@ -136,17 +181,19 @@ std::uint32_t encode_enclosing_sphere(const Sphere& parent, const Sphere& target
 }
 
 LeafCode encode_enclosing_leaf(const Sphere& parent, const Sphere& target, LeafTrim mode) {
-  const auto trimmed = [&](std::uint32_t code, const Sphere& d) {
-    // The largest trim whose sphere around the decoded centre still holds the target.
+  // The largest trim whose sphere around the decoded centre still holds the target (encloses,
+  // with the squared centre distance computed once).
+  const auto trimmed = [&](std::uint32_t code, const Sphere& d, double dist2) {
+    const double need = std::sqrt(dist2) + double(target.radius);
     std::uint32_t t = 0;
     while (t < max_leaf_trim(mode) &&
-           encloses({d.center, trimmed_leaf_radius(d.radius, t + 1, mode)}, target)) {
+           need <= double(trimmed_leaf_radius(d.radius, t + 1, mode))) {
       ++t;
     }
     return LeafCode{code, t, trimmed_leaf_radius(d.radius, t, mode), true};
   };
   if (!(parent.radius > 0) || !std::isfinite(parent.radius)) {
-    LeafCode c = trimmed(kParentCode, parent);
+    LeafCode c = trimmed(kParentCode, parent, distance_squared(parent.center, target.center));
     c.exact = encloses(parent, target);
     return c;
   }
@@ -168,14 +215,20 @@ LeafCode encode_enclosing_leaf(const Sphere& parent, const Sphere& target, LeafT
   };
   // The target's centre lies within best - s of any code that could draw it at best or less.
   const auto within = [&] { return double(best.radius) / parent.radius * (1 + 1e-5) - s; };
-  search_enclosing(parent, target, within, promising, [&](std::uint32_t code, const Sphere& d, int) {
+  // A size whose most trimmed radius is clearly above the best cannot win, nor can larger ones.
+  const auto go_on = [&](int, double radius) {
+    return radius * most_trimmed * parent.radius <= double(best.radius) * (1 + 1e-5);
+  };
+  search_enclosing(parent, target, go_on, within, promising, [&](std::uint32_t code,
+                                                                 const Sphere& d, int,
+                                                                 double dist2) {
     if (d.radius * most_trimmed > best.radius) return false;
-    const LeafCode c = trimmed(code, d);
-    if (c.radius < best.radius) best = c;
+    const LeafCode c = trimmed(code, d, dist2);
+    if (c.radius < best.radius || (c.radius == best.radius && c.code < best.code)) best = c;
     return true;
   });
   if (best.exact) return best;
-  LeafCode c = trimmed(kParentCode, parent);
+  LeafCode c = trimmed(kParentCode, parent, distance_squared(parent.center, target.center));
   c.exact = encloses(parent, target);
   return c;
 }

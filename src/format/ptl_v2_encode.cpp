@@ -131,99 +131,140 @@ std::uint32_t encode_cone(const SphereNode& node, std::uint32_t axis_code,
   return cone;
 }
 
+namespace {
+
+// Where each level of a breadth-first tree starts, and n at the end.
+std::vector<std::size_t> level_starts(std::span<const SphereNode> nodes) {
+  std::vector<std::size_t> starts;
+  for (std::size_t begin = 0, end = 1; begin < nodes.size();) {
+    starts.push_back(begin);
+    std::size_t next_end = end;  // the next level ends after the last child of this one
+    for (std::size_t i = end; i-- > begin;) {
+      if (nodes[i].child_count > 0) {
+        next_end = nodes[i].first_child + nodes[i].child_count;
+        break;
+      }
+    }
+    begin = end;
+    end = next_end;
+  }
+  starts.push_back(nodes.size());
+  return starts;
+}
+
+// fn(chunk, begin, end) over fixed chunks of [begin, end) on the pool: chunk boundaries depend
+// only on the range, so per-chunk sums added in chunk order are the same for any thread count.
+constexpr std::size_t kEncodeChunk = 4096;
+template <class Fn>
+void for_chunks(ThreadPool& pool, std::size_t begin, std::size_t end, Fn&& fn) {
+  const std::size_t chunks = (end - begin + kEncodeChunk - 1) / kEncodeChunk;
+  if (chunks == 1) return fn(0, begin, end);
+  pool.run(chunks, [&](std::size_t c) {
+    const std::size_t first = begin + c * kEncodeChunk;
+    fn(c, first, std::min(end, first + kEncodeChunk));
+  });
+}
+
+}  // namespace
+
 EncodedTree encode_tree(std::span<const SphereNode> nodes, std::span<const std::uint32_t> parent,
                         const Sphere* root_parent, const Sphere* root_decoded,
                         quant::LeafTrim mode, bool colors, ThreadPool& pool, EncodeStats& stats) {
   const std::size_t n = nodes.size();
   EncodedTree out;
+  // Level by level (breadth-first order keeps each level contiguous): a node depends only on
+  // its children (bottom-up passes) or its parent (top-down), so each level runs in parallel.
+  const std::vector<std::size_t> levels = level_starts(nodes);
+  const std::size_t level_count = levels.size() - 1;
+  std::vector<EncodeStats> chunk_stats;
+  const auto each_level = [&](bool bottom_up, auto&& fn) {
+    for (std::size_t l = 0; l < level_count; ++l) {
+      const std::size_t k = bottom_up ? level_count - 1 - l : l;
+      chunk_stats.assign((levels[k + 1] - levels[k] + kEncodeChunk - 1) / kEncodeChunk, {});
+      for_chunks(pool, levels[k], levels[k + 1], fn);
+      for (const EncodeStats& c : chunk_stats) {
+        stats.leaf_ratio_sum += c.leaf_ratio_sum;
+        stats.leaf_ratio_count += c.leaf_ratio_count;
+        stats.parent_fallbacks += c.parent_fallbacks;
+        stats.spheres_enlarged += c.spheres_enlarged;
+        for (int q = 0; q < 4; ++q) stats.cone_codes[q] += c.cone_codes[q];
+      }
+    }
+  };
+
   // Targets: the tree's spheres, enlarged bottom-up where a child sticks out (in double, rounded
   // up), so each parent's decoded sphere, which encloses its target, can enclose its children's.
   std::vector<Sphere> target(n);
-  for (std::size_t i = 0; i < n; ++i) target[i] = {nodes[i].center, nodes[i].radius};
-  for (std::size_t i = n; i-- > 0;) {
-    double need = 0;
-    for (std::uint32_t k = 0; k < nodes[i].child_count; ++k) {
-      const Sphere& c = target[nodes[i].first_child + k];
-      const double dx = double(c.center.x) - target[i].center.x;
-      const double dy = double(c.center.y) - target[i].center.y;
-      const double dz = double(c.center.z) - target[i].center.z;
-      need = std::max(need, std::sqrt(dx * dx + dy * dy + dz * dz) + double(c.radius));
+  each_level(true, [&](std::size_t c, std::size_t first, std::size_t last) {
+    for (std::size_t i = first; i < last; ++i) {
+      target[i] = {nodes[i].center, nodes[i].radius};
+      double need = 0;
+      for (std::uint32_t k = 0; k < nodes[i].child_count; ++k) {
+        const Sphere& ch = target[nodes[i].first_child + k];
+        const double dx = double(ch.center.x) - target[i].center.x;
+        const double dy = double(ch.center.y) - target[i].center.y;
+        const double dz = double(ch.center.z) - target[i].center.z;
+        need = std::max(need, std::sqrt(dx * dx + dy * dy + dz * dz) + double(ch.radius));
+      }
+      if (need > double(target[i].radius)) {
+        target[i].radius = round_up(need);
+        ++chunk_stats[c].spheres_enlarged;
+      }
     }
-    if (need > double(target[i].radius)) {
-      target[i].radius = round_up(need);
-      ++stats.spheres_enlarged;
-    }
-  }
+  });
 
   // Spheres, top-down against the decoded parents. Children touch their parent's true sphere
   // from inside (it is the smallest one around them), so a decoded parent without room to spare
   // leaves them only its own sphere. Interior nodes therefore aim at their target grown by
   // kInteriorMargin (when some code allows it), which lets their children find tight codes;
-  // leaves, drawn at their decoded size, aim at their own. Level by level (breadth-first order
-  // keeps each level contiguous): a node depends only on its decoded parent, so a level's nodes
-  // are encoded in parallel, in fixed chunks whose statistics are summed in order (the same file
-  // and report for any thread count).
+  // leaves, drawn at their decoded size, aim at their own.
   out.root_parent = root_parent        ? *root_parent
                     : nodes[0].child_count > 0 ? grown(target[0])
                                              : target[0];
   out.decoded.resize(n);
-  out.record.assign(n, 0);
-  constexpr std::size_t kChunk = 4096;
-  std::vector<EncodeStats> chunk_stats;
-  for (std::size_t begin = 0, end = 1; begin < n;) {
-    std::size_t next_end = end;  // the next level ends after the last child of this one
-    for (std::size_t i = begin; i < end; ++i) {
-      if (nodes[i].child_count > 0) next_end = nodes[i].first_child + nodes[i].child_count;
-    }
-    const std::size_t chunks = (end - begin + kChunk - 1) / kChunk;
-    chunk_stats.assign(chunks, {});
-    pool.run(chunks, [&](std::size_t c) {
-      const std::size_t first = begin + c * kChunk, last = std::min(end, first + kChunk);
-      for (std::size_t i = first; i < last; ++i) {
-        if (i == 0 && root_decoded) {
-          out.decoded[0] = *root_decoded;
-          continue;
-        }
-        const Sphere& p = i == 0 ? out.root_parent : out.decoded[parent[i]];
-        EncodeStats& st = chunk_stats[c];
-        const std::uint64_t fallbacks = st.parent_fallbacks;
-        const SphereCode code = encode_sphere(p, target[i], nodes[i].child_count, mode, st);
-        if (i == 0) st.parent_fallbacks = fallbacks;  // the root's parent is no node's
-        out.decoded[i] = code.decoded;
-        out.record[i] = code.bits;
+  out.record.resize(n);
+  each_level(false, [&](std::size_t c, std::size_t first, std::size_t last) {
+    for (std::size_t i = first; i < last; ++i) {
+      if (i == 0 && root_decoded) {
+        out.decoded[0] = *root_decoded;
+        out.record[0] = 0;
+        continue;
       }
-    });
-    for (const EncodeStats& c : chunk_stats) {
-      stats.leaf_ratio_sum += c.leaf_ratio_sum;
-      stats.leaf_ratio_count += c.leaf_ratio_count;
-      stats.parent_fallbacks += c.parent_fallbacks;
+      const Sphere& p = i == 0 ? out.root_parent : out.decoded[parent[i]];
+      EncodeStats& st = chunk_stats[c];
+      const std::uint64_t fallbacks = st.parent_fallbacks;
+      const SphereCode code = encode_sphere(p, target[i], nodes[i].child_count, mode, st);
+      if (i == 0) st.parent_fallbacks = fallbacks;  // the root's parent is no node's
+      out.decoded[i] = code.decoded;
+      out.record[i] = code.bits;
     }
-    begin = end;
-    end = next_end;
-  }
+  });
 
-  // Normals, then cones bottom-up around the decoded normals: each holds the true cone and the
-  // decoded cones (leaves: decoded normals) of the children.
+  // Normals and colours, then cones bottom-up around the decoded normals: each holds the true
+  // cone and the decoded cones (leaves: decoded normals) of the children.
   out.normal_code.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    out.normal_code[i] = encode_normal_nearest(normalized(nodes[i].normal));
-    out.record[i] |= std::uint64_t{out.normal_code[i]} << kNormalShift;
-  }
-  out.cone_angle.assign(n, 0.0);
-  for (std::size_t i = n; i-- > 0;) {
-    const SphereNode& nd = nodes[i];
-    if (nd.child_count == 0) continue;
-    const std::uint32_t cone = encode_cone(
-        nd, out.normal_code[i], {&out.normal_code[nd.first_child], nd.child_count},
-        {&out.cone_angle[nd.first_child], nd.child_count}, out.cone_angle[i]);
-    ++stats.cone_codes[cone];
-    out.record[i] |= std::uint64_t{cone} << kConeShift;
-  }
-  if (colors) {
-    for (std::size_t i = 0; i < n; ++i) {
-      out.record[i] |= std::uint64_t{encode_rgb565_nearest(nodes[i].color)} << kColorShift;
+  out.cone_angle.resize(n);
+  for_chunks(pool, 0, n, [&](std::size_t, std::size_t first, std::size_t last) {
+    for (std::size_t i = first; i < last; ++i) {
+      out.normal_code[i] = encode_normal_nearest(normalized(nodes[i].normal));
+      out.record[i] |= std::uint64_t{out.normal_code[i]} << kNormalShift;
+      if (colors) {
+        out.record[i] |= std::uint64_t{encode_rgb565_nearest(nodes[i].color)} << kColorShift;
+      }
     }
-  }
+  });
+  each_level(true, [&](std::size_t c, std::size_t first, std::size_t last) {
+    for (std::size_t i = first; i < last; ++i) {
+      const SphereNode& nd = nodes[i];
+      out.cone_angle[i] = 0.0;
+      if (nd.child_count == 0) continue;
+      const std::uint32_t cone = encode_cone(
+          nd, out.normal_code[i], {&out.normal_code[nd.first_child], nd.child_count},
+          {&out.cone_angle[nd.first_child], nd.child_count}, out.cone_angle[i]);
+      ++chunk_stats[c].cone_codes[cone];
+      out.record[i] |= std::uint64_t{cone} << kConeShift;
+    }
+  });
   return out;
 }
 
