@@ -66,8 +66,9 @@ int run_convert(const ConvertCommandOptions& o) {
       std::string line = "phases:";
       for (std::size_t i = 0; i < r.phase_seconds.size(); ++i) {
         char part[64];
-        std::snprintf(part, sizeof part, "%s %s %.1f s", i ? "," : "",
-                      r.phase_seconds[i].first.c_str(), r.phase_seconds[i].second);
+        const double t = r.phase_seconds[i].second;
+        std::snprintf(part, sizeof part, t < 10 ? "%s %s %.2f s" : "%s %s %.1f s", i ? "," : "",
+                      r.phase_seconds[i].first.c_str(), t);
         line += part;
       }
       std::printf("%s\n", line.c_str());

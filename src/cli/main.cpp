@@ -11,6 +11,7 @@
 
 #include "commands.hpp"
 #include "options.hpp"
+#include "util.hpp"
 #include "pointillist/core/atomic_file.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/pipeline/chunk_jobs.hpp"
@@ -18,6 +19,7 @@
 namespace pc = pointillist::cli;
 
 int main(int argc, char** argv) {
+  pc::use_huge_pages(argv);
   pointillist::remove_temporary_files_on_signals();
   CLI::App app{"Pointillist: multiresolution splat models from 3D scans, rendered fast on the CPU"};
   app.require_subcommand(1);

@@ -1,12 +1,42 @@
 #include "util.hpp"
 
 #include <malloc.h>
+#include <unistd.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <limits>
+#include <string>
+#include <string_view>
 
 namespace pointillist::cli {
+
+void use_huge_pages(char** argv) {
+#if defined(__linux__) && defined(__GLIBC__) && (__GLIBC__ > 2 || __GLIBC_MINOR__ >= 35)
+  const char* opt_out = std::getenv("POINTILLIST_HUGE_PAGES");
+  if (opt_out && std::string_view(opt_out) == "0") return;
+  const char* tunables = std::getenv("GLIBC_TUNABLES");
+  const std::string given = tunables ? tunables : "";
+  if (given.find("glibc.malloc.hugetlb") != std::string::npos) return;
+  std::ifstream mode_file("/sys/kernel/mm/transparent_hugepage/enabled");
+  std::string mode;
+  std::getline(mode_file, mode);
+  if (mode.find("[madvise]") == std::string::npos) return;
+  const std::string wanted = (given.empty() ? "" : given + ":") + "glibc.malloc.hugetlb=1";
+  if (::setenv("GLIBC_TUNABLES", wanted.c_str(), 1) != 0) return;
+  ::execv("/proc/self/exe", argv);
+  // Not started again: run as we are, without the tunable in the environment of children.
+  if (tunables) {
+    ::setenv("GLIBC_TUNABLES", tunables, 1);
+  } else {
+    ::unsetenv("GLIBC_TUNABLES");
+  }
+#else
+  (void)argv;
+#endif
+}
 
 void keep_freed_memory() {
   ::mallopt(M_MMAP_MAX, 0);

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <sstream>
 
@@ -25,6 +26,10 @@
 
 namespace pointillist {
 namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
 
 bool ends_with(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() &&
@@ -133,8 +138,11 @@ ConvertResult convert(std::span<const std::string> inputs, const std::string& ou
   }
   if (ranks && o.jobs->rank() != 0) return {};  // rank 0 converts other outputs alone
   std::vector<std::string> warnings;
+  const auto start = std::chrono::steady_clock::now();
   PointSet points = merge_inputs(inputs, pool, progress, {.columns = o.columns}, &warnings);
+  const double read_seconds = seconds_since(start);
   ConvertResult result = convert_points(std::move(points), inputs, output, o, pool, progress);
+  result.phase_seconds.insert(result.phase_seconds.begin(), {"read", read_seconds});
   warnings.insert(warnings.end(), result.warnings.begin(), result.warnings.end());
   result.warnings = std::move(warnings);
   return result;
@@ -148,10 +156,16 @@ ConvertResult convert_points(PointSet points, std::span<const std::string> input
   const bool to_qs = ends_with(output, ".qs");
   ConvertResult result;
   result.input_points = points.size();
+  auto phase_start = std::chrono::steady_clock::now();
+  const auto phase_done = [&](const char* name) {
+    result.phase_seconds.emplace_back(name, seconds_since(phase_start));
+    phase_start = std::chrono::steady_clock::now();
+  };
   // A mesh goes to write_qs as read: like qsplat_make, it computes normals and radii from the
   // faces itself (that is what makes the file byte-identical to the original tool's).
   if (!(to_qs && points.is_mesh())) {
     prepare_splats(points, pool, progress, o.prepare);
+    phase_done("prepare");
   } else if (o.prepare.normals != NormalSource::Auto || o.prepare.radius_scale != 1.0f ||
              o.prepare.k != PrepareOptions{}.k || o.prepare.drop_outliers) {
     result.warnings.push_back(
@@ -164,18 +178,22 @@ ConvertResult convert_points(PointSet points, std::span<const std::string> input
   if (to_qs) {
     ProgressPhase phase(progress, "write", 0);
     write_qs(output, points, {.write_colors = points.has_colors()});
+    phase_done("write");
   } else if (to_ptl) {
     const SphereTree tree = build_sphere_tree(points, pool, progress);
+    phase_done("hierarchy");
     std::ostringstream meta;
     meta << metadata_head(inputs, o);
     for (const auto& c : points.comments) meta << "comment: " << c << "\n";
     ProgressPhase phase(progress, "write", 0);
     if (o.ptl_version == 1) {
       write_ptl(output, tree, meta.str());
+      phase_done("write");
     } else {
       PtlV2WriteOptions v2;
       if (o.leaf_trim) v2.leaf_trim = *o.leaf_trim;
       write_ptl_v2(output, tree, meta.str(), v2, pool);
+      phase_done("write");
       if (o.features) {
         // Features of the splats as the file stores them (quantized centres and normals,
         // enlarged radii), which is what the renderer draws: found on the written file's
@@ -188,12 +206,14 @@ ConvertResult convert_points(PointSet points, std::span<const std::string> input
              << " surfaces\n";
         v2.features = &features;
         write_ptl_v2(output, tree, meta.str(), v2, pool);
+        phase_done("features");
       }
     }
   } else {
     ProgressPhase phase(progress, "write", 0);
     write_ply(output, points,
               {.encoding = o.ascii ? PlyEncoding::Ascii : PlyEncoding::BinaryLittleEndian});
+    phase_done("write");
   }
   return result;
 }

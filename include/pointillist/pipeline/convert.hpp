@@ -52,7 +52,8 @@ struct ConvertResult {
   std::vector<std::string> warnings;
   std::size_t chunks = 0;           // chunks of a chunked conversion (0: in one piece)
   std::uint64_t halo_points = 0;    // points copied into other chunks' halos
-  // Wall time of each phase of a chunked conversion, in order (rank 0's view under MPI).
+  // Wall time of each phase, in order (chunked: rank 0's view under MPI; in one piece: read,
+  // prepare, hierarchy, write, features).
   std::vector<std::pair<std::string, double>> phase_seconds;
 };
 
