@@ -15,6 +15,10 @@ namespace pointillist::cli {
 
 void use_huge_pages(char** argv) {
 #if defined(__linux__) && defined(__GLIBC__) && (__GLIBC__ > 2 || __GLIBC_MINOR__ >= 35)
+  // Only the batch commands gain (rendering measured the same); the others start once.
+  if (!argv[0] || !argv[1]) return;
+  const std::string_view command = argv[1];
+  if (command != "convert" && command != "generate") return;
   const char* opt_out = std::getenv("POINTILLIST_HUGE_PAGES");
   if (opt_out && std::string_view(opt_out) == "0") return;
   const char* tunables = std::getenv("GLIBC_TUNABLES");

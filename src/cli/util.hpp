@@ -23,8 +23,9 @@ std::string input_names(std::span<const std::string> inputs, bool file_names = f
 // the same peak). The peak resident memory is unchanged; it is simply not given back early.
 void keep_freed_memory();
 
-// Memory in 2 MB pages where the system offers them on request (transparent huge pages in
-// "madvise" mode, glibc 2.35 or later): glibc's allocator only asks for them when started with
+// For `convert` and `generate` (argv[1]): memory in 2 MB pages where the system offers them on
+// request (transparent huge pages in "madvise" mode, glibc 2.35 or later): glibc's allocator
+// only asks for them when started with
 // GLIBC_TUNABLES=glibc.malloc.hugetlb=1, so the process starts itself again once with that
 // added (same arguments, same process id). A fresh 2 MB page costs a fraction of 512 fresh
 // 4 KB pages to fault in, and the TLB covers more: the dragon converts in half the wall time.

@@ -77,7 +77,8 @@ namespace {
 // keep the least (value, code) explicitly. Only
 // centres within `max_distance()` of the target's (parent units; asked at each size) are
 // considered, and codes for which `wanted(distance, radius)` (the candidate's centre distance
-// to the target's and its radius, parent units, double) is false are skipped undecoded.
+// to the target's and its radius, parent units, double) is false are skipped undecoded;
+// `wanted` must turn down every larger distance once it turns one down.
 template <class GoOn, class MaxDistance, class Wanted, class Offer>
 void search_enclosing(const Sphere& parent, const Sphere& target, GoOn&& go_on,
                       MaxDistance&& max_distance, Wanted&& wanted, Offer&& offer) {
@@ -128,10 +129,10 @@ void search_enclosing(const Sphere& parent, const Sphere& target, GoOn&& go_on,
     for (int a = 0; a < 3; ++a) {
       near[a] = std::clamp(int(std::lround((kSphereGrid * (t[a] + 1) - m) / 2)), lo[a], hi[a]);
     }
-    if (!visit(near[0], near[1], near[2], offset(0, near[0]), offset(1, near[1]),
-               offset(2, near[2]))) {
-      return;
-    }
+    const double nx = offset(0, near[0]), ny = offset(1, near[1]), nz = offset(2, near[2]);
+    // No cell of the box is nearer, so when `wanted` turns it down it turns them all down.
+    if (!wanted(std::sqrt(nx * nx + ny * ny + nz * nz), radius)) continue;
+    if (!visit(near[0], near[1], near[2], nx, ny, nz)) return;
     for (int x = lo[0]; x <= hi[0]; ++x) {
       const double ex = offset(0, x);
       for (int y = lo[1]; y <= hi[1]; ++y) {

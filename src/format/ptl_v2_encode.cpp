@@ -240,6 +240,8 @@ EncodedTree encode_tree(std::span<const SphereNode> nodes, std::span<const std::
     }
   });
 
+  target = {};  // its memory serves the arrays below
+
   // Normals and colours, then cones bottom-up around the decoded normals: each holds the true
   // cone and the decoded cones (leaves: decoded normals) of the children.
   out.normal_code.resize(n);

@@ -121,3 +121,22 @@ TEST(ViewCli, BadModelAndMissingDisplayEndWithAMessage) {
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_THAT(r.output, HasSubstr("s.ply:1: unknown event"));
 }
+
+// The window lives in a library loaded by `view` only: a program copied away from it still
+// converts, and its `view` says which library it looked for and where, instead of crashing.
+TEST(ViewCli, AProgramWithoutItsWindowLibraryConvertsAndSaysWhyItCannotView) {
+  pointillist::testing::TempDir dir;
+  const std::string copy = dir.file("pointillist");
+  auto r = run_shell("cp " + std::string(POINTILLIST_CLI_PATH) + " " + copy);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = run_shell(copy + " generate --scene sphere --points 2000 --quiet -o " + dir.file("s.ply"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = run_shell(copy + " convert " + dir.file("s.ply") + " -o " + dir.file("s.ptl") + " --quiet");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = run_shell("env DISPLAY=:99 ASAN_OPTIONS=detect_leaks=0 " + copy + " view " +
+                dir.file("s.ptl") + " --quiet");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("pointillist-sdl-window.so"));
+  EXPECT_THAT(r.output, HasSubstr(dir.path().string()));
+  EXPECT_THAT(r.output, HasSubstr("cmake --install"));
+}

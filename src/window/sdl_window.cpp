@@ -1,3 +1,7 @@
+// The viewer's SDL 2 window, built as its own shared library (pointillist-sdl-window.so) that
+// `pointillist view` loads at run time (viewer/window_loader.cpp): the other commands then start
+// without SDL and the ~55 desktop libraries it pulls in. Only the C entry point at the end is
+// looked up by name; errors cross back as text, never as exceptions.
 #include "pointillist/viewer/sdl_window.hpp"
 
 #include <SDL.h>
@@ -206,8 +210,16 @@ class SdlWindow final : public Window {
 
 }  // namespace
 
-std::unique_ptr<Window> open_sdl_window(const std::string& title, int width, int height) {
-  return std::make_unique<SdlWindow>(title, width, height);
-}
-
 }  // namespace pointillist
+
+extern "C" __attribute__((visibility("default"))) pointillist::Window*
+pointillist_open_sdl_window(const char* title, int width, int height, std::string* error) {
+  try {
+    return new pointillist::SdlWindow(title, width, height);
+  } catch (const std::exception& e) {
+    *error = e.what();
+  } catch (...) {
+    *error = "cannot open a window (unknown error)";
+  }
+  return nullptr;
+}
