@@ -26,6 +26,7 @@ int run_convert(const ConvertCommandOptions& o) {
   ThreadPool pool(o.threads);
   ConvertOptions options = o.convert;
   options.jobs = mpi_job();
+  options.prefault = true;  // freed memory is kept (above)
   // Under mpirun, rank 0 speaks for the job.
   const bool lead = options.jobs == nullptr || options.jobs->rank() == 0;
   const bool quiet = o.quiet || !lead;

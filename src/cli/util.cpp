@@ -44,7 +44,7 @@ void use_huge_pages(char** argv) {
 
 void keep_freed_memory() {
   ::mallopt(M_MMAP_MAX, 0);
-  ::mallopt(M_TRIM_THRESHOLD, std::numeric_limits<int>::max());
+  ::mallopt(M_TRIM_THRESHOLD, -1);  // never trim (INT_MAX still trimmed a free top over 2 GB)
 }
 
 std::string human_bytes(double bytes) {

@@ -92,6 +92,8 @@ void search_enclosing(const Sphere& parent, const Sphere& target, GoOn&& go_on,
   const double s = double(target.radius) / rho;
   constexpr double kSlack = 1e-6;  // widens the box a little; the exact test decides
   const int m_first = std::clamp(int(std::floor(kSphereGrid * s)), 1, kSphereGrid);
+  const std::int16_t* const codes = qs_detail::sphere_code_table().data();
+  const qs_detail::SphereCandidate* const table = qs_detail::sphere_table().data();
   for (int m = m_first; m <= kSphereGrid; ++m) {
     const double radius = double(m) / kSphereGrid;
     if (!go_on(m, radius)) return;
@@ -114,9 +116,10 @@ void search_enclosing(const Sphere& parent, const Sphere& target, GoOn&& go_on,
     };
     const auto visit = [&](int x, int y, int z, double ex, double ey, double ez) {
       if (!wanted(std::sqrt(ex * ex + ey * ey + ez * ez), radius)) return true;
-      const int code = qs_detail::sphere_code(m, x, y, z);
+      // x, y, z lie in the box, within 0..13 - m: sphere_code without its range checks
+      const int code = codes[((m * kSphereGrid + x) * kSphereGrid + y) * kSphereGrid + z];
       if (code < 0) return true;
-      const Sphere d = qs_detail::decode_sphere(parent, std::uint32_t(code));
+      const Sphere d = qs_detail::decode_sphere(parent, table[code]);
       // encloses(d, target), keeping the squared centre distance for `offer`
       const double dist2 = distance_squared(d.center, target.center);
       if (!(std::sqrt(dist2) + double(target.radius) <= double(d.radius))) return true;
@@ -127,7 +130,9 @@ void search_enclosing(const Sphere& parent, const Sphere& target, GoOn&& go_on,
     // `wanted` skip most of the box undecoded.
     int near[3];
     for (int a = 0; a < 3; ++a) {
-      near[a] = std::clamp(int(std::lround((kSphereGrid * (t[a] + 1) - m) / 2)), lo[a], hi[a]);
+      // (either of two equally near cells will do)
+      near[a] = std::clamp(int(std::floor((kSphereGrid * (t[a] + 1) - m) * 0.5 + 0.5)), lo[a],
+                           hi[a]);
     }
     const double nx = offset(0, near[0]), ny = offset(1, near[1]), nz = offset(2, near[2]);
     // No cell of the box is nearer, so when `wanted` turns it down it turns them all down.

@@ -169,6 +169,11 @@ std::unique_ptr<PointStream> open_point_stream(const std::string& path,
   return std::make_unique<WholeFileStream>(path, read_point_file(path, Progress::none(), options));
 }
 
+bool point_count_is_exact(const std::string& path) {
+  const Kind kind = kind_of(path);
+  return kind == Kind::Ply || kind == Kind::Las;
+}
+
 std::uint64_t point_count_estimate(const std::string& path) {
   if (!std::filesystem::exists(path)) {
     throw IoError(path + ": no such file; check the path (models fetched by "

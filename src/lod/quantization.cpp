@@ -102,6 +102,8 @@ int normal_cell(float t) {
 
 }  // namespace
 
+std::span<const std::int16_t> sphere_code_table() { return sphere_tables().code; }
+
 std::span<const SphereCandidate, kSphereCodeCount> sphere_table() {
   return sphere_tables().entries;
 }

@@ -73,5 +73,8 @@ std::unique_ptr<PointStream> open_point_stream(const std::string& path,
 // at least 6 bytes; a gzip file is taken to inflate 16 times). Throws what open_point_stream
 // throws for a bad PLY or LAS header, IoError for a missing file.
 std::uint64_t point_count_estimate(const std::string& path);
+// Whether point_count_estimate is the file's exact count (PLY and LAS give it in their headers;
+// for text and OBJ it is a bound from the file size).
+bool point_count_is_exact(const std::string& path);
 
 }  // namespace pointillist

@@ -35,6 +35,9 @@ std::span<const SphereCandidate, kSphereCodeCount> sphere_table();
 // Code of the cube of m cells with low cell (x, y, z), or -1 when that cube is not in the table
 // (out of range or skipped).
 int sphere_code(int m, int x, int y, int z);
+// sphere_code's table for searches that look up many codes: entry ((m * 13 + x) * 13 + y) * 13
+// + z for m in 1..13 and x, y, z in 0..13 - m (-1 where the cube is skipped).
+std::span<const std::int16_t> sphere_code_table();
 
 // Decoded sphere of candidate `s` relative to the decoded parent sphere (spec §4.2): float32,
 // each component multiplied then added, so every reader and writer of a format built on these

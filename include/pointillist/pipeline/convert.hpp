@@ -42,6 +42,9 @@ struct ConvertOptions {
   // one process converting with the same options in chunks) and only rank 0 writes it; other
   // outputs are converted by rank 0 alone.
   ChunkJobs* jobs = nullptr;
+  // In one piece, touch most of the memory the conversion will need on every thread before
+  // reading (prefault_heap, core/heap.hpp): for processes that keep freed memory (the CLI).
+  bool prefault = false;
 };
 
 struct ConvertResult {
