@@ -194,20 +194,23 @@ EncodedTree encode_tree(std::span<const SphereNode> nodes, std::span<const std::
 
   // Targets: the tree's spheres, enlarged bottom-up where a child sticks out (in double, rounded
   // up), so each parent's decoded sphere, which encloses its target, can enclose its children's.
-  std::vector<Sphere> target(n);
+  // Only radii change: a target's centre is its node's.
+  std::vector<float> target_radius(n);
+  const auto target = [&](std::size_t i) { return Sphere{nodes[i].center, target_radius[i]}; };
   each_level(true, [&](std::size_t c, std::size_t first, std::size_t last) {
     for (std::size_t i = first; i < last; ++i) {
-      target[i] = {nodes[i].center, nodes[i].radius};
+      const Vec3f centre = nodes[i].center;
+      target_radius[i] = nodes[i].radius;
       double need = 0;
       for (std::uint32_t k = 0; k < nodes[i].child_count; ++k) {
-        const Sphere& ch = target[nodes[i].first_child + k];
-        const double dx = double(ch.center.x) - target[i].center.x;
-        const double dy = double(ch.center.y) - target[i].center.y;
-        const double dz = double(ch.center.z) - target[i].center.z;
-        need = std::max(need, std::sqrt(dx * dx + dy * dy + dz * dz) + double(ch.radius));
+        const std::size_t ch = nodes[i].first_child + k;
+        const double dx = double(nodes[ch].center.x) - centre.x;
+        const double dy = double(nodes[ch].center.y) - centre.y;
+        const double dz = double(nodes[ch].center.z) - centre.z;
+        need = std::max(need, std::sqrt(dx * dx + dy * dy + dz * dz) + double(target_radius[ch]));
       }
-      if (need > double(target[i].radius)) {
-        target[i].radius = round_up(need);
+      if (need > double(target_radius[i])) {
+        target_radius[i] = round_up(need);
         ++chunk_stats[c].spheres_enlarged;
       }
     }
@@ -219,8 +222,8 @@ EncodedTree encode_tree(std::span<const SphereNode> nodes, std::span<const std::
   // kInteriorMargin (when some code allows it), which lets their children find tight codes;
   // leaves, drawn at their decoded size, aim at their own.
   out.root_parent = root_parent        ? *root_parent
-                    : nodes[0].child_count > 0 ? grown(target[0])
-                                             : target[0];
+                    : nodes[0].child_count > 0 ? grown(target(0))
+                                             : target(0);
   out.decoded.resize(n);
   out.record.resize(n);
   each_level(false, [&](std::size_t c, std::size_t first, std::size_t last) {
@@ -233,14 +236,14 @@ EncodedTree encode_tree(std::span<const SphereNode> nodes, std::span<const std::
       const Sphere& p = i == 0 ? out.root_parent : out.decoded[parent[i]];
       EncodeStats& st = chunk_stats[c];
       const std::uint64_t fallbacks = st.parent_fallbacks;
-      const SphereCode code = encode_sphere(p, target[i], nodes[i].child_count, mode, st);
+      const SphereCode code = encode_sphere(p, target(i), nodes[i].child_count, mode, st);
       if (i == 0) st.parent_fallbacks = fallbacks;  // the root's parent is no node's
       out.decoded[i] = code.decoded;
       out.record[i] = code.bits;
     }
   });
 
-  target = {};  // its memory serves the arrays below
+  target_radius = {};  // its memory serves the arrays below
 
   // Normals and colours, then cones bottom-up around the decoded normals: each holds the true
   // cone and the decoded cones (leaves: decoded normals) of the children.
