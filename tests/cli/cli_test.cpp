@@ -268,3 +268,26 @@ TEST(Cli, ChunkCullingSkipsChunksInACloseUpWithoutChangingTheImage) {
   EXPECT_THAT(on.output, ::testing::Not(HasSubstr("\"chunks_culled\": 0,")));
   EXPECT_EQ(read_png_rgb8(dir.file("on.png")).pixels, read_png_rgb8(dir.file("off.png")).pixels);
 }
+
+// convert restarts itself once with glibc's huge-page tunable (cli/util.hpp use_huge_pages): the
+// restart may not lose an argument or change a byte. The reference is the same conversion with
+// no restart (the opt-out, and the tunable given as off).
+TEST(Cli, MemoryTuningChangesNoByteOfTheOutput) {
+  pointillist::testing::TempDir dir;
+  Result r = pointillist::testing::run_cli("generate --scene demo --points 30000 --quiet -o " +
+                                           dir.file("in.ply"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = pointillist::testing::run_cli("convert " + dir.file("in.ply") + " -o " +
+                                    dir.file("tuned.ptl") + " --quiet");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = pointillist::testing::run_shell(
+      "env POINTILLIST_HUGE_PAGES=0 GLIBC_TUNABLES=glibc.malloc.hugetlb=0 " +
+      std::string(POINTILLIST_CLI_PATH) + " convert " + dir.file("in.ply") + " -o " +
+      dir.file("plain.ptl") + " --quiet");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream a(dir.file("tuned.ptl"), std::ios::binary), b(dir.file("plain.ptl"), std::ios::binary);
+  const std::string tuned{std::istreambuf_iterator<char>(a), {}};
+  const std::string plain{std::istreambuf_iterator<char>(b), {}};
+  ASSERT_GT(tuned.size(), 1000u);
+  EXPECT_TRUE(tuned == plain) << "the tuned conversion wrote different bytes";
+}
