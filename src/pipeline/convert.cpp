@@ -140,7 +140,9 @@ ConvertResult convert(std::span<const std::string> inputs, const std::string& ou
   if (ranks && o.jobs->rank() != 0) return {};  // rank 0 converts other outputs alone
   std::vector<std::string> warnings;
   const auto start = std::chrono::steady_clock::now();
-  if (o.prefault) {
+  // Measured for model outputs (a .ply output needs little beyond what reading fills).
+  const bool prefault = o.prefault && (ends_with(output, ".ptl") || ends_with(output, ".qs"));
+  if (prefault) {
     // Reading fills arrays about the size of an uncompressed binary input (PLY or LAS): touch
     // that much first, so that it is not faulted in on the one reading thread.
     std::uint64_t bytes = 0;
@@ -152,7 +154,7 @@ ConvertResult convert(std::span<const std::string> inputs, const std::string& ou
   }
   PointSet points = merge_inputs(inputs, pool, progress, {.columns = o.columns}, &warnings);
   const double read_seconds = seconds_since(start);
-  if (o.prefault) {
+  if (prefault) {
     // What the hierarchy and the encoder will need beyond the points just read, below every
     // measured in-one-piece peak (141-171 bytes a point in all, of which reading holds 36-50),
     // counted only for inputs whose headers give the count. Touched after reading, when the
@@ -166,7 +168,7 @@ ConvertResult convert(std::span<const std::string> inputs, const std::string& ou
   }
   const double memory_seconds = seconds_since(start) - read_seconds;
   ConvertResult result = convert_points(std::move(points), inputs, output, o, pool, progress);
-  if (o.prefault) {
+  if (prefault) {
     result.phase_seconds.insert(result.phase_seconds.begin(), {"memory", memory_seconds});
   }
   result.phase_seconds.insert(result.phase_seconds.begin(), {"read", read_seconds});
