@@ -418,14 +418,28 @@ class LasStream final : public PointStream {
 
 }  // namespace
 
+// The size LasFile checks the header against: the file's, or for gzip data (whose length is
+// known only at its end) no bound, a short file failing when its records are read.
+std::uint64_t data_size(const FileWindow& file) {
+  return file.compressed() ? std::numeric_limits<std::uint64_t>::max() - 1 : file.size();
+}
+
+// A gzip file's records against what its data can hold (parse_header checked a plain file's).
+void check_records_fit(const FileWindow& file, const LasHeader& h) {
+  file.check_holds(h.point_offset + h.point_count * h.record_length,
+                   std::to_string(h.point_count) + " points of " +
+                       std::to_string(h.record_length) + " bytes from byte " +
+                       std::to_string(h.point_offset));
+}
+
 std::unique_ptr<PointStream> open_las_stream(const std::string& path,
                                              const PointReadOptions& options) {
   auto file = std::make_unique<FileWindow>(path);
   std::vector<char> prefix;
-  file->read(0, static_cast<std::size_t>(std::min<std::uint64_t>(file->size(), 1 << 16)), prefix);
-  if (has_gzip_magic({prefix.data(), prefix.size()})) return nullptr;
+  file->read_some(0, 1 << 16, prefix);  // decompressed for a gzip file
   const std::string_view head(prefix.data(), prefix.size());
-  const LasHeader h = LasFile(path, head, false, file->size()).parse_header();
+  const LasHeader h = LasFile(path, head, file->compressed(), data_size(*file)).parse_header();
+  check_records_fit(*file, h);
 
   // The first pass: the statistics read_las finds, a window at a time.
   const std::size_t stride = h.record_length;
@@ -463,7 +477,8 @@ std::unique_ptr<PointStream> open_las_stream(const std::string& path,
   info.path = path;
   info.point_count = h.point_count;
   info.has_colors = frame.rgb >= 0;
-  info.file_size = file->size();
+  // Progress counts decompressed bytes of a gzip file, up to the last record.
+  info.file_size = file->compressed() ? h.point_offset + h.point_count * stride : file->size();
   info.origin = frame.origin;
   info.up = {0, 0, 1};
   info.comments = las_comments(h);
@@ -475,9 +490,12 @@ std::unique_ptr<PointStream> open_las_stream(const std::string& path,
 std::optional<std::uint64_t> las_header_point_count(const std::string& path) {
   FileWindow file(path);
   std::vector<char> prefix;
-  file.read(0, static_cast<std::size_t>(std::min<std::uint64_t>(file.size(), 1 << 16)), prefix);
-  if (has_gzip_magic({prefix.data(), prefix.size()})) return std::nullopt;
-  return LasFile(path, {prefix.data(), prefix.size()}, false, file.size()).parse_header().point_count;
+  file.read_some(0, 1 << 16, prefix);
+  const LasHeader h =
+      LasFile(path, {prefix.data(), prefix.size()}, file.compressed(), data_size(file))
+          .parse_header();
+  check_records_fit(file, h);
+  return h.point_count;
 }
 
 }  // namespace io_detail

@@ -480,35 +480,39 @@ std::unique_ptr<PointStream> open_ply_stream(const std::string& path,
   constexpr std::size_t kMaxHeaderBytes = 16 << 20;
   std::vector<char> prefix;
   for (std::size_t want = 1 << 16;; want *= 4) {
-    file->read(0, static_cast<std::size_t>(std::min<std::uint64_t>(file->size(), want)), prefix);
+    file->read_some(0, want, prefix);  // decompressed for a gzip file
     const std::string_view head(prefix.data(), prefix.size());
-    if (has_gzip_magic(head)) return nullptr;
-    if (has_header_end(head) || prefix.size() == file->size() || want >= kMaxHeaderBytes) break;
+    if (has_header_end(head) || prefix.size() < want || want >= kMaxHeaderBytes) break;
   }
   PlyProgress progress(Progress::none(), 1);
   const PlyReadOptions read_options{.read_colors = options.read_colors, .pool = options.pool};
   PlyRead read(path, read_options, progress);
-  read.prepare({prefix.data(), prefix.size()}, false);
+  read.prepare({prefix.data(), prefix.size()}, file->compressed());
   const Header& header = read.header;
   if (header.format == Format::Ascii) return nullptr;
+  // offset + the bytes of `e`, refused when a header's count makes it overflow
+  const auto past = [&](std::uint64_t offset, const Element& e) {
+    const std::uint64_t stride = std::max<std::uint64_t>(1, e.fixed_size());
+    if (e.count > (std::numeric_limits<std::uint64_t>::max() - offset) / stride) {
+      throw FormatError(path + ": element " + e.name + " has " + std::to_string(e.count) +
+                        " records of " + std::to_string(stride) +
+                        " bytes, more than any file holds; the header is wrong");
+    }
+    return offset + e.count * e.fixed_size();
+  };
   std::uint64_t offset = header.body_offset;
   std::size_t vertex = 0;
   for (; header.elements[vertex].name != "vertex"; ++vertex) {
     const Element& e = header.elements[vertex];
     if (e.has_lists()) return nullptr;  // where the vertices start depends on the lists
-    offset += e.count * e.fixed_size();
+    offset = past(offset, e);
   }
   const Element& element = header.elements[vertex];
   if (element.has_lists()) return nullptr;
-  const std::uint64_t need = offset + element.count * element.fixed_size();
-  if (need > file->size()) {
-    throw FormatError(path + ": byte " + std::to_string(file->size()) + ": file ends early: " +
-                      std::to_string(element.count) + " vertices of " +
-                      std::to_string(element.fixed_size()) + " bytes from byte " +
-                      std::to_string(offset) + " need " + std::to_string(need) +
-                      " bytes, the file has " + std::to_string(file->size()) +
-                      "; the file is truncated");
-  }
+  const std::uint64_t need = past(offset, element);
+  file->check_holds(need, std::to_string(element.count) + " vertices of " +
+                              std::to_string(element.fixed_size()) + " bytes from byte " +
+                              std::to_string(offset));
   PointStreamInfo info;
   info.path = path;
   info.point_count = element.count;
@@ -519,7 +523,8 @@ std::unique_ptr<PointStream> open_ply_stream(const std::string& path,
     if (read.ctx.plans[e].kind == ElementPlan::Kind::Face && header.elements[e].count > 0)
       info.is_mesh = true;
   }
-  info.file_size = file->size();
+  // Progress counts decompressed bytes of a gzip file, up to the last vertex.
+  info.file_size = file->compressed() ? need : file->size();
   take_header_comments(header, info.comments, info.origin, info.up);
   auto stream = std::make_unique<PlyStream>(std::move(file), header, vertex, read.ctx.plans[vertex],
                                             offset, read.vertex_plan(), options.pool);

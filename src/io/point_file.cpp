@@ -169,9 +169,13 @@ std::unique_ptr<PointStream> open_point_stream(const std::string& path,
   return std::make_unique<WholeFileStream>(path, read_point_file(path, Progress::none(), options));
 }
 
-bool point_count_is_exact(const std::string& path) {
+std::optional<std::uint64_t> exact_point_count(const std::string& path) {
   const Kind kind = kind_of(path);
-  return kind == Kind::Ply || kind == Kind::Las;
+  if (kind == Kind::Ply) {
+    if (const auto stream = io_detail::open_ply_stream(path, {})) return stream->info().point_count;
+  }
+  if (kind == Kind::Las) return io_detail::las_header_point_count(path);
+  return std::nullopt;
 }
 
 std::uint64_t point_count_estimate(const std::string& path) {
@@ -179,13 +183,7 @@ std::uint64_t point_count_estimate(const std::string& path) {
     throw IoError(path + ": no such file; check the path (models fetched by "
                          "scripts/fetch-models.sh are in ~/.cache/pointillist/models)");
   }
-  const Kind kind = kind_of(path);
-  if (kind == Kind::Ply) {
-    if (const auto stream = io_detail::open_ply_stream(path, {})) return stream->info().point_count;
-  }
-  if (kind == Kind::Las) {
-    if (const auto count = io_detail::las_header_point_count(path)) return *count;
-  }
+  if (const auto count = exact_point_count(path)) return *count;
   const std::uint64_t size = std::filesystem::file_size(path);
   const bool gzip = path.size() > 3 && path.compare(path.size() - 3, 3, ".gz") == 0;
   return (gzip ? 16 : 1) * size / 6 + 1;

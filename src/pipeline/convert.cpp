@@ -147,8 +147,7 @@ ConvertResult convert(std::span<const std::string> inputs, const std::string& ou
     // that much first, so that it is not faulted in on the one reading thread.
     std::uint64_t bytes = 0;
     for (const std::string& path : inputs) {
-      const bool gzip = path.size() > 3 && path.compare(path.size() - 3, 3, ".gz") == 0;
-      if (point_count_is_exact(path) && !gzip) bytes += std::filesystem::file_size(path);
+      if (exact_point_count(path)) bytes += std::filesystem::file_size(path);
     }
     prefault_heap(std::min(bytes, budget / 4), pool);
   }
@@ -157,13 +156,11 @@ ConvertResult convert(std::span<const std::string> inputs, const std::string& ou
   if (prefault) {
     // What the hierarchy and the encoder will need beyond the points just read, below every
     // measured in-one-piece peak (141-171 bytes a point in all, of which reading holds 36-50),
-    // counted only for inputs whose headers give the count. Touched after reading, when the
+    // counted only for inputs whose headers give the count (binary PLY, LAS). Touched after reading, when the
     // input file is no longer mapped, so the peak does not hold both.
     constexpr std::uint64_t kPrefaultBytesPerPoint = 90;
     std::uint64_t known = 0;
-    for (const std::string& path : inputs) {
-      if (point_count_is_exact(path)) known += point_count_estimate(path);
-    }
+    for (const std::string& path : inputs) known += exact_point_count(path).value_or(0);
     prefault_heap(std::min(known * kPrefaultBytesPerPoint, budget / 2), pool);
   }
   const double memory_seconds = seconds_since(start) - read_seconds;

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <optional>
 
 #include "io/io_test_support.hpp"
 #include "io/las_builder.hpp"
@@ -276,6 +277,90 @@ TEST(PointStream, LasGivesTheSamePointsOriginAndColoursAsTheWholeFileReader) {
   EXPECT_EQ(stream->info().comments, whole.comments);
   EXPECT_TRUE(stream->info().has_colors);
   expect_same_points(drain(*stream, 4096), whole);
+}
+
+// gzip PLY and LAS files stream too (decompressed as they are read, again on rewind): the
+// points, frame and colours of the plain file read whole are the oracle.
+TEST(PointStream, GzipBinaryPlyAndLasStreamTheirPlainFilesPoints) {
+  TempDir dir;
+  const std::string plain = dir.file("cloud.ply"), packed = dir.file("cloud.ply.gz");
+  write_ply(plain, sample_points(40000, true, true, true), {.encoding = PlyEncoding::BinaryBigEndian});
+  testing::write_file(packed, testing::gzip(testing::read_file(plain)));
+  auto stream = open_point_stream(packed);
+  EXPECT_TRUE(stream->info().streamed);
+  EXPECT_EQ(stream->info().point_count, 40000u);
+  expect_same_points(drain(*stream, 3000), read_point_file(plain));
+  EXPECT_EQ(stream->bytes_done(), stream->info().file_size);  // progress ends at 100 %
+  EXPECT_EQ(exact_point_count(packed), std::optional<std::uint64_t>(40000));
+
+  testing::LasSpec spec{.format = 2, .scale = {0.001, 0.001, 0.001}, .offset = {300000, 0, 0}};
+  std::vector<testing::LasPoint> points;
+  for (std::int32_t i = 0; i < 30000; ++i) {
+    points.push_back({i * 3 - 7000, (i * 11) % 9000, i % 500, static_cast<std::uint16_t>(i * 9),
+                      static_cast<std::uint16_t>(i * 5), static_cast<std::uint16_t>(i * 2)});
+  }
+  const std::string las = dir.file("tile.las"), las_gz = dir.file("tile.las.gz");
+  testing::write_file(las, testing::build_las(spec, points));
+  testing::write_file(las_gz, testing::gzip(testing::read_file(las)));
+  stream = open_point_stream(las_gz);
+  EXPECT_TRUE(stream->info().streamed);
+  const PointSet whole = read_point_file(las);
+  EXPECT_EQ(stream->info().origin, whole.origin);
+  EXPECT_TRUE(stream->info().has_colors);
+  expect_same_points(drain(*stream, 2500), whole);
+}
+
+// A gzip file whose data ends early, or is damaged, fails with a message naming it (its length
+// is known only at its end, so the short one fails when the missing points are read).
+TEST(PointStream, ShortOrDamagedGzipDataFailsWithAMessage) {
+  TempDir dir;
+  const std::string plain = dir.file("cloud.ply");
+  write_ply(plain, sample_points(20000, false, true, false));
+  std::string bytes = testing::read_file(plain);
+  bytes.resize(bytes.size() - 7);
+  const std::string short_gz = dir.file("short.ply.gz");
+  testing::write_file(short_gz, testing::gzip(bytes));
+  try {
+    auto stream = open_point_stream(short_gz);
+    drain(*stream, 4096);
+    FAIL() << "a short gzip file read to the end";
+  } catch (const FormatError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find(short_gz), std::string::npos) << m;
+    EXPECT_NE(m.find("truncated"), std::string::npos) << m;
+  }
+  std::string packed = testing::gzip(testing::read_file(plain));
+  for (std::size_t i = packed.size() / 2; i < packed.size() / 2 + 64; ++i) packed[i] ^= 0x5a;
+  const std::string damaged = dir.file("damaged.ply.gz");
+  testing::write_file(damaged, packed);
+  try {
+    auto stream = open_point_stream(damaged);
+    drain(*stream, 4096);
+    FAIL() << "a damaged gzip file read to the end";
+  } catch (const FormatError& e) {
+    EXPECT_NE(std::string(e.what()).find(damaged), std::string::npos) << e.what();
+  }
+}
+
+// A gzip LAS whose header claims more points than its data can inflate to (deflate's ratio is
+// at most 1032 to 1) is refused when opened, before anything is sized by that count.
+TEST(PointStream, AGzipHeaderClaimingMorePointsThanItsDataCanHoldIsRefused) {
+  TempDir dir;
+  std::vector<testing::LasPoint> points(100, testing::LasPoint{1, 2, 3, 0, 0, 0});
+  std::string las = testing::build_las(testing::LasSpec{.format = 2}, points);
+  for (int i = 107; i < 111; ++i) las[i] = static_cast<char>(0xff);  // 4,294,967,295 points
+  const std::string path = dir.file("bomb.las.gz");
+  testing::write_file(path, testing::gzip(las));
+  try {
+    open_point_stream(path);
+    FAIL() << "the claim was believed";
+  } catch (const FormatError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find(path), std::string::npos) << m;
+    EXPECT_NE(m.find("4294967295 points"), std::string::npos) << m;
+    EXPECT_NE(m.find("inflate to at most"), std::string::npos) << m;
+  }
+  EXPECT_THROW(point_count_estimate(path), FormatError);
 }
 
 TEST(PointStream, MissingFileIsAnIoError) {

@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,8 +26,8 @@ struct PointStreamInfo {
   // chunked conversion takes point clouds only.
   bool is_mesh = false;
   // Read in windows of the file, so memory does not grow with the file. False: the reader has
-  // no streaming form for this file (OBJ, ASCII PLY, gzip PLY and gzip LAS files are read whole
-  // when the stream opens) and `resident_bytes` says what it holds.
+  // no streaming form for this file (OBJ and ASCII PLY files are read whole when the stream
+  // opens) and `resident_bytes` says what it holds.
   bool streamed = true;
   std::uint64_t resident_bytes = 0;
   std::uint64_t file_size = 0;
@@ -59,8 +60,8 @@ class PointStream {
 };
 
 // Opens `path` as read_point_file would read it (the reader chosen by the extension). Binary
-// PLY (a vertex element of fixed-size records), LAS and text files (XYZ, PTS, CSV, TXT, gzip
-// too) are streamed; LAS and text run one pass over the file at open (LAS: the origin and
+// PLY (a vertex element of fixed-size records), LAS and text files (XYZ, PTS, CSV, TXT), plain
+// or gzip, are streamed (gzip data decompressed as it is read, again from its start on rewind); LAS and text run one pass over the file at open (LAS: the origin and
 // colour scale read_las uses; text: the point count, and the statistics that tell normals from
 // colours when the columns leave it open). Other files are read whole at open
 // (info().streamed false). Throws what read_point_file throws for a bad file, and
@@ -69,12 +70,12 @@ std::unique_ptr<PointStream> open_point_stream(const std::string& path,
                                                const PointReadOptions& options = {});
 
 // How many points `path` holds, found cheaply (no pass over the points): the header's count for
-// binary PLY and LAS; for other files an upper estimate from the file's size (a text line holds
+// binary PLY and LAS (gzip too); for other files an upper estimate from the file's size (a text line holds
 // at least 6 bytes; a gzip file is taken to inflate 16 times). Throws what open_point_stream
 // throws for a bad PLY or LAS header, IoError for a missing file.
 std::uint64_t point_count_estimate(const std::string& path);
-// Whether point_count_estimate is the file's exact count (PLY and LAS give it in their headers;
-// for text and OBJ it is a bound from the file size).
-bool point_count_is_exact(const std::string& path);
+// The header's count of a binary PLY (vertex element of fixed-size records) or a LAS file, plain
+// or gzip, read cheaply; nothing for other files. Throws as point_count_estimate.
+std::optional<std::uint64_t> exact_point_count(const std::string& path);
 
 }  // namespace pointillist
