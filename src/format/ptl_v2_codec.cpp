@@ -90,15 +90,16 @@ void search_enclosing(const Sphere& parent, const Sphere& target, GoOn&& go_on,
                        (double(target.center.y) - parent.center.y) / rho,
                        (double(target.center.z) - parent.center.z) / rho};
   const double s = double(target.radius) / rho;
-  constexpr double kSlack = 1e-6;  // widens the box a little; the exact test decides
+  // Widens the box by what the decoded floats may differ from the lattice; the exact test decides.
+  const double slack = estimate_margin(parent);
   const int m_first = std::clamp(int(std::floor(kSphereGrid * s)), 1, kSphereGrid);
   const std::int16_t* const codes = qs_detail::sphere_code_table().data();
   const qs_detail::SphereCandidate* const table = qs_detail::sphere_table().data();
   for (int m = m_first; m <= kSphereGrid; ++m) {
     const double radius = double(m) / kSphereGrid;
     if (!go_on(m, radius)) return;
-    const double reach = std::min(radius - s, max_distance()) + kSlack;
-    const double room = 1 - radius + kSlack;
+    const double reach = std::min(radius - s, max_distance()) + slack;
+    const double room = 1 - radius + slack;
     if (reach < 0) continue;
     int lo[3], hi[3];
     bool empty = false;
@@ -209,18 +210,22 @@ LeafCode encode_enclosing_leaf(const Sphere& parent, const Sphere& target, LeafT
   LeafCode best{kParentCode, 0, std::numeric_limits<float>::infinity(), false};
   const float most_trimmed = trimmed_leaf_radius(1.0f, max_leaf_trim(mode), mode);
   // A candidate whose drawn radius, estimated in double, is clearly above the best so far is not
-  // decoded (the estimate is within 1e-6 of the float result; the margin is 1e-5).
+  // decoded: its centre distance is taken as short as the decoded floats could make it
+  // (estimate_margin), and radii get a relative margin of 1e-5 for their float rounding.
   const double s = double(target.radius) / parent.radius;
+  const double margin = estimate_margin(parent);
   const double step = 1.0 - double(trimmed_leaf_radius(1.0f, 1, mode));
   const auto promising = [&](double distance, double radius) {
-    const double need = distance + s;
+    const double need = distance - margin + s;
     if (need > radius * (1 + 1e-5)) return false;
     const double t = std::min(double(max_leaf_trim(mode)),
                               std::floor(std::max(0.0, 1.0 - need / radius) / step));
     return radius * (1.0 - t * step) * parent.radius <= double(best.radius) * (1 + 1e-5);
   };
   // The target's centre lies within best - s of any code that could draw it at best or less.
-  const auto within = [&] { return double(best.radius) / parent.radius * (1 + 1e-5) - s; };
+  const auto within = [&] {
+    return double(best.radius) / parent.radius * (1 + 1e-5) - s + margin;
+  };
   // A size whose most trimmed radius is clearly above the best cannot win, nor can larger ones.
   const auto go_on = [&](int, double radius) {
     return radius * most_trimmed * parent.radius <= double(best.radius) * (1 + 1e-5);

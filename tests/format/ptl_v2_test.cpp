@@ -126,11 +126,16 @@ std::vector<Candidate> spec_sphere_table() {
 }
 
 // Checks every third leaf of a file written with `trim` leaf trims (steps of 1/steps).
-void expect_smallest_drawn_leaves(quant::LeafTrim trim, int steps, int max_trim) {
+// `shift` moves the scene away from the origin, where float centres carry less precision.
+void expect_smallest_drawn_leaves(quant::LeafTrim trim, int steps, int max_trim,
+                                  float shift = 0) {
   const std::vector<Candidate> table = spec_sphere_table();
   ASSERT_EQ(table.size(), 7621u);
   TempDir dir;
-  const SphereTree tree = scene_tree(5000, 50, false);
+  PointSet points = scene_points(5000, 50, false);
+  for (Vec3f& x : points.positions) x = {x.x + shift, x.y - shift / 2, x.z + shift / 3};
+  ThreadPool pool(2);
+  const SphereTree tree = build_sphere_tree(points, pool);
   write_ptl_v2(dir.file("c.ptl"), tree, "", {.leaf_trim = trim});
   const SphereTree d = PtlV2File::open(dir.file("c.ptl"))->decode_all();
   ASSERT_EQ(d.nodes.size(), tree.nodes.size());
@@ -183,6 +188,12 @@ TEST(PtlV2, LeavesGetTheCodeAndTrimThatDrawThemSmallestWhileHoldingTheTrueSphere
 
 TEST(PtlV2, LeafTrimsInEighthsAsTheFirstVersion2FilesKeepThem) {
   expect_smallest_drawn_leaves(quant::LeafTrim::Eighths, 8, 3);
+}
+
+// Far from the origin a float centre is coarse next to a leaf (ulp(600) = 6e-5, leaves ~1e-2):
+// the search's estimates of centre distances must allow for that, or it skips the best code.
+TEST(PtlV2, LeavesFarFromTheOriginStillGetTheCodeThatDrawsThemSmallest) {
+  expect_smallest_drawn_leaves(quant::LeafTrim::Sixteenths, 16, 7, 600.0f);
 }
 
 TEST(PtlV2, EnclosesSpheresOfATreeThatDoesNotNest) {
