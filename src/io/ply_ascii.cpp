@@ -357,6 +357,12 @@ std::uint64_t count_element_lines(const char* begin, const char* end) {
   return lines;
 }
 
+std::uint64_t parse_ascii_lines(const BodyContext& ctx, const char* begin, const char* end,
+                                std::uint64_t first) {
+  std::vector<Triangle> unused;
+  return AsciiParser(ctx, unused).parse(begin, end, first);
+}
+
 void fail_ascii_ends_early(const BodyContext& ctx, std::uint64_t lines) {
   std::vector<Triangle> unused;
   AsciiParser(ctx, unused).fail_ends_early(lines, ctx.data.data() + ctx.data.size());

@@ -13,7 +13,8 @@ void BodyContext::fail_at_byte(std::size_t offset, const std::string& what) cons
 }
 
 void BodyContext::fail_at_char(const char* pos, const std::string& what) const {
-  const std::size_t line = 1 + static_cast<std::size_t>(std::count(data.data(), pos, '\n'));
+  const std::uint64_t line =
+      line_base + 1 + static_cast<std::uint64_t>(std::count(data.data(), pos, '\n'));
   throw FormatError(path + ": line " + std::to_string(line) + ": " + what);
 }
 

@@ -7,12 +7,14 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "ply_header.hpp"
 #include "pointillist/core/math.hpp"
+#include "pointillist/io/point_stream.hpp"
 
 namespace pointillist {
 class ThreadPool;
@@ -81,6 +83,7 @@ struct BodyContext {
   std::uint64_t byte_base = 0;
   std::uint64_t index_base = 0;
   std::uint64_t index_total = 0;
+  std::uint64_t line_base = 0;  // lines of the file before `data` (ascii windows)
 
   // "path: byte N: what" (binary bodies).
   [[noreturn]] void fail_at_byte(std::size_t offset, const std::string& what) const;
@@ -107,6 +110,12 @@ struct StreamState {
 // valid bytes are read.
 void decode_ascii_stream(const BodyContext& ctx, std::vector<Triangle>& triangles,
                          const std::function<StreamState(std::size_t)>& wait);
+
+// Parses the element lines in [begin, end) (whole lines, inside ctx.data), the first being
+// element line `first` of ctx.header's body; returns how many it parsed. Throws as
+// decode_ascii_body. For windows of a streamed file (ctx.line_base numbers their lines).
+std::uint64_t parse_ascii_lines(const BodyContext& ctx, const char* begin, const char* end,
+                                std::uint64_t first);
 
 // Throws FormatError when an element count cannot fit in the bytes after the header, so callers
 // can allocate for the counts safely. Names the exact place when it can (a binary body whose
@@ -161,3 +170,16 @@ struct FanBuilder {
 };
 
 }  // namespace pointillist::ply
+
+namespace pointillist::io_detail {
+
+// The vertex element of an ASCII PLY file (plain or gzip), `info` filled from its header, read
+// a window of lines at a time (ply_ascii_stream.cpp). `scales`: the three colour scales.
+std::unique_ptr<PointStream> open_ascii_vertex_stream(const std::string& path,
+                                                      const ply::Header& header,
+                                                      std::size_t vertex,
+                                                      const ply::ElementPlan& plan,
+                                                      const ply::ColorScale* scales,
+                                                      PointStreamInfo info);
+
+}  // namespace pointillist::io_detail

@@ -489,7 +489,35 @@ std::unique_ptr<PointStream> open_ply_stream(const std::string& path,
   PlyRead read(path, read_options, progress);
   read.prepare({prefix.data(), prefix.size()}, file->compressed());
   const Header& header = read.header;
-  if (header.format == Format::Ascii) return nullptr;
+  PointStreamInfo info;
+  info.path = path;
+  info.has_normals = read.vertex_plan().normals;
+  info.has_colors = read.vertex_plan().colors;
+  info.has_radii = read.vertex_plan().radii;
+  for (std::size_t e = 0; e < header.elements.size(); ++e) {
+    if (read.ctx.plans[e].kind == ElementPlan::Kind::Face && header.elements[e].count > 0)
+      info.is_mesh = true;
+  }
+  take_header_comments(header, info.comments, info.origin, info.up);
+  if (header.format == Format::Ascii) {
+    std::size_t vertex = 0;
+    while (header.elements[vertex].name != "vertex") ++vertex;
+    const Element& element = header.elements[vertex];
+    // At least a digit and a blank or newline for each value: a count the file cannot hold is
+    // refused before anything is sized by it.
+    const std::uint64_t values = std::max<std::size_t>(1, element.properties.size());
+    if (element.count > std::numeric_limits<std::uint64_t>::max() / (2 * values)) {
+      throw FormatError(path + ": element vertex has " + std::to_string(element.count) +
+                        " lines, more than any file holds; the header is wrong");
+    }
+    file->check_holds(element.count * 2 * values,
+                      std::to_string(element.count) + " vertex lines of " +
+                          std::to_string(values) + " values");
+    info.point_count = element.count;
+    info.file_size = file->size();
+    return open_ascii_vertex_stream(path, header, vertex, read.ctx.plans[vertex],
+                                    read.vertex_plan().scales, std::move(info));
+  }
   // offset + the bytes of `e`, refused when a header's count makes it overflow
   const auto past = [&](std::uint64_t offset, const Element& e) {
     const std::uint64_t stride = std::max<std::uint64_t>(1, e.fixed_size());
@@ -513,19 +541,9 @@ std::unique_ptr<PointStream> open_ply_stream(const std::string& path,
   file->check_holds(need, std::to_string(element.count) + " vertices of " +
                               std::to_string(element.fixed_size()) + " bytes from byte " +
                               std::to_string(offset));
-  PointStreamInfo info;
-  info.path = path;
   info.point_count = element.count;
-  info.has_normals = read.vertex_plan().normals;
-  info.has_colors = read.vertex_plan().colors;
-  info.has_radii = read.vertex_plan().radii;
-  for (std::size_t e = 0; e < header.elements.size(); ++e) {
-    if (read.ctx.plans[e].kind == ElementPlan::Kind::Face && header.elements[e].count > 0)
-      info.is_mesh = true;
-  }
   // Progress counts decompressed bytes of a gzip file, up to the last vertex.
   info.file_size = file->compressed() ? need : file->size();
-  take_header_comments(header, info.comments, info.origin, info.up);
   auto stream = std::make_unique<PlyStream>(std::move(file), header, vertex, read.ctx.plans[vertex],
                                             offset, read.vertex_plan(), options.pool);
   stream->set_info(std::move(info));

@@ -10,16 +10,16 @@
 
 namespace pointillist::io_detail {
 
-// A binary PLY file whose vertex element has fixed-size records and follows only fixed-size
-// elements, read a window of vertices at a time; null for any other PLY file (ASCII, gzip,
-// lists before or in the vertex element), which the caller reads whole. Throws what read_ply
-// throws for a bad header or a file too short for its vertices.
+// A PLY file (plain or gzip) read a window of vertices at a time: binary when the vertex
+// element has fixed-size records and follows only fixed-size elements, ASCII always (a window
+// of lines, ply_ascii_stream.cpp); null for other binary files (lists before or in the vertex
+// element), which the caller reads whole. Throws what read_ply throws for a bad header or a
+// file too short for its vertices.
 std::unique_ptr<PointStream> open_ply_stream(const std::string& path,
                                              const PointReadOptions& options);
 
-// An uncompressed LAS file, read a window of records at a time after one pass over all of them
-// (the origin and the colour scale, as read_las finds them); null for a gzip file. Throws what
-// read_las throws.
+// A LAS file (plain or gzip), read a window of records at a time after one pass over all of
+// them (the origin and the colour scale, as read_las finds them). Throws what read_las throws.
 std::unique_ptr<PointStream> open_las_stream(const std::string& path,
                                              const PointReadOptions& options);
 
@@ -30,7 +30,8 @@ std::unique_ptr<PointStream> open_xyz_stream(const std::string& path,
                                              const PointReadOptions& options);
 
 // The point count a LAS file's header states (checked as read_las checks it: every record must
-// be in the file); nothing for a gzip file. Throws what read_las throws for a bad header.
+// be in the file; for gzip data, what it can inflate to). Throws what read_las throws for a bad
+// header.
 std::optional<std::uint64_t> las_header_point_count(const std::string& path);
 
 // The bytes of a window: enough for a few million records without holding many at once.

@@ -143,11 +143,14 @@ ConvertResult convert(std::span<const std::string> inputs, const std::string& ou
   // Measured for model outputs (a .ply output needs little beyond what reading fills).
   const bool prefault = o.prefault && (ends_with(output, ".ptl") || ends_with(output, ".qs"));
   if (prefault) {
-    // Reading fills arrays about the size of an uncompressed binary input (PLY or LAS): touch
-    // that much first, so that it is not faulted in on the one reading thread.
+    // Reading fills arrays about the size of a binary input (PLY or LAS), at most ~40 bytes a
+    // point with faces (an ASCII or gzip file's size says less): touch that much first, so
+    // that it is not faulted in on the one reading thread.
     std::uint64_t bytes = 0;
     for (const std::string& path : inputs) {
-      if (exact_point_count(path)) bytes += std::filesystem::file_size(path);
+      if (const auto count = exact_point_count(path)) {
+        bytes += std::min<std::uint64_t>(std::filesystem::file_size(path), *count * 40);
+      }
     }
     prefault_heap(std::min(bytes, budget / 4), pool);
   }

@@ -174,14 +174,72 @@ TEST(PointStream, AllZeroNormalsAreSeenAsUnusable) {
   EXPECT_FALSE(stream->saw_usable_normals());
 }
 
-TEST(PointStream, AsciiPlyIsReadWholeWithTheSamePoints) {
+// ASCII PLY streams a window of lines at a time, plain or gzip, with an element before the
+// vertices and blank lines among them: the whole-file reader's points are the oracle.
+TEST(PointStream, AsciiPlyStreamsTheWholeFileReadersPoints) {
   TempDir dir;
-  const std::string ascii = dir.file("cloud.ply");
-  write_ply(ascii, sample_points(300, true, true, false), {.encoding = PlyEncoding::Ascii});
-  const auto stream = open_point_stream(ascii);
-  EXPECT_FALSE(stream->info().streamed);
-  EXPECT_GT(stream->info().resident_bytes, 0u);
-  expect_same_points(drain(*stream, 64), read_point_file(ascii));
+  const std::string made = dir.file("made.ply");
+  write_ply(made, sample_points(300000, true, true, true), {.encoding = PlyEncoding::Ascii});
+  std::string text = testing::read_file(made);
+  // an element of two lines before the vertices, and blank lines in the body
+  const std::size_t at = text.find("element vertex");
+  text.insert(at, "element camera 2\nproperty float f\n");
+  const std::size_t body = text.find("end_header\n") + 11;
+  text.insert(body, "1.5\n\n2.5\n");
+  text.insert(text.find('\n', body + 5000) + 1, "  \n");
+  const std::string plain = dir.file("cloud.ply"), packed = dir.file("cloud.ply.gz");
+  testing::write_file(plain, text);
+  testing::write_file(packed, testing::gzip(text));
+  const PointSet whole = read_point_file(plain);
+  ASSERT_EQ(whole.size(), 300000u);
+  for (const std::string& path : {plain, packed}) {
+    const auto stream = open_point_stream(path);
+    EXPECT_TRUE(stream->info().streamed) << path;
+    EXPECT_EQ(stream->info().point_count, 300000u);
+    expect_same_points(drain(*stream, 70000), whole);
+  }
+}
+
+// A bad value in an ASCII PLY is named at the same line by the stream as by the whole-file
+// reader, past several windows; a file with too few vertex lines fails when read.
+TEST(PointStream, AsciiPlyErrorsNameTheSameLineAsTheWholeFileReader) {
+  TempDir dir;
+  const std::string path = dir.file("bad.ply");
+  write_ply(path, sample_points(200000, false, false, false), {.encoding = PlyEncoding::Ascii});
+  std::string text = testing::read_file(path);
+  std::size_t line_start = text.find("end_header\n") + 11;
+  for (int k = 0; k < 180000; ++k) line_start = text.find('\n', line_start) + 1;
+  text.replace(line_start, text.find(' ', line_start) - line_start, "1.2.3");
+  testing::write_file(path, text);
+  std::string whole_message, stream_message;
+  try {
+    read_point_file(path);
+  } catch (const FormatError& e) {
+    whole_message = e.what();
+  }
+  try {
+    const auto stream = open_point_stream(path);
+    drain(*stream, 50000);
+  } catch (const FormatError& e) {
+    stream_message = e.what();
+  }
+  EXPECT_NE(whole_message.find("vertex 180000 of 200000"), std::string::npos) << whole_message;
+  EXPECT_EQ(stream_message, whole_message);
+
+  const std::string short_path = dir.file("short.ply");
+  write_ply(short_path, sample_points(1000, false, false, false), {.encoding = PlyEncoding::Ascii});
+  std::string short_text = testing::read_file(short_path);
+  short_text.resize(short_text.rfind('\n', short_text.size() - 2) + 1);  // the last line gone
+  testing::write_file(short_path, short_text);
+  try {
+    const auto stream = open_point_stream(short_path);
+    drain(*stream, 300);
+    FAIL() << "a short ASCII PLY read to the end";
+  } catch (const FormatError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find(short_path), std::string::npos) << m;
+    EXPECT_NE(m.find("ends early"), std::string::npos) << m;
+  }
 }
 
 // Text files of every shape read_xyz knows, streamed: the same points, origin and comments as

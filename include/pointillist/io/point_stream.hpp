@@ -26,8 +26,9 @@ struct PointStreamInfo {
   // chunked conversion takes point clouds only.
   bool is_mesh = false;
   // Read in windows of the file, so memory does not grow with the file. False: the reader has
-  // no streaming form for this file (OBJ and ASCII PLY files are read whole when the stream
-  // opens) and `resident_bytes` says what it holds.
+  // no streaming form for this file (OBJ files, and binary PLY files with lists before or in
+  // the vertex element, are read whole when the stream opens) and `resident_bytes` says what
+  // it holds.
   bool streamed = true;
   std::uint64_t resident_bytes = 0;
   std::uint64_t file_size = 0;
@@ -59,9 +60,10 @@ class PointStream {
   PointStreamInfo info_;
 };
 
-// Opens `path` as read_point_file would read it (the reader chosen by the extension). Binary
-// PLY (a vertex element of fixed-size records), LAS and text files (XYZ, PTS, CSV, TXT), plain
-// or gzip, are streamed (gzip data decompressed as it is read, again from its start on rewind); LAS and text run one pass over the file at open (LAS: the origin and
+// Opens `path` as read_point_file would read it (the reader chosen by the extension). PLY
+// (binary with a vertex element of fixed-size records, or ASCII), LAS and text files (XYZ, PTS,
+// CSV, TXT), plain or gzip, are streamed (gzip data decompressed as it is read, again from its
+// start on rewind); LAS and text run one pass over the file at open (LAS: the origin and
 // colour scale read_las uses; text: the point count, and the statistics that tell normals from
 // colours when the columns leave it open). Other files are read whole at open
 // (info().streamed false). Throws what read_point_file throws for a bad file, and
@@ -74,8 +76,9 @@ std::unique_ptr<PointStream> open_point_stream(const std::string& path,
 // at least 6 bytes; a gzip file is taken to inflate 16 times). Throws what open_point_stream
 // throws for a bad PLY or LAS header, IoError for a missing file.
 std::uint64_t point_count_estimate(const std::string& path);
-// The header's count of a binary PLY (vertex element of fixed-size records) or a LAS file, plain
-// or gzip, read cheaply; nothing for other files. Throws as point_count_estimate.
+// The header's count of a PLY (binary with a vertex element of fixed-size records, or ASCII) or
+// a LAS file, plain or gzip, read cheaply; nothing for other files. Throws as
+// point_count_estimate.
 std::optional<std::uint64_t> exact_point_count(const std::string& path);
 
 }  // namespace pointillist
