@@ -145,6 +145,27 @@ TEST(ChunkedConvert, AGzipTextFileGivesTheOnePieceHierarchy) {
   EXPECT_TRUE(c.parts.has_colors);
 }
 
+// gzip ASCII and gzip binary PLY inputs stream into chunks (a window of lines; decompressed as
+// read) and give the hierarchy of the conversion in one piece, node for node.
+TEST(ChunkedConvert, GzipAsciiAndBinaryPlyGiveTheOnePieceHierarchy) {
+  TempDir dir;
+  PointSet p = sample_scene(demo_scene(), 20000, 6).points;
+  for (const Vec3f& x : p.positions) {
+    p.colors.push_back({std::uint8_t(128 + 60 * x.x), std::uint8_t(128 + 60 * x.y),
+                        std::uint8_t(128 + 60 * x.z)});
+  }
+  for (const PlyEncoding encoding : {PlyEncoding::Ascii, PlyEncoding::BinaryBigEndian}) {
+    const std::string plain = dir.file("scan.ply"), input = dir.file("scan.ply.gz");
+    write_ply(plain, p, {.encoding = encoding});
+    testing::write_file(input, testing::gzip(testing::read_file(plain)));
+    const Converted c = convert_both(dir, input, {.chunk_points = 1500});
+    EXPECT_GE(c.parts_result.chunks, 8u);
+    ASSERT_EQ(c.parts.nodes.size(), c.whole.nodes.size());
+    EXPECT_EQ(differing_nodes(c), 0u);
+    EXPECT_TRUE(c.parts.has_colors);
+  }
+}
+
 // Two georeferenced LAS tiles of one survey, side by side, one without colours: merged by the
 // same rules in chunks as in one piece.
 TEST(ChunkedConvert, MergesTilesAsTheConversionInOnePieceDoes) {
