@@ -3,11 +3,13 @@
 // loads; the common face layout (uchar count, int indices) has its own loop; everything else goes
 // through a generic per-property walker.
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cstring>
 
 #include "ply_body.hpp"
 #include "pointillist/core/error.hpp"
+#include "pointillist/core/thread_pool.hpp"
 
 namespace pointillist::ply {
 namespace {
@@ -301,6 +303,44 @@ class BinaryDecoder {
   // Defined before decode_simple_faces, which calls it from a generic lambda: clang 14 does not
   // instantiate a member template that such a lambda uses before the template's definition
   // (undefined internal symbols at link time).
+  // The common case in parallel: every face a triangle with indices in range, so the records
+  // have one size and any piece can be decoded on its own. False (nothing kept) when some
+  // record says otherwise; the serial loop then decodes all and names the first bad one.
+  template <class C, class I, bool Swap>
+  bool decode_triangles_in_parallel(std::size_t e, std::size_t pos, std::size_t used) {
+    constexpr std::size_t kRecord = sizeof(C) + 3 * sizeof(I);
+    constexpr std::uint64_t kMinFaces = 1 << 18, kPiece = 1 << 16;
+    const std::uint64_t count = header_.elements[e].count;
+    if (!ctx_.pool || ctx_.pool->thread_count() < 2 || count < kMinFaces ||
+        count > (size_ - pos) / kRecord) {
+      return false;
+    }
+    const std::uint64_t vertex_count = ctx_.vertex_count;
+    std::atomic<bool> simple{true};
+    ctx_.pool->run(static_cast<std::size_t>((count + kPiece - 1) / kPiece), [&](std::size_t k) {
+      const std::uint64_t first = k * kPiece, last = std::min(count, first + kPiece);
+      const unsigned char* r = data_ + pos + first * kRecord;
+      for (std::uint64_t f = first; f < last && simple.load(std::memory_order_relaxed);
+           ++f, r += kRecord) {
+        const auto a = static_cast<std::int64_t>(load<I, Swap>(r + sizeof(C)));
+        const auto b = static_cast<std::int64_t>(load<I, Swap>(r + sizeof(C) + sizeof(I)));
+        const auto c = static_cast<std::int64_t>(load<I, Swap>(r + sizeof(C) + 2 * sizeof(I)));
+        if (static_cast<std::int64_t>(load<C, Swap>(r)) != 3 ||
+            static_cast<std::uint64_t>(a) >= vertex_count ||
+            static_cast<std::uint64_t>(b) >= vertex_count ||
+            static_cast<std::uint64_t>(c) >= vertex_count) {
+          simple.store(false, std::memory_order_relaxed);
+          return;
+        }
+        triangles_[used + f] = {static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(b),
+                                static_cast<std::uint32_t>(c)};
+      }
+    });
+    if (!simple.load()) return false;
+    report(count * kRecord);
+    return true;
+  }
+
   template <class C, class I, bool Swap>
   std::size_t decode_faces(std::size_t e, std::size_t pos) {
     const std::uint64_t count = header_.elements[e].count;
@@ -309,6 +349,9 @@ class BinaryDecoder {
     // Most faces are triangles: size for that, grow when polygons need more.
     std::size_t used = triangles_.size();
     triangles_.resize(used + count);
+    if (decode_triangles_in_parallel<C, I, Swap>(e, pos, used)) {
+      return pos + count * (sizeof(C) + 3 * sizeof(I));
+    }
     for (std::uint64_t f = 0; f < count; ++f) {
       if (size_ - p < sizeof(C)) fail_ends_early(e, f, 0, p, sizeof(C));
       const std::int64_t n = static_cast<std::int64_t>(load<C, Swap>(data_ + p));

@@ -308,6 +308,7 @@ PointSet parse_stream(GzipInflater& inflater,
   if (read.header.format != Format::Ascii) {
     state = wait(std::numeric_limits<std::size_t>::max());
     read.ctx.data = {inflater.data(), state.available};
+    read.ctx.pool = nullptr;  // this runs in one of the pool's tasks: no nested run
     check_counts_fit(read.ctx);
     read.allocate(state.available);
     decode_binary_body(read.ctx, read.points.triangles);

@@ -3,10 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <random>
+#include <string>
+#include <vector>
 
 #include "io_test_support.hpp"
 #include "pointillist/core/error.hpp"
@@ -191,6 +194,76 @@ TEST(PlyReader, ParallelAsciiErrorsNameTheRightLine) {
   EXPECT_NE(parallel_error(missing).find("file ends early: face 59999 of 60000 is missing"),
             std::string::npos)
       << parallel_error(missing);
+}
+
+// A binary mesh of `faces` triangles (uchar counts, int indices, little endian) over 1000
+// vertices, with the hand-made triangle list as the oracle; `quad_at` makes that face a quad
+// (fanned into two triangles), `bad_at` gives those faces an index out of range.
+struct GeneratedBinary {
+  std::string bytes;
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+};
+GeneratedBinary generate_binary_mesh(std::uint32_t faces, std::int64_t quad_at,
+                                     std::vector<std::uint32_t> bad_at = {}) {
+  GeneratedBinary g;
+  constexpr std::uint32_t kVertices = 1000;
+  g.bytes = "ply\nformat binary_little_endian 1.0\nelement vertex 1000\nproperty float x\n"
+            "property float y\nproperty float z\nelement face " + std::to_string(faces) +
+            "\nproperty list uchar int vertex_indices\nend_header\n";
+  const auto put = [&](const void* p, std::size_t n) {
+    g.bytes.append(static_cast<const char*>(p), n);
+  };
+  for (std::uint32_t v = 0; v < kVertices; ++v) {
+    const float xyz[3] = {float(v), float(v % 7), float(v % 13)};
+    put(xyz, sizeof xyz);
+  }
+  for (std::uint32_t f = 0; f < faces; ++f) {
+    const std::int32_t a = std::int32_t(f % kVertices), b = std::int32_t((f * 7 + 1) % kVertices),
+                       c = std::int32_t((f * 13 + 2) % kVertices), d = std::int32_t((f + 5) % kVertices);
+    const bool quad = std::int64_t(f) == quad_at;
+    const bool bad = std::find(bad_at.begin(), bad_at.end(), f) != bad_at.end();
+    const std::uint8_t n = quad ? 4 : 3;
+    put(&n, 1);
+    const std::int32_t first = bad ? std::int32_t(kVertices + f) : a;
+    put(&first, 4);
+    put(&b, 4);
+    put(&c, 4);
+    if (quad) put(&d, 4);
+    g.triangles.push_back({std::uint32_t(a), std::uint32_t(b), std::uint32_t(c)});
+    if (quad) g.triangles.push_back({std::uint32_t(a), std::uint32_t(c), std::uint32_t(d)});
+  }
+  return g;
+}
+
+// Large triangle lists are decoded in parallel pieces; a polygon or a bad index anywhere sends
+// the whole element back to the one-thread decoder, which fans the polygon and names the first
+// bad face exactly as it does without a pool.
+TEST(PlyReader, ParallelBinaryFacesMatchTheListAndTheOneThreadErrors) {
+  TempDir dir;
+  const std::string path = dir.file("mesh.ply");
+  for (const std::int64_t quad_at : {std::int64_t{-1}, std::int64_t{280000}}) {
+    SCOPED_TRACE(quad_at);
+    const GeneratedBinary g = generate_binary_mesh(300000, quad_at);
+    write_file(path, g.bytes);
+    ThreadPool pool(2);
+    EXPECT_EQ(read_ply(path, Progress::none(), {.pool = &pool}).triangles, g.triangles);
+  }
+  const GeneratedBinary bad = generate_binary_mesh(300000, -1, {200000, 290000});
+  write_file(path, bad.bytes);
+  std::string one_thread, two_threads;
+  try {
+    read_ply(path);
+  } catch (const FormatError& e) {
+    one_thread = e.what();
+  }
+  ThreadPool pool(2);
+  try {
+    read_ply(path, Progress::none(), {.pool = &pool});
+  } catch (const FormatError& e) {
+    two_threads = e.what();
+  }
+  EXPECT_NE(one_thread.find("face 200000 of 300000"), std::string::npos) << one_thread;
+  EXPECT_EQ(two_threads, one_thread);
 }
 
 // With a pool, a .gz file is inflated on one thread while the other parses.
