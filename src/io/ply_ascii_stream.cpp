@@ -59,12 +59,7 @@ class AsciiPlyStream final : public PointStream {
     if (!positioned_) rewind();
     const std::uint64_t n =
         std::min<std::uint64_t>({max, info_.point_count - next_, kWindowLines});
-    batch.positions.resize(n);
-    batch.normals.resize(info_.has_normals ? n : 0);
-    batch.colors.resize(info_.has_colors ? n : 0);
-    batch.radii.resize(info_.has_radii ? n : 0);
-    batch.triangles.clear();
-    batch.comments.clear();
+    size_batch(batch, static_cast<std::size_t>(n), info_);
     if (n == 0) {
       lines_.release();
       return 0;

@@ -429,12 +429,7 @@ class PlyStream final : public PointStream {
     const std::uint64_t n =
         std::min<std::uint64_t>({max, info_.point_count - next_,
                                  std::max<std::uint64_t>(1, kStreamWindowBytes / stride)});
-    batch.positions.resize(n);
-    batch.normals.resize(vp_.normals ? n : 0);
-    batch.colors.resize(vp_.colors ? n : 0);
-    batch.radii.resize(vp_.radii ? n : 0);
-    batch.triangles.clear();
-    batch.comments.clear();
+    size_batch(batch, static_cast<std::size_t>(n), info_);  // info_ says what vp_ reads
     if (n == 0) return 0;
     const std::uint64_t at = vertex_offset_ + next_ * stride;
     file_->read(at, static_cast<std::size_t>(n * stride), buffer_);

@@ -170,6 +170,10 @@ std::unique_ptr<PointStream> open_point_stream(const std::string& path,
 }
 
 std::optional<std::uint64_t> exact_point_count(const std::string& path) {
+  if (!std::filesystem::exists(path)) {
+    throw IoError(path + ": no such file; check the path (models fetched by "
+                         "scripts/fetch-models.sh are in ~/.cache/pointillist/models)");
+  }
   const Kind kind = kind_of(path);
   if (kind == Kind::Ply) {
     if (const auto stream = io_detail::open_ply_stream(path, {})) return stream->info().point_count;
@@ -179,10 +183,6 @@ std::optional<std::uint64_t> exact_point_count(const std::string& path) {
 }
 
 std::uint64_t point_count_estimate(const std::string& path) {
-  if (!std::filesystem::exists(path)) {
-    throw IoError(path + ": no such file; check the path (models fetched by "
-                         "scripts/fetch-models.sh are in ~/.cache/pointillist/models)");
-  }
   if (const auto count = exact_point_count(path)) return *count;
   const std::uint64_t size = std::filesystem::file_size(path);
   const bool gzip = path.size() > 3 && path.compare(path.size() - 3, 3, ".gz") == 0;

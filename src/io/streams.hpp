@@ -34,6 +34,17 @@ std::unique_ptr<PointStream> open_xyz_stream(const std::string& path,
 // header.
 std::optional<std::uint64_t> las_header_point_count(const std::string& path);
 
+// Sizes `batch` for `n` points of a stream: positions, and normals, colours and radii as `info`
+// has them; no triangles or comments.
+inline void size_batch(PointSet& batch, std::size_t n, const PointStreamInfo& info) {
+  batch.positions.resize(n);
+  batch.normals.resize(info.has_normals ? n : 0);
+  batch.colors.resize(info.has_colors ? n : 0);
+  batch.radii.resize(info.has_radii ? n : 0);
+  batch.triangles.clear();
+  batch.comments.clear();
+}
+
 // The bytes of a window: enough for a few million records without holding many at once.
 inline constexpr std::size_t kStreamWindowBytes = std::size_t{32} << 20;
 

@@ -8,7 +8,9 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <optional>
 #include <sstream>
+#include <vector>
 
 #include "pointillist/core/error.hpp"
 #include "pointillist/core/heap.hpp"
@@ -116,8 +118,14 @@ ConvertResult convert(std::span<const std::string> inputs, const std::string& ou
   }
   // Inputs too large for the memory budget in one piece go to .ptl v2 in chunks.
   const std::uint64_t budget = o.memory_budget ? o.memory_budget : default_memory_budget();
+  // Each input's header count (binary PLY, LAS, ASCII PLY), read once: the budget's estimate
+  // and the prefault below both use it.
+  std::vector<std::optional<std::uint64_t>> exact;
   std::uint64_t estimate = 0;
-  for (const std::string& path : inputs) estimate += point_count_estimate(path);
+  for (const std::string& path : inputs) {
+    exact.push_back(exact_point_count(path));
+    estimate += exact.back() ? *exact.back() : point_count_estimate(path);  // a bound
+  }
   const bool to_v2 = ends_with(output, ".ptl") && o.ptl_version == 2;
   const bool over = estimate > budget / chunking::kInCoreBytesPerPoint;
   const bool ranks = o.jobs != nullptr && o.jobs->size() > 1;
@@ -147,9 +155,9 @@ ConvertResult convert(std::span<const std::string> inputs, const std::string& ou
     // point with faces (an ASCII or gzip file's size says less): touch that much first, so
     // that it is not faulted in on the one reading thread.
     std::uint64_t bytes = 0;
-    for (const std::string& path : inputs) {
-      if (const auto count = exact_point_count(path)) {
-        bytes += std::min<std::uint64_t>(std::filesystem::file_size(path), *count * 40);
+    for (std::size_t i = 0; i < inputs.size(); ++i) {
+      if (exact[i]) {
+        bytes += std::min<std::uint64_t>(std::filesystem::file_size(inputs[i]), *exact[i] * 40);
       }
     }
     prefault_heap(std::min(bytes, budget / 4), pool);
@@ -163,7 +171,7 @@ ConvertResult convert(std::span<const std::string> inputs, const std::string& ou
     // input file is no longer mapped, so the peak does not hold both.
     constexpr std::uint64_t kPrefaultBytesPerPoint = 90;
     std::uint64_t known = 0;
-    for (const std::string& path : inputs) known += exact_point_count(path).value_or(0);
+    for (const auto& count : exact) known += count.value_or(0);
     prefault_heap(std::min(known * kPrefaultBytesPerPoint, budget / 2), pool);
   }
   const double memory_seconds = seconds_since(start) - read_seconds;

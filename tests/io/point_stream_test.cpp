@@ -42,6 +42,17 @@ PointSet drain(PointStream& stream, std::size_t batch) {
   return all;
 }
 
+// The message of the FormatError that `fn` throws ("" when it throws none).
+template <class Fn>
+std::string format_error_of(Fn&& fn) {
+  try {
+    fn();
+  } catch (const FormatError& e) {
+    return e.what();
+  }
+  return "";
+}
+
 template <class T>
 bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
   return a.size() == b.size() &&
@@ -129,18 +140,9 @@ TEST(PointStream, ReportsBadValuesAtTheSamePlaceAsTheWholeFileReader) {
   points.positions[2345].y = std::numeric_limits<float>::quiet_NaN();
   const std::string path = dir.file("nan.ply");
   write_ply(path, points);
-  std::string whole_message, stream_message;
-  try {
-    read_point_file(path);
-  } catch (const FormatError& e) {
-    whole_message = e.what();
-  }
-  try {
-    const auto stream = open_point_stream(path);
-    drain(*stream, 1000);
-  } catch (const FormatError& e) {
-    stream_message = e.what();
-  }
+  const std::string whole_message = format_error_of([&] { read_point_file(path); });
+  const std::string stream_message =
+      format_error_of([&] { drain(*open_point_stream(path), 1000); });
   EXPECT_NE(whole_message.find("vertex 2345 of 3000"), std::string::npos) << whole_message;
   EXPECT_EQ(stream_message, whole_message);
 }
@@ -211,18 +213,9 @@ TEST(PointStream, AsciiPlyErrorsNameTheSameLineAsTheWholeFileReader) {
   for (int k = 0; k < 180000; ++k) line_start = text.find('\n', line_start) + 1;
   text.replace(line_start, text.find(' ', line_start) - line_start, "1.2.3");
   testing::write_file(path, text);
-  std::string whole_message, stream_message;
-  try {
-    read_point_file(path);
-  } catch (const FormatError& e) {
-    whole_message = e.what();
-  }
-  try {
-    const auto stream = open_point_stream(path);
-    drain(*stream, 50000);
-  } catch (const FormatError& e) {
-    stream_message = e.what();
-  }
+  const std::string whole_message = format_error_of([&] { read_point_file(path); });
+  const std::string stream_message =
+      format_error_of([&] { drain(*open_point_stream(path), 50000); });
   EXPECT_NE(whole_message.find("vertex 180000 of 200000"), std::string::npos) << whole_message;
   EXPECT_EQ(stream_message, whole_message);
 

@@ -78,7 +78,7 @@ std::unique_ptr<PointStream> open_point_stream(const std::string& path,
 std::uint64_t point_count_estimate(const std::string& path);
 // The header's count of a PLY (binary with a vertex element of fixed-size records, or ASCII) or
 // a LAS file, plain or gzip, read cheaply; nothing for other files. Throws as
-// point_count_estimate.
+// point_count_estimate (IoError for a missing file).
 std::optional<std::uint64_t> exact_point_count(const std::string& path);
 
 }  // namespace pointillist
