@@ -1,11 +1,16 @@
-// Consistent normal orientation by propagation along a minimum spanning tree: Hoppe, DeRose,
-// Duchamp, McDonald, Stuetzle, "Surface reconstruction from unorganized points", SIGGRAPH 1992,
-// section 3.3. The graph is the symmetrized k-nearest-neighbour graph with edge weight
-// 1 - |n_i·n_j|, so the tree follows the smoothest paths and crosses creases last. Each connected
-// component is seeded at its point farthest from the centroid of the whole cloud (Hoppe seeds
-// at the largest z instead; the farthest point lies on the convex hull and works for any
-// rotation); then the component's points vote whether its normals point away from the centroid,
-// and the whole component is flipped when they mostly do not.
+// Consistent normal orientation by propagation along a spanning tree of smooth edges: Hoppe,
+// DeRose, Duchamp, McDonald, Stuetzle, "Surface reconstruction from unorganized points",
+// SIGGRAPH 1992, section 3.3. The graph is the symmetrized k-nearest-neighbour graph with edge
+// weight 1 - |n_i·n_j|, so the tree follows the smoothest paths and crosses creases last. Hoppe
+// grows one minimum spanning tree by Prim's algorithm, which runs on one thread and jumps over the
+// whole cloud; here the Morton-ordered points are cut into pieces of kPiece points (compact blocks
+// of space) that grow their own minimum spanning trees in parallel, in cache; then the
+// components of all pieces are joined by Kruskal's rule on the graph of components, strongest
+// evidence first, the evidence of a pair being the summed n_u·n_v of the edges between them.
+// Finally each joined surface's points vote whether its normals point away from the centroid,
+// and the whole surface is flipped when they mostly do not (Hoppe seeds at the largest z; a
+// vote works for any rotation and for surfaces that face the centroid in places, like a torus).
+// The pieces do not depend on the thread count, so neither do the normals.
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -20,6 +25,9 @@ namespace pointillist::prep_detail {
 namespace {
 
 constexpr std::size_t kGrain = 1 << 14;
+// Points per piece of the orientation forest: a piece's nodes and rows stay in cache while its
+// trees grow.
+constexpr std::size_t kPiece = 1 << 14;
 constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 constexpr std::uint32_t kInTree = kNone - 1;
 
@@ -27,7 +35,7 @@ constexpr std::uint32_t kInTree = kNone - 1;
 struct Node {
   Vec3f normal;
   float key = std::numeric_limits<float>::infinity();  // lightest edge to the tree so far
-  std::uint32_t parent = kNone;
+  std::uint32_t parent = kNone;  // in the frontier: its tree neighbour; in the tree: component
   std::uint32_t slot = kNone;  // place in the heap; kNone before the push, kInTree after the pop
 };
 
@@ -183,6 +191,75 @@ Vec3f centroid(std::span<const Vec3f> positions, ThreadPool& pool) {
   return {float(s[0] / double(n)), float(s[1] / double(n)), float(s[2] / double(n))};
 }
 
+// Union-find over components with each one's flip relative to its parent, so that joining two
+// sets by "these two agree / are opposite" keeps every relative flip.
+class ParityForest {
+ public:
+  explicit ParityForest(std::size_t n) : parent_(n), flip_(n, 0), size_(n, 1) {
+    for (std::size_t i = 0; i < n; ++i) parent_[i] = static_cast<std::uint32_t>(i);
+  }
+  // The root of x's set and x's flip relative to it.
+  std::pair<std::uint32_t, std::uint8_t> find(std::uint32_t x) {
+    std::uint8_t flip = 0;
+    std::uint32_t r = x;
+    while (parent_[r] != r) {
+      flip ^= flip_[r];
+      r = parent_[r];
+    }
+    // Path compression: point every node on the way at the root, with its flip to it.
+    std::uint8_t rest = flip;
+    while (parent_[x] != r) {
+      const std::uint32_t up = parent_[x];
+      const std::uint8_t own = flip_[x];
+      parent_[x] = r;
+      flip_[x] = rest;
+      rest ^= own;
+      x = up;
+    }
+    return {r, flip};
+  }
+  // Joins the sets of a and b so that a and b flip alike (or oppositely); false when they are
+  // already in one set.
+  bool join(std::uint32_t a, std::uint32_t b, bool opposite) {
+    const auto [ra, fa] = find(a);
+    const auto [rb, fb] = find(b);
+    if (ra == rb) return false;
+    const auto [big, small] = size_[ra] >= size_[rb] ? std::pair{ra, rb} : std::pair{rb, ra};
+    parent_[small] = big;
+    flip_[small] = std::uint8_t(fa ^ fb ^ (opposite ? 1 : 0));
+    size_[big] += size_[small];
+    return true;
+  }
+
+ private:
+  std::vector<std::uint32_t> parent_;
+  std::vector<std::uint8_t> flip_;
+  std::vector<std::uint32_t> size_;
+};
+
+// Evidence between two components of different pieces: the sum of n_u·n_v over the neighbour
+// edges that join them (positive: their normals agree as oriented so far).
+struct Link {
+  std::uint32_t a, b;  // a < b
+  double sum;
+};
+
+// Sorts links by pair and sums each pair's evidence, in the order given (stable).
+void merge_links(std::vector<Link>& links) {
+  std::stable_sort(links.begin(), links.end(), [](const Link& x, const Link& y) {
+    return x.a < y.a || (x.a == y.a && x.b < y.b);
+  });
+  std::size_t out = 0;
+  for (std::size_t i = 0; i < links.size(); ++i) {
+    if (out > 0 && links[out - 1].a == links[i].a && links[out - 1].b == links[i].b) {
+      links[out - 1].sum += links[i].sum;
+    } else {
+      links[out++] = links[i];
+    }
+  }
+  links.resize(out);
+}
+
 }  // namespace
 
 void orient_normals_ordered(const OrderedCloud& cloud, std::uint32_t graph_k,
@@ -196,97 +273,136 @@ void orient_normals_ordered(const OrderedCloud& cloud, std::uint32_t graph_k,
   const std::span<const Vec3f> p = cloud.positions;
   const ReverseEdges reverse = m > 0 ? missing_reverse_edges(cloud, m, pool) : ReverseEdges{};
   const Vec3f c = centre ? *centre : centroid(p, pool);
-  const auto far = [&](std::size_t i) {
-    const float f = length_squared(p[i] - c);
-    return std::isfinite(f) ? f : -1.0f;
-  };
 
-  // Prim's algorithm; a point is oriented when it joins the tree, from its parent.
+  // 1. Each piece (a run of kPiece points in Morton order, a compact block of space) grows
+  // Prim's trees over the edges inside it, in parallel: a point is oriented when it joins the
+  // tree, from its parent. Each tree is a component of the piece, seeded at its first point.
   std::vector<Node> nodes(n);
-  for (std::size_t i = 0; i < n; ++i) nodes[i].normal = normals[i];
-  FrontierHeap heap(nodes);
-  std::size_t joined = 0;
-  const auto relax = [&](const Node& from, std::uint32_t u, std::uint32_t v) {
-    Node& to = nodes[v];
-    if (to.slot == kInTree) return;
-    const float w = std::max(0.0f, 1.0f - std::abs(dot(from.normal, to.normal)));
-    if (w < to.key) {
-      to.key = w;
-      to.parent = u;
-      if (to.slot == kNone) {
-        heap.push(v);
-      } else {
-        heap.decreased(v);
+  parallel_for(pool, n, kGrain, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) nodes[i].normal = normals[i];
+  });
+  const std::size_t pieces = (n + kPiece - 1) / kPiece;
+  std::vector<std::vector<double>> votes(pieces);  // per component: sum of n·(p - c)
+  pool.run(pieces, [&](std::size_t piece) {
+    const auto lo = static_cast<std::uint32_t>(piece * kPiece);
+    const auto size = static_cast<std::uint32_t>(std::min(kPiece, n - lo));
+    FrontierHeap heap(nodes);
+    const auto relax = [&](const Node& from, std::uint32_t u, std::uint32_t v) {
+      if (v - lo >= size) return;  // outside the piece
+      Node& to = nodes[v];
+      if (to.slot == kInTree) return;
+      const float w = std::max(0.0f, 1.0f - std::abs(dot(from.normal, to.normal)));
+      if (w < to.key) {
+        to.key = w;
+        to.parent = u;
+        if (to.slot == kNone) {
+          heap.push(v);
+        } else {
+          heap.decreased(v);
+        }
       }
-    }
-  };
-  const auto in_tree = [&](std::size_t i) { return nodes[i].slot == kInTree; };
-  std::vector<std::uint32_t> members;
-  std::uint32_t component_count = 0;
-  if (components) components->assign(n, 0);
-  const auto grow_tree = [&](std::uint32_t seed) {
-    if (dot(nodes[seed].normal, p[seed] - c) < 0.0f) nodes[seed].normal = -nodes[seed].normal;
-    nodes[seed].key = 0.0f;
-    heap.push(seed);
-    members.clear();
-    while (!heap.empty()) {
-      const std::uint32_t u = heap.pop();
-      members.push_back(u);
-      Node& node = nodes[u];
-      if (node.parent != kNone && dot(node.normal, nodes[node.parent].normal) < 0.0f) {
-        node.normal = -node.normal;
+    };
+    std::vector<double>& vote = votes[piece];
+    for (std::uint32_t seed = lo; seed < lo + size; ++seed) {
+      if (nodes[seed].slot == kInTree) continue;
+      const auto id = static_cast<std::uint32_t>(vote.size());
+      double sum = 0;
+      nodes[seed].key = 0.0f;
+      heap.push(seed);
+      while (!heap.empty()) {
+        const std::uint32_t u = heap.pop();
+        Node& node = nodes[u];
+        if (node.parent != kNone && dot(node.normal, nodes[node.parent].normal) < 0.0f) {
+          node.normal = -node.normal;
+        }
+        node.parent = id;  // the parent is not needed once u is oriented
+        sum += double(dot(node.normal, p[u] - c));
+        for (const std::uint32_t v : cloud.row(u).first(m)) relax(node, u, v);
+        for (std::uint32_t e = reverse.begin[u]; e < reverse.begin[u + 1]; ++e) {
+          relax(node, u, reverse.from[e]);
+        }
       }
-      for (const std::uint32_t v : cloud.row(u).first(m)) relax(node, u, v);
-      for (std::uint32_t e = reverse.begin[u]; e < reverse.begin[u + 1]; ++e) {
-        relax(node, u, reverse.from[e]);
-      }
-      if (++joined % 65536 == 0) phase.advance(65536);
+      vote.push_back(sum);
     }
-    // The component's points vote: normals are made to point away from the centroid where,
-    // summed over the component, they most do (each point weighted by how squarely its normal
-    // faces away from or toward the centroid). One seed alone can sit where "away" is
-    // ambiguous (the edge of a ground plane) and turn a whole scan inside out.
-    double vote = 0;
-    for (const std::uint32_t u : members) vote += double(dot(nodes[u].normal, p[u] - c));
-    if (components) {
-      for (const std::uint32_t u : members) (*components)[u] = component_count;
-    }
-    ++component_count;
-    if (vote < 0) {
-      for (const std::uint32_t u : members) nodes[u].normal = -nodes[u].normal;
-    }
-  };
+    phase.advance(size / 2);
+  });
 
-  // Each component is seeded at its farthest point: the farthest point not yet in a tree always
-  // is one. A scan finds it; after kScans components the rest are sorted by distance once.
-  constexpr int kScans = 8;
-  for (int scan = 0; scan < kScans && joined < n; ++scan) {
-    std::uint32_t seed = kNone;
-    float seed_far = -2.0f;  // below every far()
-    for (std::size_t i = 0; i < n; ++i) {
-      if (in_tree(i)) continue;
-      const float f = far(i);
-      if (f > seed_far) {  // ties go to the lower index
-        seed_far = f;
-        seed = static_cast<std::uint32_t>(i);
+  // 2. Components of different pieces are joined through the edges between them: per pair,
+  // the sum of n_u·n_v over those edges says whether they agree. Pairs are joined strongest
+  // evidence first (Kruskal's rule on the graph of components), so a few edges across a crease
+  // cannot overrule many along a smooth surface.
+  std::vector<std::size_t> first(pieces + 1, 0);
+  for (std::size_t piece = 0; piece < pieces; ++piece) {
+    first[piece + 1] = first[piece] + votes[piece].size();
+  }
+  const std::size_t count = first[pieces];
+  const auto global = [&](std::uint32_t u) {
+    return static_cast<std::uint32_t>(first[u / kPiece] + nodes[u].parent);
+  };
+  std::vector<std::vector<Link>> piece_links(pieces);
+  pool.run(pieces, [&](std::size_t piece) {
+    const std::size_t lo = piece * kPiece, hi = std::min(n, lo + kPiece);
+    std::vector<Link>& links = piece_links[piece];
+    for (std::size_t u = lo; u < hi; ++u) {
+      for (const std::uint32_t v : cloud.row(u).first(m)) {
+        if (v / kPiece == piece) continue;
+        const std::uint32_t a = global(std::uint32_t(u)), b = global(v);
+        links.push_back({std::min(a, b), std::max(a, b),
+                         double(dot(nodes[u].normal, nodes[v].normal))});
       }
     }
-    grow_tree(seed);
+    merge_links(links);
+    phase.advance((hi - lo) - (hi - lo) / 2);
+  });
+  std::vector<Link> links;
+  for (auto& l : piece_links) {
+    links.insert(links.end(), l.begin(), l.end());
+    l = {};
   }
-  if (joined < n) {
-    std::vector<std::pair<float, std::uint32_t>> rest;
-    for (std::size_t i = 0; i < n; ++i) {
-      if (!in_tree(i)) rest.emplace_back(far(i), static_cast<std::uint32_t>(i));
-    }
-    std::sort(rest.begin(), rest.end(), [](const auto& a, const auto& b) {
-      return a.first > b.first || (a.first == b.first && a.second < b.second);
-    });
-    for (const auto& [d2, i] : rest) {
-      if (!in_tree(i)) grow_tree(i);
-    }
+  merge_links(links);  // piece order within a pair: the same sums for any thread count
+  std::sort(links.begin(), links.end(), [](const Link& x, const Link& y) {
+    const double sx = std::abs(x.sum), sy = std::abs(y.sum);
+    return sx > sy || (sx == sy && (x.a < y.a || (x.a == y.a && x.b < y.b)));
+  });
+  ParityForest forest(count);
+  for (const Link& l : links) {
+    if (l.sum != 0) forest.join(l.a, l.b, l.sum < 0);  // no evidence either way: no link
   }
-  for (std::size_t i = 0; i < n; ++i) normals[i] = nodes[i].normal;
-  phase.advance(joined % 65536);
+
+  // 3. Each joined surface's points vote: its normals are made to point away from the centroid
+  // where, summed over the surface, they most do (each point weighted by how squarely its
+  // normal faces away from or toward the centroid). One seed alone can sit where "away" is
+  // ambiguous (the edge of a ground plane) and turn a whole scan inside out.
+  std::vector<double> vote(count);
+  for (std::size_t piece = 0; piece < pieces; ++piece) {
+    std::copy(votes[piece].begin(), votes[piece].end(), vote.begin() + std::ptrdiff_t(first[piece]));
+  }
+  votes = {};
+  std::vector<std::uint8_t> flip(count);
+  std::vector<std::uint32_t> root(count);
+  std::vector<double> surface_vote(count, 0.0);
+  for (std::uint32_t g = 0; g < count; ++g) {
+    const auto [r, f] = forest.find(g);
+    root[g] = r;
+    flip[g] = f;
+    surface_vote[r] += f ? -vote[g] : vote[g];  // in component order: the same bits always
+  }
+  // Surfaces are numbered in the order of their first point.
+  std::vector<std::uint32_t> number(count, kNone);
+  std::uint32_t surfaces = 0;
+  for (std::uint32_t g = 0; g < count; ++g) {
+    if (number[root[g]] == kNone) number[root[g]] = surfaces++;
+    number[g] = number[root[g]];
+    flip[g] ^= surface_vote[root[g]] < 0 ? 1 : 0;
+  }
+  if (components) components->resize(n);
+  parallel_for(pool, n, kGrain, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t u = begin; u < end; ++u) {
+      const std::uint32_t g = global(std::uint32_t(u));
+      normals[u] = flip[g] ? -nodes[u].normal : nodes[u].normal;
+      if (components) (*components)[u] = number[g];
+    }
+  });
 }
 
 }  // namespace pointillist::prep_detail

@@ -45,12 +45,13 @@ std::vector<T> to_caller_order(const OrderedCloud& cloud, std::span<const T> in,
 std::vector<Vec3f> pca_normals_ordered(const OrderedCloud& cloud, std::uint32_t k, ThreadPool& pool,
                                        Progress& progress);
 
-// Flips normals in place so neighbours agree, propagating along a minimum spanning tree of the
-// symmetrized graph of the first `graph_k` neighbours (Hoppe et al. 1992, section 3.3);
+// Flips normals in place so neighbours agree, propagating along minimum spanning trees of the
+// symmetrized graph of the first `graph_k` neighbours inside pieces of the Morton order, then
+// joining the pieces' components (Hoppe et al. 1992, section 3.3; normal_orientation.cpp);
 // progress phase "orientation".
 // `centre`: the point "away" is measured from; null: the cloud's centroid. `components`, when
-// not null, receives each point's connected component of the graph (numbered in the order they
-// were oriented), Morton order.
+// not null, receives each point's joined surface (oriented each on its own), numbered in the
+// order of their first point, Morton order.
 void orient_normals_ordered(const OrderedCloud& cloud, std::uint32_t graph_k,
                             std::span<Vec3f> normals, ThreadPool& pool, Progress& progress,
                             const Vec3f* centre = nullptr,

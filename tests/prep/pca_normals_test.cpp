@@ -2,9 +2,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
+#include <set>
 
 #include "pointillist/core/error.hpp"
 #include "pointillist/prep/normals.hpp"
+#include "pointillist/prep/prepare.hpp"
 #include "pointillist/scene/analytic.hpp"
 
 using namespace pointillist;
@@ -116,6 +119,39 @@ TEST(PcaNormals, IsolatedClustersAreSeededAwayFromTheCentroid) {
   for (std::size_t i = 0; i < p.size(); ++i) {
     EXPECT_GT(n[i].x * p[i].x, 0.0f) << "point " << i;
   }
+}
+
+TEST(PcaNormals, ATorusCutIntoManyPiecesIsOrientedAsOne) {
+  // 200,000 samples: twelve pieces of the orientation forest, each a block of space whose trees
+  // are grown on their own; the pieces must be joined consistently, including those of the
+  // inner half that faces the centroid.
+  const SurfaceSamples s = sample_scene(torus_scene(1.0f, 0.35f), 200'000, 6);
+  ThreadPool pool(2);
+  const NormalErrors e = compare(pca_normals(s.points.positions, pool), s.true_normals);
+  EXPECT_LT(e.mean_deg, 1.0);
+  EXPECT_EQ(e.inward, 0u);
+}
+
+TEST(PcaNormals, EachSeparateShapeIsOneOrientationComponent) {
+  // Sphere, torus and cube apart, 60,000 samples (four pieces, which cut the shapes): every
+  // shape is one joined surface and no two shapes share one.
+  const SurfaceSamples s = sample_scene(demo_scene(), 60'000, 7);
+  ThreadPool pool(2);
+  PointSet points = s.points;
+  points.normals.clear();
+  points.radii.clear();
+  std::vector<std::uint32_t> components;
+  prepare_splats(points, pool, Progress::none(), {.orientation_components = &components});
+  ASSERT_EQ(components.size(), s.points.size());
+  std::map<std::uint32_t, std::set<std::uint32_t>> shapes_of;  // component -> shapes
+  std::map<std::uint32_t, std::set<std::uint32_t>> components_of;
+  for (std::size_t i = 0; i < components.size(); ++i) {
+    shapes_of[components[i]].insert(s.shape_ids[i]);
+    components_of[s.shape_ids[i]].insert(components[i]);
+  }
+  EXPECT_EQ(components_of.size(), 3u);
+  for (const auto& [shape, ids] : components_of) EXPECT_EQ(ids.size(), 1u) << "shape " << shape;
+  for (const auto& [id, shapes] : shapes_of) EXPECT_EQ(shapes.size(), 1u) << "component " << id;
 }
 
 TEST(PcaNormals, SameBitsForAnyThreadCount) {
