@@ -28,7 +28,11 @@ class MergedInputs {
   // As merge_inputs warns: files without colours among files with them are drawn grey.
   std::optional<std::string> colour_warning() const;
 
-  std::uint64_t count() const { return count_; }
+  // Points the passes see: the inputs' less the dropped.
+  std::uint64_t count() const { return count_ - dropped_.size(); }
+  // From now on the passes skip these points (input indices, ascending, unique) and number the
+  // others consecutively.
+  void drop(std::vector<std::uint64_t> indices) { dropped_ = std::move(indices); }
   bool has_normals() const { return normals_; }
   bool has_radii() const { return radii_; }
   bool has_colors() const { return colors_; }
@@ -41,11 +45,13 @@ class MergedInputs {
     for (const auto& s : streams_) normals_ = normals_ && s->saw_usable_normals();
   }
 
-  // Calls fn(batch, index of its first point) over every point, in order; tells `progress`
-  // which file it reads when there are several.
+  // Calls fn(batch, index of its first point) over every point not dropped, in order; tells
+  // `progress` which file it reads when there are several.
   template <class Fn>
   void for_each_batch(Progress& progress, Fn&& fn) {
-    std::uint64_t next = 0;
+    std::uint64_t next = 0, read = 0;  // points passed on; points read
+    std::size_t skip = 0;              // the next dropped index
+    std::vector<std::uint8_t> keep;
     PointSet batch;
     for (std::size_t k = 0; k < streams_.size(); ++k) {
       const auto& stream = streams_[k];
@@ -68,8 +74,17 @@ class MergedInputs {
         if (!normals_) batch.normals.clear();
         if (!radii_) batch.radii.clear();
         if (colors_ && batch.colors.empty()) batch.colors.assign(n, kMissingColor);
+        if (skip < dropped_.size() && dropped_[skip] < read + n) {
+          keep.assign(n, 1);
+          for (; skip < dropped_.size() && dropped_[skip] < read + n; ++skip) {
+            keep[dropped_[skip] - read] = 0;
+          }
+          keep_points(batch, keep);
+        }
+        read += n;
+        if (batch.size() == 0) continue;
         fn(batch, next);
-        next += n;
+        next += batch.size();
       }
     }
   }
@@ -82,6 +97,7 @@ class MergedInputs {
   Vec3f up_{0, 1, 0};
   std::vector<std::string> comments_;
   std::set<std::string> seen_;
+  std::vector<std::uint64_t> dropped_;
 };
 
 }  // namespace pointillist::chunking

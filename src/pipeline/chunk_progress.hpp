@@ -18,9 +18,15 @@ namespace pointillist::chunking {
 // from the profile of a 10 M-point run, where preparing the chunks, their neighbours, normals
 // and radii, is most of it), as one overall figure in points: phase names and totals go to
 // `inner` as they are.
+// The outlier pass of --drop-outliers: its scan, plan and distribute, and the outliers phase.
+constexpr double kOutlierPassShare = 0.03 + 0.03 + 0.05 + 0.10;
+
 class OverallProgress final : public Progress {
  public:
-  OverallProgress(Progress& inner, std::uint64_t points) : inner_(inner), points_(points) {}
+  // `extra_share`: phases that run on top of the usual ones (the outlier pass: its scan, plan,
+  // distribute and outliers phases), as a share of the usual whole.
+  OverallProgress(Progress& inner, std::uint64_t points, double extra_share = 0.0)
+      : inner_(inner), points_(points), whole_(1.0 + extra_share) {}
   void begin_phase(std::string_view name, std::uint64_t total) override {
     inner_.begin_phase(name, total);
     phase_ = kPhases.size();
@@ -60,7 +66,8 @@ class OverallProgress final : public Progress {
     std::string_view name;
     double share;
   };
-  static constexpr std::array<Phase, 7> kPhases = {{{"scan", 0.03},
+  static constexpr std::array<Phase, 8> kPhases = {{{"outliers", 0.10},
+                                                    {"scan", 0.03},
                                                     {"plan", 0.03},
                                                     {"distribute", 0.05},
                                                     {"prepare", 0.55},
@@ -72,10 +79,11 @@ class OverallProgress final : public Progress {
     if (phase_ < kPhases.size() && total_ > 0) {
       f += kPhases[phase_].share * std::min(1.0, double(done_.load()) / double(total_));
     }
-    inner_.overall(std::uint64_t(std::min(1.0, f) * double(points_)), points_);
+    inner_.overall(std::uint64_t(std::min(1.0, f / whole_) * double(points_)), points_);
   }
   Progress& inner_;
   std::uint64_t points_;
+  double whole_;
   std::size_t phase_ = kPhases.size();
   std::uint64_t total_ = 0;
   std::atomic<std::uint64_t> done_{0};

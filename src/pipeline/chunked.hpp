@@ -26,11 +26,14 @@ constexpr std::uint64_t kPlanBytesPerPoint = 16;
 // A chunk's halo reaches this many point spacings beyond its box (a 16-neighbourhood on a
 // surface spans about 2.3).
 constexpr float kHaloSpacings = 6.0f;
+// With outlier removal the halo reaches this much farther: a point's verdict takes its
+// neighbours' neighbourhoods, and the chunk's own points need the verdicts of their neighbours.
+constexpr float kOutlierHaloFactor = 2.0f;
 
 // Converts `inputs` (point clouds) to the .ptl v2 file `output` in chunks of at most
 // `max_chunk_points` points (rounded to the hierarchy's levels). `metadata_head` starts the
 // file's metadata (the comments follow). Throws OptionError for options it cannot honour yet
-// (--drop-outliers, --features), Error for a mesh input, and what reading and writing throw.
+// (--features), Error for a mesh input, and what reading and writing throw.
 ConvertResult convert_chunked(std::span<const std::string> inputs, const std::string& output,
                               const ConvertOptions& options, const std::string& metadata_head,
                               std::uint64_t max_chunk_points, ThreadPool& pool,

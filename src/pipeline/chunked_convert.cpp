@@ -11,6 +11,9 @@
 //      subtree, is summarized and kept on disk as its splats in split order;
 //   5. write: a PtlV2PartWriter lays out the file over the summaries; each chunk's subtree is
 //      rebuilt from its splats (no partition: they are in split order) and written in place.
+// With --drop-outliers, steps 1-3 run once before, with a wider halo, for each chunk to find its
+// outliers (chunk_stages.hpp); the real pass skips them, so its chunks are cut from the points the
+// conversion in one piece keeps and give its hierarchy.
 // Everything goes to a folder beside the output, removed at the end and on failure; the output
 // appears only when complete.
 #include <algorithm>
@@ -31,6 +34,7 @@
 #include "chunk_messages.hpp"
 #include "chunk_orientation.hpp"
 #include "chunk_plan.hpp"
+#include "chunk_stages.hpp"
 #include "chunk_progress.hpp"
 #include "chunked.hpp"
 #include "pointillist/core/error.hpp"
@@ -43,212 +47,6 @@
 namespace pointillist::chunking {
 namespace {
 
-// Binary levels of the plan: enough chunks for `max_points` each, paired as the hierarchy's
-// levels pair (sphere_tree_root_halves), at least one level.
-std::uint32_t plan_levels(std::uint64_t n, std::uint64_t max_points) {
-  std::uint32_t levels = 1;
-  while ((n >> levels) > max_points && levels < 20) ++levels;
-  const bool odd = sphere_tree_root_halves(n);
-  if ((levels % 2 == 1) != odd) ++levels;
-  while (levels > 1 && (n >> levels) < 2) levels -= 2;
-  return levels;
-}
-
-// Calls fn(chunk, pool) for each of `chunks`, `workers` chunks at a time, each worker with a
-// pool of its own (one thread): the serial parts of preparing a chunk (its orientation tree)
-// then overlap. Results go to per-chunk slots, so they do not depend on the worker count.
-void for_each_chunk(std::span<const std::size_t> chunks, ThreadPool& pool,
-                    const std::function<void(std::size_t, ThreadPool&)>& fn) {
-  const std::size_t workers = std::min<std::size_t>(pool.thread_count(), chunks.size());
-  if (workers <= 1) {
-    for (const std::size_t c : chunks) fn(c, pool);
-    return;
-  }
-  std::vector<std::unique_ptr<ThreadPool>> pools;
-  for (std::size_t w = 0; w < workers; ++w) pools.push_back(std::make_unique<ThreadPool>(1));
-  std::atomic<std::size_t> next{0};
-  pool.run(workers, [&](std::size_t w) {
-    for (std::size_t k; (k = next.fetch_add(1)) < chunks.size();) fn(chunks[k], *pools[w]);
-  });
-}
-
-// What rank 0 learns from the inputs and the plan, and every rank needs.
-struct Shared {
-  std::uint64_t n = 0;
-  RecordLayout layout;
-  bool colors = false;
-  Vec3f centroid;
-  ChunkPlan plan;
-  std::vector<float> reach;  // halo reach of each chunk
-  std::string input_name;    // for messages
-};
-
-void broadcast_shared(ChunkJobs& jobs, Shared& s) {
-  MessageWriter w;
-  if (jobs.rank() == 0) {
-    w.put(s.n);
-    w.put(s.layout);
-    w.put(s.colors);
-    w.put(s.centroid);
-    w.put(s.plan.levels);
-    w.put_vector(s.plan.splits);
-    w.put_vector(s.plan.counts);
-    w.put_vector(s.plan.boxes);
-    w.put_vector(s.reach);
-    w.put_vector(std::vector<char>(s.input_name.begin(), s.input_name.end()));
-  }
-  jobs.broadcast(w.bytes());
-  if (jobs.rank() == 0) return;
-  MessageReader r(w.bytes());
-  s.n = r.get<std::uint64_t>();
-  s.layout = r.get<RecordLayout>();
-  s.colors = r.get<bool>();
-  s.centroid = r.get<Vec3f>();
-  s.plan.levels = r.get<std::uint32_t>();
-  s.plan.splits = r.get_vector<Split>();
-  s.plan.counts = r.get_vector<std::uint64_t>();
-  s.plan.boxes = r.get_vector<Aabb>();
-  s.reach = r.get_vector<float>();
-  const auto name = r.get_vector<char>();
-  s.input_name.assign(name.begin(), name.end());
-}
-
-// Runs fn, then settles with the other ranks: every rank throws when one failed.
-template <class Fn>
-void step(ChunkJobs& jobs, Fn&& fn) {
-  std::exception_ptr error;
-  try {
-    fn();
-  } catch (...) {
-    error = std::current_exception();
-  }
-  jobs.settle(error);
-}
-
-// Rank 0: the inputs scanned, the plan made, and the chunk files (with halos) written.
-void scan_plan_distribute(MergedInputs& in, const WorkFolder& folder, const ConvertOptions& o,
-                          std::uint64_t budget, std::uint32_t levels, ThreadPool& pool,
-                          Progress& progress, Shared& sh, ConvertResult& result) {
-  const std::uint64_t n = sh.n;
-  // The plan holds every position in memory when the budget allows, else it works from a file
-  // of them.
-  const bool plan_on_disk = n * kPlanBytesPerPoint > budget / 2;
-
-  // The disk must hold the conversion's files at their peak: the positions (for a plan on
-  // disk), then the chunk files (each point once, plus its halo copies), which become the
-  // prepared splats (43 bytes each), then the splats in split order (31 bytes) as the output is
-  // written.
-  {
-    const double halo_share = 0.1;  // a generous bound: chunks of 1 M points have about 2 %
-    const RecordLayout records{in.has_normals(), in.has_radii()};  // at most, before the scan
-    const double per_point = std::max({plan_on_disk ? 12.0 : 0.0,
-                                       double(records.size()) * (1 + halo_share), 43.0,
-                                       31.0 + 12});
-    const std::uint64_t chunk = n >> levels;
-    const auto need = std::uint64_t(double(n) * per_point + double(chunk) * 43);
-    std::error_code error;
-    const std::filesystem::space_info space =
-        std::filesystem::space(std::filesystem::path(folder.file("")).parent_path(), error);
-    if (!error && space.available < need) {
-      throw IoError(folder.file("") + ": the chunked conversion needs about " +
-                    std::to_string(need / 1000000) + " MB of free disk beside the output, " +
-                    std::to_string(space.available / 1000000) +
-                    " MB are free; free some space or write the output to another disk");
-    }
-  }
-
-  // 1. Positions, their box and centroid.
-  std::vector<PlanPoint> positions;
-  std::optional<ChunkFiles> position_file;
-  if (plan_on_disk) {
-    position_file.emplace(folder, 1, "positions", std::size_t{1} << 22);
-  } else {
-    positions.reserve(n);
-  }
-  double sum[3] = {0, 0, 0};
-  Aabb box;
-  {
-    ProgressPhase phase(progress, "scan", n);
-    std::uint64_t seen = 0;
-    in.for_each_batch(progress, [&](const PointSet& b, std::uint64_t) {
-      for (const Vec3f& p : b.positions) {
-        if (!is_finite(p)) {
-          throw Error(sh.input_name + ": vertex " + std::to_string(seen) +
-                      " has a non-finite position; remove it from the file");
-        }
-        if (plan_on_disk) {
-          position_file->append(0, &p, sizeof p);
-        } else {
-          positions.push_back({p, static_cast<std::uint32_t>(seen)});
-        }
-        ++seen;
-        box.extend(p);
-        sum[0] += p.x;
-        sum[1] += p.y;
-        sum[2] += p.z;
-      }
-      phase.advance(b.size());
-    });
-    if (position_file) position_file->flush_all();
-  }
-  in.drop_unusable_normals();
-  sh.layout = {in.has_normals(), in.has_radii()};
-  sh.centroid = {float(sum[0] / double(n)), float(sum[1] / double(n)), float(sum[2] / double(n))};
-
-  // 2. The plan.
-  {
-    ProgressPhase phase(progress, "plan", n);
-    if (plan_on_disk) {
-      const std::string path = folder.file(ChunkFiles::name("positions", 0));
-      // A quarter of the budget for the selections' candidates (32 bytes each).
-      const std::size_t candidates = std::max<std::uint64_t>(budget / 4 / 32, 1024);
-      sh.plan = plan_chunks_on_disk(path, n, box, levels, candidates, pool, progress);
-      std::filesystem::remove(path);
-    } else {
-      sh.plan = plan_chunks(std::move(positions), levels, pool);
-      phase.advance(n);
-    }
-  }
-  std::vector<PlanPoint>().swap(positions);
-  const ChunkPlan& plan = sh.plan;
-  const std::size_t chunks = plan.chunk_count();
-  // Halo reach: a multiple of the chunk's point spacing (its box's two largest extents over its
-  // point count, as for a surface), scaled with the neighbourhood size.
-  sh.reach.assign(chunks, 0.0f);
-  float max_reach = 0;
-  const float neighbourhood = std::sqrt(std::max(16.0f, float(o.prepare.k)) / 16.0f);
-  for (std::size_t c = 0; c < chunks; ++c) {
-    const Vec3f e = plan.boxes[c].hi - plan.boxes[c].lo;
-    float x[3] = {e.x, e.y, e.z};
-    std::sort(x, x + 3);
-    const float spacing = std::sqrt(x[2] * x[1] / float(std::max<std::uint64_t>(plan.counts[c], 1)));
-    sh.reach[c] = kHaloSpacings * spacing * neighbourhood;
-    max_reach = std::max(max_reach, sh.reach[c]);
-  }
-
-  // 3. Distribute.
-  const std::size_t buffer_bytes =
-      std::clamp<std::size_t>((std::size_t{256} << 20) / chunks, 4096, 1 << 20);
-  ChunkFiles files(folder, chunks, "chunk", buffer_bytes);
-  ProgressPhase phase(progress, "distribute", n);
-  std::vector<char> record(sh.layout.size());
-  in.for_each_batch(progress, [&](const PointSet& b, std::uint64_t first) {
-    for (std::size_t i = 0; i < b.size(); ++i) {
-      const Vec3f& p = b.positions[i];
-      const std::uint32_t own = plan.chunk_of(p, first + i);
-      encode_record(sh.layout, b, i, first + i, false, record.data());
-      files.append(own, record.data(), record.size());
-      record[15] = 1;
-      plan.for_near_chunks(p, own, sh.reach, max_reach, [&](std::uint32_t c) {
-        files.append(c, record.data(), record.size());
-        ++result.halo_points;
-      });
-    }
-    phase.advance(b.size());
-  });
-  files.flush_all();
-}
-
 std::string relations_kind(int rank) { return "relations" + std::to_string(rank); }
 
 }  // namespace
@@ -257,11 +55,6 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
                               const ConvertOptions& o, const std::string& metadata_head,
                               std::uint64_t max_chunk_points, ThreadPool& pool,
                               Progress& outer_progress) {
-  if (o.prepare.drop_outliers) {
-    throw OptionError("convert: --drop-outliers is not available for chunked conversion yet (the "
-                      "input needs more than --memory); give a larger --memory, or drop the "
-                      "outliers first (convert to .ply with --drop-outliers, in parts)");
-  }
   if (o.features) {
     throw OptionError("convert: --features are not available for chunked conversion yet (the "
                       "input needs more than --memory); give a larger --memory");
@@ -276,26 +69,42 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
   std::optional<OverallProgress> overall;
   std::optional<WorkFolder> folder;
   Progress* progress_ptr = &Progress::none();
+  std::uint64_t input_points = 0;
   step(jobs, [&] {
     if (!root) return;
     in.emplace(inputs, o.columns);
-    sh.n = in->count();
+    input_points = in->count();
     sh.colors = in->has_colors();
-    overall.emplace(outer_progress, sh.n);
+    overall.emplace(outer_progress, input_points,
+                    o.prepare.drop_outliers ? kOutlierPassShare : 0.0);
     progress_ptr = &*overall;
     if (const auto warning = in->colour_warning()) result.warnings.push_back(*warning);
-    const std::uint32_t levels = plan_levels(sh.n, std::max<std::uint64_t>(max_chunk_points, 2));
     folder.emplace(output);
-    scan_plan_distribute(*in, *folder, o, budget, levels, pool, *progress_ptr, sh, result);
+  });
+  if (!root) folder.emplace(output, WorkFolder::kJoin);
+  if (o.prepare.drop_outliers) {
+    // A first pass finds the outliers; the conversion then never sees them.
+    std::vector<std::uint64_t> dropped = find_outliers_in_chunks(
+        jobs, root ? &*in : nullptr, *folder, o, max_chunk_points, sh.input_name, pool,
+        *progress_ptr);
+    if (root) in->drop(std::move(dropped));
+  }
+  step(jobs, [&] {
+    if (!root) return;
+    sh.n = in->count();
+    if (sh.n == 0) {
+      throw Error(sh.input_name + ": every point is an outlier; convert without --drop-outliers");
+    }
+    const std::uint32_t levels = plan_levels(sh.n, std::max<std::uint64_t>(max_chunk_points, 2));
+    scan_plan_distribute(*in, *folder, o, budget, levels, 1.0f, pool, *progress_ptr, sh, result);
   });
   broadcast_shared(jobs, sh);
-  if (!root) folder.emplace(output, WorkFolder::kJoin);
   Progress& progress = *progress_ptr;
   const std::uint64_t n = sh.n;
   const ChunkPlan& plan = sh.plan;
   const std::size_t chunks = plan.chunk_count();
   const bool colors = sh.colors;
-  result.input_points = n;
+  result.input_points = root ? input_points : n;
   result.chunks = chunks;
   // This rank's chunks, and their share of the points.
   std::vector<std::size_t> mine;
@@ -324,6 +133,7 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
       s.points = read_chunk(path, sh.layout, colors, own, s.index);
       std::filesystem::remove(path);
       PrepareOptions prepare = o.prepare;
+      prepare.drop_outliers = false;  // the outlier pass dropped them
       prepare.orientation_centre = sh.centroid;
       prepare.input_name = sh.input_name;
       prepare.orientation_components = &s.piece;
@@ -538,7 +348,8 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
     for (const std::string& comment : in->comments()) meta << "comment: " << comment << "\n";
     writer.finish(bounds, {centre, view_radius}, in->origin(), in->up(), meta.str());
   });
-  result.output_points = n;
+  result.output_points = 0;
+  for (const std::uint64_t count : own_count) result.output_points += count;
   if (overall) result.phase_seconds = overall->phase_seconds();
   return result;
 }

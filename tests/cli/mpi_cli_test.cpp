@@ -72,6 +72,22 @@ TEST(MpiConvert, TwoRanksWriteTheBytesOfOneProcess) {
   EXPECT_FALSE(std::filesystem::exists(two + ".chunks"));
 }
 
+TEST(MpiConvert, TwoRanksDropTheOutliersOfOneProcess) {
+  // The outlier pass runs on both ranks and rank 0 gathers their verdicts.
+  if (skip_without_mpi()) GTEST_SKIP() << "this build has no MPI, or mpirun is not installed";
+  TempDir dir;
+  const std::string cloud = write_cloud(dir, 30000);
+  const std::string one = dir.file("one.ptl"), two = dir.file("two.ptl");
+  const std::string options = " --chunk-points 2000 --drop-outliers --threads ";
+  const CliResult a = testing::run_cli("convert " + cloud + " -o " + one + options + "2");
+  ASSERT_EQ(a.exit_code, 0) << a.output;
+  const CliResult b = mpirun2("convert " + cloud + " -o " + two + options + "1");
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  EXPECT_THAT(b.output, HasSubstr("outliers of 30000 points"));
+  EXPECT_TRUE(file_bytes(one) == file_bytes(two)) << "the files differ";
+  EXPECT_FALSE(std::filesystem::exists(two + ".chunks"));
+}
+
 TEST(MpiConvert, AFailingRankStopsEveryRankWithOneMessageAndLeavesNothing) {
   if (skip_without_mpi()) GTEST_SKIP() << "this build has no MPI, or mpirun is not installed";
   TempDir dir;

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <random>
 
 #include "pointillist/core/error.hpp"
 #include "pointillist/eval/image_compare.hpp"
@@ -242,13 +243,69 @@ TEST(ChunkedConvert, LeavesNoChunkFolderAndReplacesALeftOverOne) {
   EXPECT_EQ(files, 2u);  // the input and the output
 }
 
+TEST(ChunkedConvert, DropsTheOutliersTheConversionInOnePieceDrops) {
+  // The demo scene and 40 strays 0.02 to 0.04 scene diagonals above its surfaces (along the
+  // exact normal), spread over the scene and so over many chunks: each chunk judges its points
+  // with a wider halo, and the conversion then plans its chunks without them, so it drops what
+  // the one-piece conversion drops and builds its hierarchy.
+  TempDir dir;
+  const SurfaceSamples samples = sample_scene(demo_scene(), 60000, 12);
+  PointSet p = samples.points;
+  Aabb box;
+  for (const Vec3f& x : p.positions) box.extend(x);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  const std::size_t surface = p.size();
+  for (std::size_t i = 0; i < 40; ++i) {
+    const std::size_t at = i * (surface / 40);
+    const float height = (0.2f + 0.2f * u(rng)) * length(box.hi - box.lo) / 10.0f;
+    p.positions.push_back(p.positions[at] + samples.true_normals[at] * height);
+  }
+  p.normals.clear();
+  p.radii.clear();
+  const std::string input = dir.file("strays.ply");
+  write_ply(input, p);
+  ConvertOptions whole_options, parts_options{.chunk_points = 2000};
+  whole_options.prepare.drop_outliers = parts_options.prepare.drop_outliers = true;
+  ThreadPool pool(2);
+  const std::vector<std::string> inputs{input};
+  const ConvertResult w =
+      convert(inputs, dir.file("whole.ptl"), whole_options, pool, Progress::none());
+  const ConvertResult c =
+      convert(inputs, dir.file("parts.ptl"), parts_options, pool, Progress::none());
+  ASSERT_EQ(w.chunks, 0u);
+  ASSERT_GE(c.chunks, 16u);
+  std::printf("[chunked outliers] one piece dropped %zu, %zu chunks dropped %zu of %zu points\n",
+              w.input_points - w.output_points, c.chunks, c.input_points - c.output_points,
+              c.input_points);
+  EXPECT_GE(w.input_points - w.output_points, 40u);  // the strays, and maybe a few more
+  EXPECT_LE(w.input_points - w.output_points, 40u + surface / 200);
+  EXPECT_EQ(c.output_points, w.output_points);
+  const SphereTree whole = PtlV2File::open(dir.file("whole.ptl"))->decode_all();
+  const SphereTree parts = PtlV2File::open(dir.file("parts.ptl"))->decode_all();
+  EXPECT_EQ(parts.leaf_count, whole.leaf_count);
+  // The same points planned alike: the one-piece hierarchy, bit for bit.
+  ASSERT_EQ(parts.nodes.size(), whole.nodes.size());
+  EXPECT_EQ(differing_nodes({whole, parts, c}), 0u);
+  for (const float az : {0.0f, 120.0f, 240.0f}) {
+    const Camera cam = orbit_camera(whole.view_sphere, {.azimuth_deg = az, .elevation_deg = 25,
+                                                        .width = 400, .height = 300});
+    Frame fa, fb;
+    render(whole.view(), cam, {}, pool, fa);
+    render(parts.view(), cam, {}, pool, fb);
+    EXPECT_GE(psnr_rgb({fa.width, fa.height, fa.color}, {fb.width, fb.height, fb.color}), 40.0)
+        << "azimuth " << az;
+    EXPECT_NEAR(double(fb.stats.splats), double(fa.stats.splats), 0.01 * double(fa.stats.splats));
+  }
+}
+
 TEST(ChunkedConvert, SaysWhatItCannotDoYet) {
   TempDir dir;
   const std::string input = write_cloud(dir, 4000, "scene.ply");
   ThreadPool pool(1);
   const std::vector<std::string> inputs{input};
   ConvertOptions o{.chunk_points = 1000};
-  o.prepare.drop_outliers = true;
+  o.features = FeatureOptions{};
   EXPECT_THROW(convert(inputs, dir.file("a.ptl"), o, pool, Progress::none()), OptionError);
   // A budget too small for the input in one piece, for an output that is only written whole.
   try {
