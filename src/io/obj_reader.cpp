@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "pointillist/core/file_bytes.hpp"
+#include "obj_vertex.hpp"
 #include "ply_body.hpp"
 #include "text_numbers.hpp"
 #include "pointillist/core/error.hpp"
@@ -65,32 +66,12 @@ class ObjParser {
   // `v x y z [w]` or `v x y z r g b`.
   void parse_vertex(const char* p, const char* le) {
     double values[7] = {};
-    int count = 0;
-    const char* first_token = nullptr;
-    for (;;) {
-      p = skip_blanks(p, le);
-      if (p == le) break;
-      if (count == 7) fail_vertex_count(first_token, count + 1);
-      const char* q = parse_real(p, le, values[count]);
-      if (!q)
-        fail(p, "v: value " + std::to_string(count + 1) + ": expected a number, found " +
-                    quote_token(p, le));
-      if (count < 3 && !std::isfinite(values[count]))
-        fail(p, "v: coordinate " + std::to_string(count + 1) + " is not a finite number (found " +
-                    quote_token(p, le) + ")");
-      if (!first_token) first_token = p;
-      ++count;
-      p = q;
-    }
-    if (count != 3 && count != 4 && count != 6) fail_vertex_count(first_token ? first_token : p, count);
+    const auto fail_at = [this](const char* pos, const std::string& what) { fail(pos, what); };
+    const int count = parse_obj_vertex(p, le, values, fail_at);
     if (positions_.empty()) origin_ = text_origin(values);
     if (positions_.size() >= static_cast<std::size_t>(kMaxVertices))
       fail(p, "more than 2^32 - 1 vertices (triangles hold 32-bit indices)");
-    if (const int a = io_detail::axis_beyond_float(values, origin_); a >= 0) {
-      fail(p, "v: coordinate " + std::to_string(a + 1) +
-                  " is too far from the other vertices for a float (more than 3.4e38 from " +
-                  io_detail::short_number(origin_[a]) + "); remove the stray vertex");
-    }
+    check_obj_vertex_fits(values, origin_, le, fail_at);
     positions_.push_back({static_cast<float>(values[0] - origin_[0]),
                           static_cast<float>(values[1] - origin_[1]),
                           static_cast<float>(values[2] - origin_[2])});
@@ -103,11 +84,6 @@ class ObjParser {
       for (int c = 3; c < 6; ++c) max_color_ = std::max(max_color_, values[c]);
       ++colored_count_;
     }
-  }
-
-  [[noreturn, gnu::cold]] void fail_vertex_count(const char* pos, int count) const {
-    fail(pos, "v: expected 3, 4 or 6 numbers (x y z, x y z w, or x y z r g b), found " +
-                  std::to_string(count) + (count > 7 ? " or more" : ""));
   }
 
   void parse_normal(const char* p, const char* le) {

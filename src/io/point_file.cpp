@@ -165,6 +165,7 @@ std::unique_ptr<PointStream> open_point_stream(const std::string& path,
   if (kind == Kind::Ply) stream = io_detail::open_ply_stream(path, options);
   if (kind == Kind::Las) stream = io_detail::open_las_stream(path, options);
   if (kind == Kind::Text) stream = io_detail::open_xyz_stream(path, options);
+  if (kind == Kind::Obj) stream = io_detail::open_obj_stream(path, options);
   if (stream) return stream;
   return std::make_unique<WholeFileStream>(path, read_point_file(path, Progress::none(), options));
 }

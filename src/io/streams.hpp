@@ -29,6 +29,12 @@ std::unique_ptr<PointStream> open_las_stream(const std::string& path,
 std::unique_ptr<PointStream> open_xyz_stream(const std::string& path,
                                              const PointReadOptions& options);
 
+// A Wavefront OBJ file (gzip too), its `v` lines read a window of lines at a time after one
+// pass over all of them at open (the count, the origin, the colours' presence and scale, and
+// whether faces make it a mesh). Throws what read_obj throws for a bad vertex line.
+std::unique_ptr<PointStream> open_obj_stream(const std::string& path,
+                                             const PointReadOptions& options);
+
 // The point count a LAS file's header states (checked as read_las checks it: every record must
 // be in the file; for gzip data, what it can inflate to). Throws what read_las throws for a bad
 // header.

@@ -79,6 +79,38 @@ PointSet sample_points(std::size_t n, bool normals, bool colors, bool radii) {
   return p;
 }
 
+// Each text file of `files` (name, contents), plain and gzip, with and without colours: its
+// stream states what read_point_file reads and yields its points, bit for bit (a mesh's
+// vertex positions only: their normals come from its faces).
+void expect_text_files_stream_as_read_whole(
+    const TempDir& dir, const std::vector<std::pair<std::string, std::string>>& files) {
+  for (const auto& [name, text] : files) {
+    for (const bool gz : {false, true}) {
+      const std::string path = dir.file(name + (gz ? ".gz" : ""));
+      testing::write_file(path, gz ? testing::gzip(text) : text);
+      for (const bool colors : {true, false}) {
+        SCOPED_TRACE(path + (colors ? "" : ", no colours"));
+        const PointReadOptions options{.read_colors = colors};
+        const auto stream = open_point_stream(path, options);
+        EXPECT_TRUE(stream->info().streamed);
+        const PointSet whole = read_point_file(path, Progress::none(), options);
+        EXPECT_EQ(stream->info().point_count, whole.size());
+        EXPECT_EQ(stream->info().origin, whole.origin);
+        EXPECT_EQ(stream->info().comments, whole.comments);
+        EXPECT_EQ(stream->info().has_colors, whole.has_colors());
+        EXPECT_EQ(stream->info().is_mesh, whole.is_mesh());
+        PointSet streamed = drain(*stream, 100000);
+        if (!stream->saw_usable_normals()) streamed.normals.clear();
+        if (whole.is_mesh()) {
+          EXPECT_TRUE(same_bits(streamed.positions, whole.positions));
+        } else {
+          expect_same_points(streamed, whole);
+        }
+      }
+    }
+  }
+}
+
 TEST(PointStream, BinaryPlyGivesTheSamePointsAsTheWholeFileReader) {
   TempDir dir;
   for (const PlyEncoding encoding : {PlyEncoding::BinaryLittleEndian,
@@ -255,26 +287,7 @@ TEST(PointStream, TextFilesAreStreamedWithTheSamePointsAsTheWholeFileReader) {
       {"words.txt", "# x y z r g b\n0 0 0 65535 0 1000\n1 1 1 300 300 300\n"},
       {"zeros.xyz", "1 2 3 0 0 0\n2 3 4 0 0 0\n"},
       {"big.xyz", big}};
-  for (const auto& [name, text] : files) {
-    for (const bool gz : {false, true}) {
-      const std::string path = dir.file(name + (gz ? ".gz" : ""));
-      testing::write_file(path, gz ? testing::gzip(text) : text);
-      for (const bool colors : {true, false}) {
-        SCOPED_TRACE(path + (colors ? "" : ", no colours"));
-        const PointReadOptions options{.read_colors = colors};
-        const auto stream = open_point_stream(path, options);
-        EXPECT_TRUE(stream->info().streamed);
-        const PointSet whole = read_point_file(path, Progress::none(), options);
-        EXPECT_EQ(stream->info().point_count, whole.size());
-        EXPECT_EQ(stream->info().origin, whole.origin);
-        EXPECT_EQ(stream->info().comments, whole.comments);
-        EXPECT_EQ(stream->info().has_colors, whole.has_colors());
-        PointSet streamed = drain(*stream, 100000);
-        if (!stream->saw_usable_normals()) streamed.normals.clear();
-        expect_same_points(streamed, whole);
-      }
-    }
-  }
+  expect_text_files_stream_as_read_whole(dir, files);
   // The columns option too.
   const std::string path = dir.file("columns.xyz");
   testing::write_file(path, "1 2 3 9 0.5 0.5 0.5\n4 5 6 9 1 0 0\n");
@@ -307,6 +320,48 @@ TEST(PointStream, ReportsABadTextLineAtTheSameLineAsTheWholeFileReader) {
   }
   EXPECT_NE(whole.find("line 333336"), std::string::npos) << whole;
   EXPECT_EQ(streamed, whole);
+}
+
+TEST(PointStream, ObjFilesAreStreamedWithTheSamePointsAsTheWholeFileReader) {
+  TempDir dir;
+  // Past several windows: 14 MB of vertex lines far from the origin, with 0..1 colours, among
+  // normals, texture coordinates, groups and comments.
+  std::string big = "# a scan written as OBJ\no scan\n";
+  for (int i = 0; i < 250000; ++i) {
+    const double a = i * 0.001;
+    big += "v " + std::to_string(512000.25 + std::cos(a) * 40) + " " +
+           std::to_string(5400000.5 + std::sin(a) * 40) + " " + std::to_string(i % 977 * 0.01) +
+           " " + std::to_string((i % 100) / 100.0) + " 0.5 1.0\n";
+    if (i % 50000 == 7) big += "vn 0 0 1\nvt 0.5 0.5\n\n# more points\ng part\n";
+  }
+  const std::vector<std::pair<std::string, std::string>> files = {
+      {"bytes.obj", "v 1 2 3 255 0 0\nv 4 5 6 0 255 0\n\nv 7 8 9 0 0 255"},  // no last newline
+      {"w.obj", "# x y z w\nv 1 2 3 1\nv 4 5 6 1\r\n  v\t7 8 9\n"},
+      {"some.obj", "v 1 2 3 0.5 0.5 0.5\nv 4 5 6\n"},  // colours on one vertex of two: none
+      {"mesh.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1\n"},
+      {"big.obj", big}};
+  expect_text_files_stream_as_read_whole(dir, files);
+}
+
+// A bad vertex far into an OBJ file is reported on the same line as the whole-file reader
+// reports it, when the stream opens.
+TEST(PointStream, ReportsABadObjVertexAtTheSameLineAsTheWholeFileReader) {
+  TempDir dir;
+  for (const std::string bad : {"v 5 5 five", "v 1 2", "v 1 2 3 4 5", "v 1 inf 2",
+                                "v 1 2 3 4 5 6 7 8", "v 1e300 0 0"}) {
+    SCOPED_TRACE(bad);
+    std::string text;
+    for (int i = 0; i < 300000; ++i) {
+      text += "v " + std::to_string(i) + " 1 2\n";
+      if (i == 222222) text += bad + "\n";
+    }
+    const std::string path = dir.file("bad.obj");
+    testing::write_file(path, text);
+    const std::string whole = format_error_of([&] { read_point_file(path); });
+    const std::string streamed = format_error_of([&] { open_point_stream(path); });
+    EXPECT_NE(whole.find("line 222224"), std::string::npos) << whole;
+    EXPECT_EQ(streamed, whole);
+  }
 }
 
 TEST(PointStream, LasGivesTheSamePointsOriginAndColoursAsTheWholeFileReader) {

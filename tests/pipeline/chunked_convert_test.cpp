@@ -146,6 +146,27 @@ TEST(ChunkedConvert, AGzipTextFileGivesTheOnePieceHierarchy) {
   EXPECT_TRUE(c.parts.has_colors);
 }
 
+// A point cloud written as OBJ (`v x y z r g b` lines) streams into chunks and gives the
+// hierarchy of the conversion in one piece (which reads the file whole).
+TEST(ChunkedConvert, AnObjPointCloudGivesTheOnePieceHierarchy) {
+  TempDir dir;
+  const PointSet p = sample_scene(demo_scene(), 20000, 6).points;
+  std::string text = "# a scan\n";
+  char line[160];
+  for (const Vec3f& x : p.positions) {
+    std::snprintf(line, sizeof line, "v %.5f %.5f %.5f %.3f %.3f %.3f\n", x.x, x.y, x.z,
+                  0.5 + 0.2 * x.x, 0.5 + 0.2 * x.y, 0.5 + 0.2 * x.z);
+    text += line;
+  }
+  const std::string input = dir.file("scan.obj");
+  testing::write_file(input, text);
+  const Converted c = convert_both(dir, input, {.chunk_points = 1500});
+  EXPECT_GE(c.parts_result.chunks, 8u);
+  ASSERT_EQ(c.parts.nodes.size(), c.whole.nodes.size());
+  EXPECT_EQ(differing_nodes(c), 0u);
+  EXPECT_TRUE(c.parts.has_colors);
+}
+
 // gzip ASCII and gzip binary PLY inputs stream into chunks (a window of lines; decompressed as
 // read) and give the hierarchy of the conversion in one piece, node for node.
 TEST(ChunkedConvert, GzipAsciiAndBinaryPlyGiveTheOnePieceHierarchy) {

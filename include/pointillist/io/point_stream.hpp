@@ -26,9 +26,8 @@ struct PointStreamInfo {
   // chunked conversion takes point clouds only.
   bool is_mesh = false;
   // Read in windows of the file, so memory does not grow with the file. False: the reader has
-  // no streaming form for this file (OBJ files, and binary PLY files with lists before or in
-  // the vertex element, are read whole when the stream opens) and `resident_bytes` says what
-  // it holds.
+  // no streaming form for this file (binary PLY files with lists before or in the vertex
+  // element are read whole when the stream opens) and `resident_bytes` says what it holds.
   bool streamed = true;
   std::uint64_t resident_bytes = 0;
   std::uint64_t file_size = 0;
