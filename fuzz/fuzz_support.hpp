@@ -11,6 +11,8 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <memory>
 #include <new>
 #include <span>
 #include <string>
@@ -19,6 +21,7 @@
 #include "pointillist/core/error.hpp"
 #include "pointillist/core/point_set.hpp"
 #include "pointillist/core/thread_pool.hpp"
+#include "pointillist/io/point_stream.hpp"
 #include "pointillist/pipeline/model.hpp"
 #include "pointillist/render/renderer.hpp"
 #include "pointillist/render/sequence.hpp"
@@ -41,7 +44,21 @@ class InputFile {
     if (fd_ < 0) finding("memfd_create failed");
     path_ = "/proc/self/fd/" + std::to_string(fd_);
   }
-  ~InputFile() { close(fd_); }
+  ~InputFile() {
+    if (!named_.empty()) unlink(named_.c_str());
+    close(fd_);
+  }
+  // The same file under a name ending in `extension` (a symbolic link in the temporary folder,
+  // removed when the harness exits normally), for readers that go by a file's extension
+  // (open_point_stream).
+  const std::string& named(const std::string& extension) {
+    if (named_.empty()) {
+      named_ = "/tmp/pointillist-fuzz-" + std::to_string(getpid()) + extension;
+      unlink(named_.c_str());
+      if (symlink(path_.c_str(), named_.c_str()) != 0) finding("symlink failed");
+    }
+    return named_;
+  }
   InputFile(const InputFile&) = delete;
   InputFile& operator=(const InputFile&) = delete;
 
@@ -60,7 +77,41 @@ class InputFile {
  private:
   int fd_;
   std::string path_;
+  std::string named_;
 };
+
+// Every point of `stream`, read `batch` at a time: positions and colours.
+inline PointSet drain_stream(PointStream& stream, std::size_t batch) {
+  PointSet all, part;
+  stream.rewind();
+  while (const std::size_t n = stream.read(part, batch)) {
+    if (part.size() != n) finding("a stream batch of the wrong size");
+    all.positions.insert(all.positions.end(), part.positions.begin(), part.positions.end());
+    all.colors.insert(all.colors.end(), part.colors.begin(), part.colors.end());
+  }
+  return all;
+}
+
+// Differential check of a streamed reader: when the whole-file reader read `whole` from `path`,
+// its stream must open and give the same positions and colours, bit for bit.
+inline void expect_stream_matches(const std::string& path, const PointSet& whole) {
+  std::unique_ptr<PointStream> stream;
+  try {
+    stream = open_point_stream(path);
+  } catch (const Error& e) {
+    finding(std::string("the stream refused what the whole reader read: ") + e.what());
+  }
+  if (stream->info().point_count != whole.size()) finding("the stream's point count differs");
+  if (stream->info().is_mesh != whole.is_mesh()) finding("the stream's mesh flag differs");
+  if (stream->info().origin != whole.origin) finding("the stream's origin differs");
+  const PointSet streamed = drain_stream(*stream, 3);
+  const auto same = [](const auto& a, const auto& b) {
+    return a.size() == b.size() &&
+           (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(a[0])) == 0);
+  };
+  if (!same(streamed.positions, whole.positions)) finding("the stream's positions differ");
+  if (!same(streamed.colors, whole.colors)) finding("the stream's colours differ");
+}
 
 // Runs `read` (which reads `path`), catching what a reader may throw for bad input: FormatError
 // (whose message must name the file), IoError, OptionError, and std::bad_alloc when a reader

@@ -1,7 +1,7 @@
 // Wavefront OBJ files (gzip too) streamed a window of lines at a time: the `v` lines of a point
 // cloud written as OBJ, as read_obj gives them, in constant memory. Opening reads every line
 // once: the vertex count, the first vertex (the origin of a file far from zero), whether every
-// vertex has a colour and on which scale, and whether there are faces (a mesh: its vertices
+// vertex has a colour and on which scale, and whether faces make triangles (a mesh: its vertices
 // stream, but the chunked conversion refuses meshes). Each read parses the next `v` lines.
 #include <filesystem>
 #include <string_view>
@@ -36,7 +36,7 @@ class ObjStream final : public PointStream {
     const char* le;
     std::string_view keyword;
     while (next(t, le, keyword)) {
-      if (keyword == "f") faces = true;
+      if (keyword == "f") faces = faces || corners(t, le) >= 3;  // a triangle, as read_obj fans
       if (keyword != "v") continue;
       double values[7] = {};
       const int n = parse_obj_vertex(t, le, values, fail_at());
@@ -101,6 +101,15 @@ class ObjStream final : public PointStream {
   bool saw_usable_normals() const override { return false; }
 
  private:
+  // The blank-separated tokens of [p, le).
+  static int corners(const char* p, const char* le) {
+    int n = 0;
+    for (p = skip_blanks(p, le); p < le; p = skip_blanks(p, le)) {
+      ++n;
+      while (p < le && !is_blank(*p)) ++p;
+    }
+    return n;
+  }
   // The next line that is not blank or a comment: t after its keyword, its end, the keyword.
   bool next(const char*& t, const char*& le, std::string_view& keyword) {
     const char* start;

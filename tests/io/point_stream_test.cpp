@@ -339,6 +339,7 @@ TEST(PointStream, ObjFilesAreStreamedWithTheSamePointsAsTheWholeFileReader) {
       {"w.obj", "# x y z w\nv 1 2 3 1\nv 4 5 6 1\r\n  v\t7 8 9\n"},
       {"some.obj", "v 1 2 3 0.5 0.5 0.5\nv 4 5 6\n"},  // colours on one vertex of two: none
       {"mesh.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1\n"},
+      {"line.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n"},  // no triangle: points
       {"big.obj", big}};
   expect_text_files_stream_as_read_whole(dir, files);
 }
