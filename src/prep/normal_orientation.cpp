@@ -31,11 +31,10 @@ constexpr std::size_t kPiece = 1 << 14;
 constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 constexpr std::uint32_t kInTree = kNone - 1;
 
-// Everything Prim's algorithm touches per point, together.
+// What Prim's algorithm keeps per point of a piece, together.
 struct Node {
-  Vec3f normal;
   float key = std::numeric_limits<float>::infinity();  // lightest edge to the tree so far
-  std::uint32_t parent = kNone;  // in the frontier: its tree neighbour; in the tree: component
+  std::uint32_t parent = kNone;  // its tree neighbour so far (an index of the whole cloud)
   std::uint32_t slot = kNone;  // place in the heap; kNone before the push, kInTree after the pop
 };
 
@@ -277,49 +276,46 @@ void orient_normals_ordered(const OrderedCloud& cloud, std::uint32_t graph_k,
   // 1. Each piece (a run of kPiece points in Morton order, a compact block of space) grows
   // Prim's trees over the edges inside it, in parallel: a point is oriented when it joins the
   // tree, from its parent. Each tree is a component of the piece, seeded at its first point.
-  std::vector<Node> nodes(n);
-  parallel_for(pool, n, kGrain, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) nodes[i].normal = normals[i];
-  });
+  std::vector<std::uint32_t> component(n);        // each point's component in its piece
   const std::size_t pieces = (n + kPiece - 1) / kPiece;
   std::vector<std::vector<double>> votes(pieces);  // per component: sum of n·(p - c)
   pool.run(pieces, [&](std::size_t piece) {
     const auto lo = static_cast<std::uint32_t>(piece * kPiece);
     const auto size = static_cast<std::uint32_t>(std::min(kPiece, n - lo));
+    std::vector<Node> nodes(size);  // indexed from lo
     FrontierHeap heap(nodes);
-    const auto relax = [&](const Node& from, std::uint32_t u, std::uint32_t v) {
-      if (v - lo >= size) return;  // outside the piece
-      Node& to = nodes[v];
+    const auto relax = [&](std::uint32_t u, std::uint32_t v) {
+      const std::uint32_t local = v - lo;
+      if (local >= size) return;  // outside the piece
+      Node& to = nodes[local];
       if (to.slot == kInTree) return;
-      const float w = std::max(0.0f, 1.0f - std::abs(dot(from.normal, to.normal)));
+      const float w = std::max(0.0f, 1.0f - std::abs(dot(normals[u], normals[v])));
       if (w < to.key) {
         to.key = w;
         to.parent = u;
         if (to.slot == kNone) {
-          heap.push(v);
+          heap.push(local);
         } else {
-          heap.decreased(v);
+          heap.decreased(local);
         }
       }
     };
     std::vector<double>& vote = votes[piece];
-    for (std::uint32_t seed = lo; seed < lo + size; ++seed) {
+    for (std::uint32_t seed = 0; seed < size; ++seed) {
       if (nodes[seed].slot == kInTree) continue;
       const auto id = static_cast<std::uint32_t>(vote.size());
       double sum = 0;
       nodes[seed].key = 0.0f;
       heap.push(seed);
       while (!heap.empty()) {
-        const std::uint32_t u = heap.pop();
-        Node& node = nodes[u];
-        if (node.parent != kNone && dot(node.normal, nodes[node.parent].normal) < 0.0f) {
-          node.normal = -node.normal;
-        }
-        node.parent = id;  // the parent is not needed once u is oriented
-        sum += double(dot(node.normal, p[u] - c));
-        for (const std::uint32_t v : cloud.row(u).first(m)) relax(node, u, v);
+        const std::uint32_t u = lo + heap.pop();
+        const std::uint32_t parent = nodes[u - lo].parent;
+        if (parent != kNone && dot(normals[u], normals[parent]) < 0.0f) normals[u] = -normals[u];
+        component[u] = id;
+        sum += double(dot(normals[u], p[u] - c));
+        for (const std::uint32_t v : cloud.row(u).first(m)) relax(u, v);
         for (std::uint32_t e = reverse.begin[u]; e < reverse.begin[u + 1]; ++e) {
-          relax(node, u, reverse.from[e]);
+          relax(u, reverse.from[e]);
         }
       }
       vote.push_back(sum);
@@ -337,7 +333,7 @@ void orient_normals_ordered(const OrderedCloud& cloud, std::uint32_t graph_k,
   }
   const std::size_t count = first[pieces];
   const auto global = [&](std::uint32_t u) {
-    return static_cast<std::uint32_t>(first[u / kPiece] + nodes[u].parent);
+    return static_cast<std::uint32_t>(first[u / kPiece] + component[u]);
   };
   std::vector<std::vector<Link>> piece_links(pieces);
   pool.run(pieces, [&](std::size_t piece) {
@@ -348,7 +344,7 @@ void orient_normals_ordered(const OrderedCloud& cloud, std::uint32_t graph_k,
         if (v / kPiece == piece) continue;
         const std::uint32_t a = global(std::uint32_t(u)), b = global(v);
         links.push_back({std::min(a, b), std::max(a, b),
-                         double(dot(nodes[u].normal, nodes[v].normal))});
+                         double(dot(normals[u], normals[v]))});
       }
     }
     merge_links(links);
@@ -399,7 +395,7 @@ void orient_normals_ordered(const OrderedCloud& cloud, std::uint32_t graph_k,
   parallel_for(pool, n, kGrain, [&](std::size_t begin, std::size_t end) {
     for (std::size_t u = begin; u < end; ++u) {
       const std::uint32_t g = global(std::uint32_t(u));
-      normals[u] = flip[g] ? -nodes[u].normal : nodes[u].normal;
+      if (flip[g]) normals[u] = -normals[u];
       if (components) (*components)[u] = number[g];
     }
   });
