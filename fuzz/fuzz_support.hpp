@@ -80,6 +80,30 @@ class InputFile {
   std::string named_;
 };
 
+// The promises of a point set returned by a reader (io/*.hpp): at least one point; every
+// attribute array empty or one entry a point; finite positions, normals and radii; triangle
+// corners index existing points.
+inline void check_point_set(const PointSet& p) {
+  const std::size_t n = p.size();
+  if (n == 0) finding("reader returned no points");
+  if (!p.normals.empty() && p.normals.size() != n) finding("normals of the wrong length");
+  if (!p.colors.empty() && p.colors.size() != n) finding("colors of the wrong length");
+  if (!p.radii.empty() && p.radii.size() != n) finding("radii of the wrong length");
+  const auto finite = [](Vec3f v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!finite(p.positions[i])) finding("non-finite position " + std::to_string(i));
+    if (!p.normals.empty() && !finite(p.normals[i]))
+      finding("non-finite normal " + std::to_string(i));
+    if (!p.radii.empty() && !std::isfinite(p.radii[i]))
+      finding("non-finite radius " + std::to_string(i));
+  }
+  for (const auto& t : p.triangles)
+    for (std::uint32_t v : t)
+      if (v >= n) finding("triangle corner " + std::to_string(v) + " out of range");
+}
+
 // Every point of `stream`, read `batch` at a time: positions and colours.
 inline PointSet drain_stream(PointStream& stream, std::size_t batch) {
   PointSet all, part;
@@ -113,6 +137,23 @@ inline void expect_stream_matches(const std::string& path, const PointSet& whole
   if (!same(streamed.colors, whole.colors)) finding("the stream's colours differ");
 }
 
+// A text reader's harness: `read(path)` on the input must fail only as readers may, keep the
+// PointSet's promises, and when it reads, the stream of the same file (named with `extension`,
+// which selects the reader) must give the same points.
+template <class Read>
+void check_reader_and_stream(InputFile& file, const std::uint8_t* data, std::size_t size,
+                             const std::string& extension, Read&& read) {
+  const std::string& path = file.write(data, size);
+  PointSet whole;
+  bool done = false;
+  expect_reader_errors(path, [&] {
+    whole = read(path);
+    check_point_set(whole);
+    done = true;
+  });
+  if (done) expect_stream_matches(file.named(extension), whole);
+}
+
 // Runs `read` (which reads `path`), catching what a reader may throw for bad input: FormatError
 // (whose message must name the file), IoError, OptionError, and std::bad_alloc when a reader
 // legitimately refuses. Anything else escapes to libFuzzer as a finding.
@@ -127,30 +168,6 @@ void expect_reader_errors(const std::string& path, Read&& read) {
   } catch (const OptionError&) {
   } catch (const std::bad_alloc&) {
   }
-}
-
-// The promises of a point set returned by a reader (io/*.hpp): at least one point; every
-// attribute array empty or one entry a point; finite positions, normals and radii; triangle
-// corners index existing points.
-inline void check_point_set(const PointSet& p) {
-  const std::size_t n = p.size();
-  if (n == 0) finding("reader returned no points");
-  if (!p.normals.empty() && p.normals.size() != n) finding("normals of the wrong length");
-  if (!p.colors.empty() && p.colors.size() != n) finding("colors of the wrong length");
-  if (!p.radii.empty() && p.radii.size() != n) finding("radii of the wrong length");
-  const auto finite = [](Vec3f v) {
-    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-  };
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!finite(p.positions[i])) finding("non-finite position " + std::to_string(i));
-    if (!p.normals.empty() && !finite(p.normals[i]))
-      finding("non-finite normal " + std::to_string(i));
-    if (!p.radii.empty() && !std::isfinite(p.radii[i]))
-      finding("non-finite radius " + std::to_string(i));
-  }
-  for (const auto& t : p.triangles)
-    for (std::uint32_t v : t)
-      if (v >= n) finding("triangle corner " + std::to_string(v) + " out of range");
 }
 
 // Draws `model` once at 32x24 from its orbit camera, loading the pages the view needs first when

@@ -7,15 +7,7 @@ using namespace pointillist;
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static fuzz::InputFile file;
-  const std::string& path = file.write(data, size);
-  PointSet whole;
-  bool read = false;
-  fuzz::expect_reader_errors(path, [&] {
-    whole = read_obj(path);
-    fuzz::check_point_set(whole);
-    read = true;
-  });
-  // The stream (a window of lines at a time) must give what the whole reader gave.
-  if (read) fuzz::expect_stream_matches(file.named(".obj"), whole);
+  fuzz::check_reader_and_stream(file, data, size, ".obj",
+                                [](const std::string& path) { return read_obj(path); });
   return 0;
 }

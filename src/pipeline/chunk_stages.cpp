@@ -200,6 +200,16 @@ void scan_plan_distribute(MergedInputs& in, const WorkFolder& folder, const Conv
   files.flush_all();
 }
 
+RankChunks rank_chunks(const ChunkJobs& jobs, const ChunkPlan& plan) {
+  RankChunks r;
+  const std::size_t chunks = plan.chunk_count();
+  for (std::size_t c = std::size_t(jobs.rank()); c < chunks; c += std::size_t(jobs.size())) {
+    r.chunks.push_back(c);
+    r.points += plan.counts[c];
+  }
+  return r;
+}
+
 std::vector<std::uint64_t> find_outliers_in_chunks(ChunkJobs& jobs, MergedInputs* in,
                                                    const WorkFolder& folder,
                                                    const ConvertOptions& o,
@@ -220,12 +230,9 @@ std::vector<std::uint64_t> find_outliers_in_chunks(ChunkJobs& jobs, MergedInputs
   });
   broadcast_shared(jobs, sh);
   const std::size_t chunks = sh.plan.chunk_count();
-  std::vector<std::size_t> mine;
-  std::uint64_t my_points = 0;
-  for (std::size_t c = std::size_t(jobs.rank()); c < chunks; c += std::size_t(jobs.size())) {
-    mine.push_back(c);
-    my_points += sh.plan.counts[c];
-  }
+  const RankChunks rank_share = rank_chunks(jobs, sh.plan);
+  const std::vector<std::size_t>& mine = rank_share.chunks;
+  const std::uint64_t my_points = rank_share.points;
   std::vector<std::vector<std::uint64_t>> dropped(chunks);
   step(jobs, [&] {
     ProgressPhase phase(progress, "outliers", my_points);

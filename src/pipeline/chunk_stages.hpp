@@ -43,6 +43,13 @@ struct Shared {
 
 void broadcast_shared(ChunkJobs& jobs, Shared& s);
 
+// The chunks this rank prepares (c % size == rank) and their share of the points.
+struct RankChunks {
+  std::vector<std::size_t> chunks;
+  std::uint64_t points = 0;
+};
+RankChunks rank_chunks(const ChunkJobs& jobs, const ChunkPlan& plan);
+
 // Runs fn, then settles with the other ranks: every rank throws when one failed.
 template <class Fn>
 void step(ChunkJobs& jobs, Fn&& fn) {

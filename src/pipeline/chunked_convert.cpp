@@ -106,13 +106,9 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
   const bool colors = sh.colors;
   result.input_points = root ? input_points : n;
   result.chunks = chunks;
-  // This rank's chunks, and their share of the points.
-  std::vector<std::size_t> mine;
-  std::uint64_t my_points = 0;
-  for (std::size_t c = std::size_t(jobs.rank()); c < chunks; c += std::size_t(jobs.size())) {
-    mine.push_back(c);
-    my_points += plan.counts[c];
-  }
+  const RankChunks own_chunks = rank_chunks(jobs, plan);
+  const std::vector<std::size_t>& mine = own_chunks.chunks;
+  const std::uint64_t my_points = own_chunks.points;
 
   // 4. Prepare each chunk with its halo; keep its own splats, their input indices and
   // orientation pieces; tell each halo point's owner how this chunk oriented it.
