@@ -12,6 +12,7 @@
 #include <numeric>
 
 #include "frame_pass.hpp"
+#include "raster/quality_occluders.hpp"
 #include "renderer_state.hpp"
 #include "select/stream_features.hpp"
 #include "select/subtree_selection.hpp"
@@ -63,6 +64,10 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
   const CameraFrame cam = make_camera_frame(camera);
   size_frame(frame, cam);
   OcclusionStats ostats;
+  // Quality mode: culling draws each visible leaf's splats as occluders (an upper bound on each
+  // pixel's reconstruction bound, quality_occluders.hpp), then the quality rasterizer draws the
+  // visible leaves once more in the order of no culling, so that its sums are the same.
+  const bool quality = fs.rasterizer == Rasterizer::Quality;
   if (scene.empty()) {  // nothing to draw: the background
     frame.splats.chunk_count = 0;
     begin_splats(cam, settings, pool, frame.scratch, frame.depth);
@@ -224,7 +229,7 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
     any_features = any_features || inst.model->tree.features;
   }
   const bool features = fs.features && any_features;
-  const bool with_discs = features;
+  const bool with_discs = features || quality;
   {
     std::uint32_t id_base = 0;
     for (std::size_t i = 0; i < scene.size(); ++i) {
@@ -396,7 +401,11 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
   std::vector<SoftwareQueries::Rect> rects;
   std::vector<std::uint8_t>& instance_drawn = c.instance_drawn;
   instance_drawn.assign(scene.size(), 0);
-  begin_splats(cam, settings, pool, frame.scratch, frame.depth);
+  if (quality) {
+    std::fill(frame.depth.begin(), frame.depth.end(), std::numeric_limits<float>::infinity());
+  } else {
+    begin_splats(cam, settings, pool, frame.scratch, frame.depth);
+  }
   c.pyramid.reset(frame.depth, cam.width, cam.height);
   // A batch's leaves are selected in groups (one chunk each, in parallel): leaves of one instance
   // up to about kGroupSplats expected splats together, so a thousand leaves drawn as one coarse
@@ -405,13 +414,16 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
   constexpr float kGroupSplats = 4096.0f;
   std::vector<std::uint32_t> order;
   std::vector<std::pair<std::size_t, std::size_t>> groups;
-  const SoftwareQueries::Draw draw = [&](std::span<const std::uint32_t> batch) {
-    const auto t0 = Clock::now();
-    order.assign(batch.begin(), batch.end());
-    std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
-      return c.meta[a].instance < c.meta[b].instance ||
-             (c.meta[a].instance == c.meta[b].instance && a < b);
-    });
+  // Leaves in the order of the selection without culling: by instance, then depth first (an
+  // instance's nodes are numbered depth first).
+  const auto canonical = [&](std::uint32_t a, std::uint32_t b) {
+    return c.meta[a].instance < c.meta[b].instance ||
+           (c.meta[a].instance == c.meta[b].instance && a < b);
+  };
+  // Selects the leaves of `order` (in canonical order) into chunks appended to the stream, in
+  // that order; with `count`, adds the selection's counts to the frame's and, in the fast mode,
+  // the pixel rectangles the chunks may touch to `rects`.
+  const auto select_order = [&](bool count) {
     groups.clear();
     float weight = 0;
     for (std::size_t k = 0; k < order.size(); ++k) {
@@ -428,6 +440,7 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
     }
     const std::size_t first = stream.chunk_count;
     if (stream.chunks.size() < first + groups.size()) stream.chunks.resize(first + groups.size());
+    const bool with_rects = count && !quality;
     task_counters.assign(groups.size(), {});
     spt_counters.assign(groups.size(), {});
     rects.assign(groups.size(), {});
@@ -471,6 +484,7 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
       }
       if (any_colors && !colored) fill_base_color(chunk, settings, with_discs);
       scale_splats(chunk, fs.splat_scale, with_discs);
+      if (!with_rects) return;
       // The pixels the chunk may touch (a splat covers its disc or the pixel of its centre).
       float x0 = std::numeric_limits<float>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
       for (std::size_t i = 0; i < chunk.count; ++i) {
@@ -488,31 +502,65 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
                     clampi(std::ceil(x1) + 1, cam.width), clampi(std::ceil(y1) + 1, cam.height)};
       }
     });
-    SoftwareQueries::Rect dirty{cam.width, cam.height, 0, 0};
+    stream.chunk_count = first + groups.size();
+    if (!count) return first;
     for (std::size_t g = 0; g < groups.size(); ++g) {
       spt_stats_ += spt_counters[g];
       counters.visited += task_counters[g].visited;
       counters.culled_frustum += task_counters[g].culled_frustum;
       counters.culled_backface += task_counters[g].culled_backface;
-      if (rects[g].x1 > rects[g].x0 && rects[g].y1 > rects[g].y0) {
-        dirty.x0 = std::min(dirty.x0, rects[g].x0);
-        dirty.y0 = std::min(dirty.y0, rects[g].y0);
-        dirty.x1 = std::max(dirty.x1, rects[g].x1);
-        dirty.y1 = std::max(dirty.y1, rects[g].y1);
-      }
     }
-    stream.chunk_count = first + groups.size();
+    return first;
+  };
+  std::vector<std::uint32_t>& drawn = c.drawn;  // quality mode: every leaf drawn this frame
+  drawn.clear();
+  const SoftwareQueries::Draw draw = [&](std::span<const std::uint32_t> batch) {
+    const auto t0 = Clock::now();
+    order.assign(batch.begin(), batch.end());
+    std::sort(order.begin(), order.end(), canonical);
+    const std::size_t first = select_order(true);
     const auto t1 = Clock::now();
-    draw_splats(stream, first, stream.chunk_count, cam, settings, pool, frame.scratch,
-                frame.depth);
+    SoftwareQueries::Rect dirty{cam.width, cam.height, 0, 0};
+    if (quality) {
+      drawn.insert(drawn.end(), batch.begin(), batch.end());
+      dirty = quality_detail::draw_quality_occluders(stream, first, stream.chunk_count, cam,
+                                                     fs.quality, pool, c.occluders, frame.depth);
+    } else {
+      for (std::size_t g = 0; g < groups.size(); ++g) {
+        if (rects[g].x1 > rects[g].x0 && rects[g].y1 > rects[g].y0) {
+          dirty.x0 = std::min(dirty.x0, rects[g].x0);
+          dirty.y0 = std::min(dirty.y0, rects[g].y0);
+          dirty.x1 = std::max(dirty.x1, rects[g].x1);
+          dirty.y1 = std::max(dirty.y1, rects[g].y1);
+        }
+      }
+      draw_splats(stream, first, stream.chunk_count, cam, settings, pool, frame.scratch,
+                  frame.depth);
+    }
     ms_select += std::chrono::duration<double, std::milli>(t1 - t0).count();
     ms_raster += std::chrono::duration<double, std::milli>(Clock::now() - t1).count();
     return dirty;
   };
-  SoftwareQueries queries(c.pyramid, cam, QueryFootprint{std::max(1.0f, fs.splat_scale)},
-                          os.query_latency, draw, ostats);
+  const QueryFootprint footprint =
+      quality ? quality_detail::quality_query_footprint(fs.quality, fs.splat_scale)
+              : QueryFootprint{std::max(1.0f, fs.splat_scale)};
+  SoftwareQueries queries(c.pyramid, cam, footprint, os.query_latency, draw, ostats);
   cull_frame(c.h, callbacks, os, queries, c.state, ostats);
-  finish_splats(cam, pool, frame.scratch, frame.color);
+  if (quality) {
+    // The visible leaves once more, in the order of no culling, then the quality pass.
+    const auto t0 = Clock::now();
+    order.assign(drawn.begin(), drawn.end());
+    std::sort(order.begin(), order.end(), canonical);
+    stream.chunk_count = 0;
+    select_order(false);
+    const auto t1 = Clock::now();
+    rasterize_quality(stream, cam, settings, fs.quality, pool, quality_scratch_, frame.color,
+                      frame.depth);
+    ms_select += std::chrono::duration<double, std::milli>(t1 - t0).count();
+    ms_raster += std::chrono::duration<double, std::milli>(Clock::now() - t1).count();
+  } else {
+    finish_splats(cam, pool, frame.scratch, frame.color);
+  }
 
   SelectionStats selection;
   selection.splats = stream.size();

@@ -99,17 +99,25 @@ void Renderer::render(std::span<const SceneInstance> scene, const Camera& camera
 
   const bool occlusion = fs.occlusion.method != OcclusionMethod::None;
   if (occlusion) {
-    const char* drop = fs.rasterizer != Rasterizer::Fast ? "--mode quality or reference"
-                       : options_.page_all                 ? "--memory and --progressive"
-                                                           : nullptr;
+    const bool quality = fs.rasterizer == Rasterizer::Quality;
+    const char* drop = fs.rasterizer == Rasterizer::Reference ? "--mode reference"
+                       : options_.page_all                    ? "--memory and --progressive"
+                       : quality && fs.lod == LodScheme::Spt  ? "--lod spt with --mode quality"
+                       : quality && fs.quality.opacity < 1.0f
+                           ? "--opacity below 1 (what shows through is not hidden)"
+                           : nullptr;
     for (const SceneInstance& inst : scene) {
       if (!drop && inst.model->pages) drop = "the paged model (open it whole)";
+      if (!drop && quality && fs.features && model_features(*inst.model)) {
+        drop = "sharp features with --mode quality (add --no-features)";
+      }
     }
     if (drop) {
       throw OptionError(std::string("occlusion culling (--occlusion ") +
                         name(fs.occlusion.method) +
-                        ") works with the fast mode on models held whole so far; drop " + drop +
-                        ", or --occlusion");
+                        ") works with the fast mode, and the quality mode of opaque surfaces "
+                        "without sharp features, on models held whole so far; drop " +
+                        drop + ", or --occlusion");
     }
   }
   last_frame_.clear();

@@ -11,6 +11,7 @@
 #include "pointillist/render/occlusion.hpp"
 #include "pointillist/render/paged.hpp"
 #include "pointillist/render/renderer.hpp"
+#include "raster/quality_occluders.hpp"
 #include "select/traversal_common.hpp"
 #include "shading.hpp"
 
@@ -147,6 +148,9 @@ struct Renderer::SceneCull {
   std::vector<std::uint8_t> tests_in, tests_out, instance_drawn;
   std::vector<float> weight;  // splats a node drawn as a leaf is expected to give
   std::vector<render_detail::InstanceView> views;
+  // Quality mode: the leaves drawn in the frame, and the occluder pass's buffers.
+  std::vector<std::uint32_t> drawn;
+  quality_detail::OccluderScratch occluders;
 
   bool matches(std::span<const SceneInstance> s, std::uint32_t leaves, LodScheme l) const {
     if (s.size() != scene.size() || leaves != leaf_points || l != lod) return false;

@@ -73,6 +73,35 @@ TEST(OcclusionCli, EveryMethodWritesTheFramesOfNoCullingAndCullsTheHiddenStatues
   }
 }
 
+TEST(OcclusionCli, QualityModeWritesTheFramesOfNoCullingAndCullsTheHiddenStatues) {
+  pointillist::testing::TempDir dir;
+  auto r = run_cli("generate --scene wall --spacing-scale 8 --points 400 --quiet -o " +
+                   dir.file("wall.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  write_text_file(dir.file("p.path"), "fov 30\n0 2 30  0 2 0\n36 2 30  36 2 0\n");
+  const std::string common = "render " + dir.file("wall.json") + " --path " + dir.file("p.path") +
+                             " --size 320x180 --mode quality --quiet ";
+  for (const char* rule : {"zrange", "zthreshold"}) {
+    const std::string none = dir.file(std::string("none_") + rule);
+    const std::string culled = dir.file(std::string("chc_") + rule);
+    r = run_cli(common + "--reconstruction " + rule + " -o " + none + ".png --frames-out " +
+                none + " --stats " + none + ".json");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    r = run_cli(common + "--reconstruction " + rule + " --occlusion chc++ -o " + culled +
+                ".png --frames-out " + culled + " --stats " + culled + ".json");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const auto plain = nlohmann::json::parse(bytes(none + ".json"));
+    const auto stats = nlohmann::json::parse(bytes(culled + ".json"));
+    for (int k = 0; k < 2; ++k) {
+      EXPECT_EQ(bytes(frame_file(culled, k)), bytes(frame_file(none, k))) << rule << " " << k;
+    }
+    EXPECT_GT(stats["frames"][0]["occlusion"]["leaves_culled"].get<int>(), 0) << rule;
+    EXPECT_LT(stats["frames"][0]["splats"].get<std::uint64_t>(),
+              plain["frames"][0]["splats"].get<std::uint64_t>())
+        << rule;
+  }
+}
+
 TEST(OcclusionCli, OptionsThatCannotApplyAreNamed) {
   pointillist::testing::TempDir dir;
   auto r = run_cli("generate --scene row --points 200 --quiet -o " + dir.file("row.json"));
@@ -87,7 +116,8 @@ TEST(OcclusionCli, OptionsThatCannotApplyAreNamed) {
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_THAT(r.output, HasSubstr("--chc-batch is ignored: it applies with --occlusion chc++"));
   for (const auto& [args, message] :
-       {std::pair{"--mode quality", "drop --mode quality or reference, or --occlusion"},
+       {std::pair{"--mode quality --lod spt", "drop --lod spt with --mode quality"},
+        std::pair{"--mode quality --opacity 0.5", "drop --opacity below 1"},
         std::pair{"--memory 1M", "--memory and --progressive"}}) {
     r = run_cli(common + "--occlusion chc++ " + args);
     EXPECT_EQ(r.exit_code, 2) << r.output;

@@ -241,6 +241,76 @@ TEST(OcclusionRender, SptChunksAreCulledWithTheSameImage) {
   }
 }
 
+TEST(OcclusionRender, QualityModeGivesTheImageOfNoCullingForBothReconstructionRules) {
+  // The occluder pass bounds each pixel's reconstruction bound from above and the quality pass
+  // sums the visible leaves in the order of no culling, so the image is the same bits.
+  const TestScene scene(false);
+  constexpr int kFrames = 4;
+  std::size_t compared = 0;
+  for (Reconstruction rule : {Reconstruction::ZRange, Reconstruction::ZThreshold}) {
+    RenderSettings settings;
+    FrameSettings none;
+    none.rasterizer = Rasterizer::Quality;
+    none.quality.reconstruction = rule;
+    const std::vector<Image> want = render_path(scene, settings, none, 2, kFrames);
+    for (OcclusionMethod m : {OcclusionMethod::StopAndWait, OcclusionMethod::ChcPlusPlus}) {
+      for (unsigned latency : {0u, 2u}) {
+        for (unsigned threads : {1u, 2u}) {
+          FrameSettings fs = none;
+          fs.occlusion.method = m;
+          fs.occlusion.query_latency = latency;
+          fs.occlusion.leaf_points = 256;
+          const std::vector<Image> got = render_path(scene, settings, fs, threads, kFrames);
+          for (int k = 0; k < kFrames; ++k) {
+            EXPECT_TRUE(same_bits(got[k], want[k]))
+                << name(m) << " rule " << int(rule) << " threads " << threads << " latency "
+                << latency << " frame " << k;
+            // Culling skips the balls behind the wall; with latency, answers of the first
+            // frames arrive after the balls are drawn (no history yet), so from frame 2 on.
+            if (latency == 0 || k >= 2) {
+              EXPECT_LT(got[k].splats, want[k].splats)
+                  << name(m) << " latency " << latency << " frame " << k;
+            }
+            ++compared;
+          }
+        }
+      }
+    }
+  }
+  EXPECT_EQ(compared, 2u * 2u * 2u * 2u * kFrames);
+}
+
+TEST(OcclusionRender, QualityModeCullsSingleSplatLeavesWithTheSameImage) {
+  // The finest culling: leaves of one point, each queried (no minimum), so every splat's
+  // fragments are tested against the occluders of the splats drawn before it.
+  const TestScene scene(false);
+  ThreadPool pool(2);
+  RenderSettings settings;
+  for (Reconstruction rule : {Reconstruction::ZRange, Reconstruction::ZThreshold}) {
+    FrameSettings fs;
+    fs.rasterizer = Rasterizer::Quality;
+    fs.quality.reconstruction = rule;
+    Renderer plain;
+    Frame frame;
+    plain.render(scene.instances, path_camera(1, 4), settings, fs, pool, frame);
+    FrameSettings culled = fs;
+    culled.occlusion.method = OcclusionMethod::StopAndWait;
+    culled.occlusion.leaf_points = 1;
+    culled.occlusion.min_query_splats = 0;
+    Renderer r;
+    Frame f;
+    r.render(scene.instances, path_camera(1, 4), settings, culled, pool, f);
+    std::size_t covered = 0;
+    for (std::size_t p = 0; p < frame.depth.size(); ++p) {
+      covered += frame.depth[p] < std::numeric_limits<float>::infinity();
+      ASSERT_EQ(std::memcmp(&frame.color[p], &f.color[p], sizeof(Rgb8)), 0) << "pixel " << p;
+      ASSERT_EQ(std::memcmp(&frame.depth[p], &f.depth[p], sizeof(float)), 0) << "pixel " << p;
+    }
+    EXPECT_GT(covered, 5000u);
+    EXPECT_GT(f.stats.occlusion.leaves_culled, 100u);
+  }
+}
+
 TEST(OcclusionRender, AnEmptySceneIsTheBackground) {
   ThreadPool pool(2);
   Renderer renderer;
@@ -266,12 +336,22 @@ TEST(OcclusionRender, CombinationsNotYetSupportedAreRefusedWithAMessage) {
   FrameSettings fs;
   fs.occlusion.method = OcclusionMethod::ChcPlusPlus;
   fs.rasterizer = Rasterizer::Quality;
+  fs.quality.opacity = 0.5f;  // culling would hide what shows through
   try {
     renderer.render(scene.instances, path_camera(0, 2), {}, fs, pool, frame);
-    FAIL() << "quality mode with occlusion culling was accepted";
+    FAIL() << "semi-transparent quality mode with occlusion culling was accepted";
   } catch (const OptionError& e) {
-    EXPECT_NE(std::string(e.what()).find("--mode quality"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("--opacity"), std::string::npos) << e.what();
   }
+  fs.quality.opacity = 1.0f;
+  fs.lod = LodScheme::Spt;
+  try {
+    renderer.render(scene.instances, path_camera(0, 2), {}, fs, pool, frame);
+    FAIL() << "quality mode of a Sequential Point Tree with occlusion culling was accepted";
+  } catch (const OptionError& e) {
+    EXPECT_NE(std::string(e.what()).find("--lod spt"), std::string::npos) << e.what();
+  }
+  fs.lod = LodScheme::QSplat;
   // A hierarchy too large for the scene (culling leaves of one point: 4,000 instances of a 4,500-node tree).
   {
     FrameSettings tiny;

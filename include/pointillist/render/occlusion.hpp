@@ -79,10 +79,15 @@ struct QueryBound {
 };
 
 // What a query must assume of the splats inside a bound: every splat of the node lies within the
-// sphere, is drawn at most `footprint_scale` times the sphere's projected size (splat scale), and
-// covers at least the pixel holding its centre.
+// sphere grown `footprint_scale` times (splat scale; in quality mode also the disc radius
+// scale), covers at most the pixels of that sphere's screen box plus one, and `pad_px` more
+// (the quality mode's screen low-pass); its fragments are nowhere nearer than the sphere's
+// centre depth less `depth_scale` radii (1 for the fast mode's centre-depth splats; the
+// quality mode's reconstruction keys reach further forward, spec §1.7).
 struct QueryFootprint {
   float footprint_scale = 1.0f;
+  float depth_scale = 1.0f;
+  float pad_px = 0.0f;
 };
 
 // The hierarchical max-depth pyramid over a depth buffer (eye depth, +∞ where empty). Level 0

@@ -111,7 +111,7 @@ bool bound_may_be_visible(const DepthPyramid& pyramid, const CameraFrame& camera
   const Vec3f d = bound.center - camera.eye;
   const double cx = dot(d, camera.right), cy = dot(d, camera.up), cz = dot(d, camera.forward);
   const double r = bound.radius;
-  const double z_min = cz - r;
+  const double z_min = cz - r * std::max(1.0f, footprint.depth_scale);
   // Splats are drawn at their centre's depth, and a splat of the node has its centre in the
   // sphere; the drawn disc lies within the sphere grown by the splat scale.
   const double rf = r * std::max(1.0f, footprint.footprint_scale) * (1.0 + 1e-6);
@@ -137,10 +137,11 @@ bool bound_may_be_visible(const DepthPyramid& pyramid, const CameraFrame& camera
   const auto clamp_px = [&](double v) { return std::clamp(v, -limit, limit); };
   // A splat covers pixel centres within its disc, or the pixel holding its centre: pixels
   // floor(x_lo) − 1 .. floor(x_hi) + 1 hold all of them with a pixel to spare.
-  const int x0 = static_cast<int>(std::floor(clamp_px(half_w + f * tx0))) - 1;
-  const int x1 = static_cast<int>(std::floor(clamp_px(half_w + f * tx1))) + 1;
-  const int y0 = static_cast<int>(std::floor(clamp_px(half_h - f * ty1))) - 1;
-  const int y1 = static_cast<int>(std::floor(clamp_px(half_h - f * ty0))) + 1;
+  const double pad = std::max(0.0f, footprint.pad_px);
+  const int x0 = static_cast<int>(std::floor(clamp_px(half_w + f * tx0 - pad))) - 1;
+  const int x1 = static_cast<int>(std::floor(clamp_px(half_w + f * tx1 + pad))) + 1;
+  const int y0 = static_cast<int>(std::floor(clamp_px(half_h - f * ty1 - pad))) - 1;
+  const int y1 = static_cast<int>(std::floor(clamp_px(half_h - f * ty0 + pad))) + 1;
   // A splat's depth is a float computed in model space and scaled into the world: allow it a
   // relative error of 1e-5 below the exact nearest depth.
   const float z = static_cast<float>(z_min - 1e-5 * (cz + r));

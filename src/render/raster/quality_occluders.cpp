@@ -1,0 +1,132 @@
+// The occluder pass of occlusion culling in quality mode (quality_occluders.hpp): the quality
+// rasterizer's per-splat setup and band binning, then per band of rows the pixels each splat
+// surely covers, computed as the rasterizer computes them.
+#include "raster/quality_occluders.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "raster/quality_kernel.hpp"
+
+namespace pointillist::quality_detail {
+namespace {
+
+constexpr int kOccluderBandRows = 32;
+// A pixel counts as covered only when its kernel argument is this far inside the edge: the
+// rasterizer's lane arithmetic may round differently from this scalar loop right at the edge.
+constexpr float kOccluderCoverMargin = 1e-3f;
+
+}  // namespace
+
+SoftwareQueries::Rect draw_quality_occluders(const SplatStream& stream, std::size_t first,
+                                             std::size_t last, const CameraFrame& camera,
+                                             const QualitySettings& quality, ThreadPool& pool,
+                                             OccluderScratch& scratch, std::span<float> bound) {
+  const int width = camera.width, height = camera.height;
+  SoftwareQueries::Rect out{width, height, 0, 0};
+  if (last <= first || width <= 0 || height <= 0) return out;
+  SetupConstants setup;
+  setup.camera = camera;
+  setup.rule = rule_constants(quality);
+  setup.lowpass_radius_px = quality.lowpass_radius_px;
+  setup.radius_scale = quality.radius_scale;
+  setup.has_colors = false;
+  setup.band_rows = kOccluderBandRows;
+  setup.band_count = (height + kOccluderBandRows - 1) / kOccluderBandRows;
+  const std::size_t chunks = last - first;
+  if (scratch.splats.size() < chunks) {
+    scratch.splats.resize(chunks);
+    scratch.bins.resize(chunks);
+    scratch.planes.resize(chunks);
+  }
+  pool.run(chunks, [&](std::size_t c) {
+    prepare_chunk(stream.chunks[first + c], setup, false, scratch.splats[c], scratch.bins[c],
+                  scratch.planes[c]);
+  });
+
+  const std::size_t bands = static_cast<std::size_t>(setup.band_count);
+  scratch.band_rects.assign(bands, out);
+  const float half_w = 0.5f * static_cast<float>(width);
+  const float half_h = 0.5f * static_cast<float>(height);
+  const float inv_f = 1.0f / camera.focal_px;
+  const float inv_rho2 = 1.0f / (quality.lowpass_radius_px * quality.lowpass_radius_px);
+  const float inf = std::numeric_limits<float>::infinity();
+  const float limit = 1.0f - kOccluderCoverMargin;
+  const bool z_range = setup.rule.z_range;
+  pool.run(bands, [&](std::size_t band) {
+    const int row0 = static_cast<int>(band) * kOccluderBandRows;
+    const int row1 = std::min(height, row0 + kOccluderBandRows);
+    SoftwareQueries::Rect& r = scratch.band_rects[band];
+    for (std::size_t c = 0; c < chunks; ++c) {
+      const std::vector<std::uint32_t>& bins = scratch.bins[c];
+      const std::size_t base = bands + 1;
+      for (std::uint32_t k = bins[band]; k < bins[band + 1]; ++k) {
+        const float* s = &scratch.splats[c][kStride * bins[base + k]];
+        const int i0 = static_cast<int>(s[kI0]), i1 = static_cast<int>(s[kI1]);
+        const int j0 = std::max(static_cast<int>(s[kJ0]), row0);
+        const int j1 = std::min(static_cast<int>(s[kJ1]), row1 - 1);
+        // The largest bound of the splat's fragments (ZThreshold: depth ≤ the disc's deepest).
+        const float u_bound = z_range ? s[kBound] : s[kDepthHi] + s[kBound];
+        const float nx = s[kNx], ny = s[kNy], nz = s[kNz], nc = s[kNc];
+        const float cx = s[kCx], cy = s[kCy], cz = s[kCz], inv_r2 = s[kInvR2];
+        for (int j = j0; j <= j1; ++j) {
+          const float pcy = static_cast<float>(j) + 0.5f;
+          const float b = (half_h - pcy) * inv_f;
+          const float dy = pcy - s[kSy];
+          float* row = bound.data() + static_cast<std::size_t>(j) * static_cast<std::size_t>(width);
+          bool any = false;
+          for (int i = i0; i <= i1; ++i) {
+            const float pcx = static_cast<float>(i) + 0.5f;
+            const float a = (pcx - half_w) * inv_f;
+            float t, x, y;
+            if (camera.ortho) {
+              t = (nc - nx * a - ny * b) / nz;
+              x = a;
+              y = b;
+            } else {
+              t = nc / ((nx * a + nz) + ny * b);
+              x = t * a;
+              y = t * b;
+            }
+            const float dx = pcx - s[kSx];
+            const float sd = (dx * dx + dy * dy) * inv_rho2;
+            float m = sd;
+            if (t > 0.0f && t < inf) {
+              const float ex = x - cx, ey = y - cy, ez = t - cz;
+              m = std::min(m, (ex * ex + ey * ey + ez * ez) * inv_r2);
+            }
+            if (!(m <= limit) || !(u_bound < row[i])) continue;
+            row[i] = u_bound;
+            any = true;
+            r.x0 = std::min(r.x0, i);
+            r.x1 = std::max(r.x1, i + 1);
+          }
+          if (any) {
+            r.y0 = std::min(r.y0, j);
+            r.y1 = std::max(r.y1, j + 1);
+          }
+        }
+      }
+    }
+  });
+  for (const SoftwareQueries::Rect& r : scratch.band_rects) {
+    if (r.x1 <= r.x0 || r.y1 <= r.y0) continue;
+    out.x0 = std::min(out.x0, r.x0);
+    out.y0 = std::min(out.y0, r.y0);
+    out.x1 = std::max(out.x1, r.x1);
+    out.y1 = std::max(out.y1, r.y1);
+  }
+  return out;
+}
+
+QueryFootprint quality_query_footprint(const QualitySettings& quality, float splat_scale) {
+  const float disc = quality.radius_scale * std::max(1.0f, splat_scale);
+  const float forward = quality.reconstruction == Reconstruction::ZRange
+                            ? disc * (1.0f + quality.z_range_margin)
+                            : disc;
+  // Relative slack for the float arithmetic of the discs' setup.
+  return {disc * (1.0f + 1e-5f), forward * (1.0f + 1e-5f), quality.lowpass_radius_px + 1.0f};
+}
+
+}  // namespace pointillist::quality_detail
