@@ -4,6 +4,8 @@
 # field (nothing hidden: the cost of culling) and a row of dragons. Each camera path is rendered
 # with --occlusion none and with each method (and CHC++ with each rule switched off on the city
 # walk), in the same run; every frame's PNG is compared with none's (identical bits expected).
+# The wall, row, field and street walk are also rendered in --mode quality, with and without
+# culling ("quality:none", "quality:chc++", compared with each other).
 #
 #   bash bench/occlusion.sh [--stride N] [--size WxH] [--markdown]
 #
@@ -60,7 +62,7 @@ runs="$work/runs.tsv"
 run() {
   local scene=$1 path=$2 label=$3
   shift 3
-  local dir="$work/out/$path/$label"
+  local dir="$work/out/$path/${label/:/-}"
   mkdir -p "$dir"
   thin "$work/$scene/$path.path" "$work/$path.thin.path"
   echo "-- $path $label"
@@ -84,6 +86,13 @@ for p in wall:wall row:row field:field city:city-walk city:city-static city:city
   if [ "$path" = city-turn ]; then
     run "$scene" "$path" chc++-no-random --occlusion chc++ --chc-off random
   fi
+  # The quality mode (an occluder pass, then the visible leaves drawn in the order of no
+  # culling), against its own run without culling.
+  case $path in
+    wall|row|field|city-walk)
+      run "$scene" "$path" quality:none --mode quality
+      run "$scene" "$path" quality:chc++ --mode quality --occlusion chc++ ;;
+  esac
 done
 
 python3 - "$runs" "$markdown" <<'EOF'
@@ -99,9 +108,11 @@ for path, label, d in runs:
     ms = [f["ms"] for f in body]
     splats = [f["splats"] for f in body]
     occ = [f.get("occlusion") for f in body]
-    if label == "none":
-        base[path] = (st.median(ms), st.median(splats), d, len(frames))
-    b = base[path]
+    # Quality runs ("quality:...") compare with the quality run without culling.
+    group = (path, label.split(":")[0] if ":" in label else "")
+    if label.split(":")[-1] == "none":
+        base[group] = (st.median(ms), st.median(splats), d, len(frames))
+    b = base[group]
     pngs = sorted(x for x in os.listdir(d) if x.startswith("frame_"))
     same = sum(filecmp.cmp(os.path.join(d, x), os.path.join(b[2], x), shallow=False)
                for x in pngs)

@@ -398,6 +398,7 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
   double ms_select = 0, ms_raster = 0;
   std::vector<Counters> task_counters;
   std::vector<SptSelectionStats> spt_counters;
+  std::vector<std::vector<std::uint32_t>> group_ends;  // quality: each leaf's end in its chunk
   std::vector<SoftwareQueries::Rect> rects;
   std::vector<std::uint8_t>& instance_drawn = c.instance_drawn;
   instance_drawn.assign(scene.size(), 0);
@@ -421,9 +422,9 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
            (c.meta[a].instance == c.meta[b].instance && a < b);
   };
   // Selects the leaves of `order` (in canonical order) into chunks appended to the stream, in
-  // that order; with `count`, adds the selection's counts to the frame's and, in the fast mode,
-  // the pixel rectangles the chunks may touch to `rects`.
-  const auto select_order = [&](bool count) {
+  // that order, adds the selection's counts to the frame's and, in the fast mode, writes the
+  // pixel rectangles the chunks may touch to `rects`; returns the first chunk.
+  const auto select_order = [&]() {
     groups.clear();
     float weight = 0;
     for (std::size_t k = 0; k < order.size(); ++k) {
@@ -440,9 +441,10 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
     }
     const std::size_t first = stream.chunk_count;
     if (stream.chunks.size() < first + groups.size()) stream.chunks.resize(first + groups.size());
-    const bool with_rects = count && !quality;
+    const bool with_rects = !quality;
     task_counters.assign(groups.size(), {});
     spt_counters.assign(groups.size(), {});
+    if (group_ends.size() < groups.size()) group_ends.resize(groups.size());
     rects.assign(groups.size(), {});
     pool.run(groups.size(), [&](std::size_t g) {
       const std::uint32_t instance = c.meta[order[groups[g].first]].instance;
@@ -471,8 +473,9 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
           const std::uint32_t n = order[k];
           roots.push_back({st.cull_tree->nodes[c.meta[n].local].tree_node, tests_in[n]});
         }
+        group_ends[g].clear();
         select_subtrees(inst.model->tree.nodes, roots, iv.v, inst.model->tree.has_colors, chunk,
-                        task_counters[g]);
+                        task_counters[g], quality ? &group_ends[g] : nullptr);
       }
       chunk.instance = instance;
       const bool colored = spt ? st.spt->has_colors : inst.model->tree.has_colors;
@@ -503,7 +506,6 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
       }
     });
     stream.chunk_count = first + groups.size();
-    if (!count) return first;
     for (std::size_t g = 0; g < groups.size(); ++g) {
       spt_stats_ += spt_counters[g];
       counters.visited += task_counters[g].visited;
@@ -512,19 +514,29 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
     }
     return first;
   };
-  std::vector<std::uint32_t>& drawn = c.drawn;  // quality mode: every leaf drawn this frame
+  // Quality mode: every leaf drawn this frame, and where its splats are in the stream.
+  std::vector<std::pair<std::uint32_t, quality_detail::StreamPiece>>& drawn = c.drawn;
   drawn.clear();
   const SoftwareQueries::Draw draw = [&](std::span<const std::uint32_t> batch) {
     const auto t0 = Clock::now();
     order.assign(batch.begin(), batch.end());
     std::sort(order.begin(), order.end(), canonical);
-    const std::size_t first = select_order(true);
+    const std::size_t first = select_order();
     const auto t1 = Clock::now();
     SoftwareQueries::Rect dirty{cam.width, cam.height, 0, 0};
     if (quality) {
-      drawn.insert(drawn.end(), batch.begin(), batch.end());
+      // Where each leaf's splats are, for the quality pass.
+      for (std::size_t g = 0; g < groups.size(); ++g) {
+        std::uint32_t begin = 0;
+        for (std::size_t k = groups[g].first; k < groups[g].second; ++k) {
+          const std::uint32_t end = group_ends[g][k - groups[g].first];
+          drawn.push_back({order[k], {static_cast<std::uint32_t>(first + g), begin, end}});
+          begin = end;
+        }
+      }
       dirty = quality_detail::draw_quality_occluders(stream, first, stream.chunk_count, cam,
-                                                     fs.quality, pool, c.occluders, frame.depth);
+                                                     settings, fs.quality, pool, quality_scratch_,
+                                                     c.occluders, frame.depth);
     } else {
       for (std::size_t g = 0; g < groups.size(); ++g) {
         if (rects[g].x1 > rects[g].x0 && rects[g].y1 > rects[g].y0) {
@@ -547,17 +559,19 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
   SoftwareQueries queries(c.pyramid, cam, footprint, os.query_latency, draw, ostats);
   cull_frame(c.h, callbacks, os, queries, c.state, ostats);
   if (quality) {
-    // The visible leaves once more, in the order of no culling, then the quality pass.
+    // The quality pass over the visible leaves' splats in the order of no culling (the setup of
+    // every chunk is the occluder pass's).
     const auto t0 = Clock::now();
-    order.assign(drawn.begin(), drawn.end());
-    std::sort(order.begin(), order.end(), canonical);
-    stream.chunk_count = 0;
-    select_order(false);
-    const auto t1 = Clock::now();
-    rasterize_quality(stream, cam, settings, fs.quality, pool, quality_scratch_, frame.color,
-                      frame.depth);
-    ms_select += std::chrono::duration<double, std::milli>(t1 - t0).count();
-    ms_raster += std::chrono::duration<double, std::milli>(Clock::now() - t1).count();
+    std::sort(drawn.begin(), drawn.end(),
+              [&](const auto& a, const auto& b) { return canonical(a.first, b.first); });
+    std::vector<quality_detail::StreamPiece>& pieces = c.pieces;
+    pieces.clear();
+    for (const auto& d : drawn) {
+      if (d.second.end > d.second.begin) pieces.push_back(d.second);
+    }
+    quality_detail::rasterize_quality_pieces(stream, pieces, cam, settings, fs.quality, pool,
+                                             quality_scratch_, frame.color, frame.depth);
+    ms_raster += std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
   } else {
     finish_splats(cam, pool, frame.scratch, frame.color);
   }

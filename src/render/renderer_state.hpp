@@ -149,7 +149,8 @@ struct Renderer::SceneCull {
   std::vector<float> weight;  // splats a node drawn as a leaf is expected to give
   std::vector<render_detail::InstanceView> views;
   // Quality mode: the leaves drawn in the frame, and the occluder pass's buffers.
-  std::vector<std::uint32_t> drawn;
+  std::vector<std::pair<std::uint32_t, quality_detail::StreamPiece>> drawn;
+  std::vector<quality_detail::StreamPiece> pieces;
   quality_detail::OccluderScratch occluders;
 
   bool matches(std::span<const SceneInstance> s, std::uint32_t leaves, LodScheme l) const {

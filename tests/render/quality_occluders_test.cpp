@@ -111,11 +111,13 @@ TEST(QualityOccluders, NeverBelowTheSmallestBoundAndFiniteWhereAFragmentIsSure) 
     std::vector<float> bound(static_cast<std::size_t>(cam.width) * cam.height,
                              std::numeric_limits<float>::infinity());
     quality_detail::OccluderScratch scratch;
+    QualityScratch prepared;
+    const RenderSettings settings;
     // Two batches, as culling draws them.
-    const SoftwareQueries::Rect r1 =
-        quality_detail::draw_quality_occluders(stream, 0, 1, cam, q, pool, scratch, bound);
-    const SoftwareQueries::Rect r2 =
-        quality_detail::draw_quality_occluders(stream, 1, 3, cam, q, pool, scratch, bound);
+    const SoftwareQueries::Rect r1 = quality_detail::draw_quality_occluders(
+        stream, 0, 1, cam, settings, q, pool, prepared, scratch, bound);
+    const SoftwareQueries::Rect r2 = quality_detail::draw_quality_occluders(
+        stream, 1, 3, cam, settings, q, pool, prepared, scratch, bound);
     std::size_t sure = 0, lowered = 0;
     for (int j = 0; j < cam.height; ++j) {
       for (int i = 0; i < cam.width; ++i) {

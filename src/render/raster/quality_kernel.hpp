@@ -4,10 +4,11 @@
 
 #include <cstdint>
 #include <cstring>
-
+#include <span>
 #include <vector>
 
 #include "pointillist/core/camera.hpp"
+#include "pointillist/core/thread_pool.hpp"
 #include "pointillist/lod/sphere_tree.hpp"
 #include "pointillist/render/quality.hpp"
 #include "pointillist/render/splat_stream.hpp"
@@ -96,6 +97,27 @@ struct SetupConstants {
   Vec3f base_color;
   int band_rows = 1, band_count = 1;  // rows of the image drawn by one band, bands
 };
+
+// The setup constants rasterize_quality uses for a stream of `camera` (its band layout for
+// `threads` workers).
+SetupConstants quality_setup(const CameraFrame& camera, const RenderSettings& settings,
+                             const QualitySettings& quality, bool has_colors, unsigned threads);
+
+// Splats [begin, end) of chunk `chunk` of a stream.
+struct StreamPiece {
+  std::uint32_t chunk = 0, begin = 0, end = 0;
+};
+
+// rasterize_quality over splats of `stream` taken piece by piece in the order of `pieces`
+// instead of in stream order, with every chunk's setup already in `scratch` (prepare_chunk with
+// quality_setup(camera, settings, quality, stream.has_colors, pool.thread_count()), no sharp
+// features). The image is rasterize_quality's on a stream holding the pieces' splats in that
+// order.
+void rasterize_quality_pieces(const SplatStream& stream, std::span<const StreamPiece> pieces,
+                              const CameraFrame& camera, const RenderSettings& settings,
+                              const QualitySettings& quality, ThreadPool& pool,
+                              QualityScratch& scratch, std::span<Rgb8> color,
+                              std::span<float> depth);
 
 // Writes the setup of every splat of `chunk` into `splats` (kStride floats each) and bins the
 // splats by band: bins[b] .. bins[b + 1] − 1 (offsets counted from bins[band_count + 1]) are

@@ -1,6 +1,6 @@
 // The occluder pass of occlusion culling in quality mode (quality_occluders.hpp): the quality
-// rasterizer's per-splat setup and band binning, then per band of rows the pixels each splat
-// surely covers, computed as the rasterizer computes them.
+// rasterizer's per-splat setup and band binning (kept for the quality pass), then per band of
+// rows the pixels each splat surely covers, computed as the rasterizer computes them.
 #include "raster/quality_occluders.hpp"
 
 #include <algorithm>
@@ -12,7 +12,12 @@
 namespace pointillist::quality_detail {
 namespace {
 
-constexpr int kOccluderBandRows = 32;
+using render_detail::Float4;
+using render_detail::Int4;
+using render_detail::min4;
+using render_detail::select4;
+using render_detail::splat4;
+
 // A pixel counts as covered only when its kernel argument is this far inside the edge: the
 // rasterizer's lane arithmetic may round differently from this scalar loop right at the edge.
 constexpr float kOccluderCoverMargin = 1e-3f;
@@ -21,28 +26,26 @@ constexpr float kOccluderCoverMargin = 1e-3f;
 
 SoftwareQueries::Rect draw_quality_occluders(const SplatStream& stream, std::size_t first,
                                              std::size_t last, const CameraFrame& camera,
+                                             const RenderSettings& settings,
                                              const QualitySettings& quality, ThreadPool& pool,
-                                             OccluderScratch& scratch, std::span<float> bound) {
+                                             QualityScratch& prepared, OccluderScratch& scratch,
+                                             std::span<float> bound) {
   const int width = camera.width, height = camera.height;
   SoftwareQueries::Rect out{width, height, 0, 0};
   if (last <= first || width <= 0 || height <= 0) return out;
-  SetupConstants setup;
-  setup.camera = camera;
-  setup.rule = rule_constants(quality);
-  setup.lowpass_radius_px = quality.lowpass_radius_px;
-  setup.radius_scale = quality.radius_scale;
-  setup.has_colors = false;
-  setup.band_rows = kOccluderBandRows;
-  setup.band_count = (height + kOccluderBandRows - 1) / kOccluderBandRows;
-  const std::size_t chunks = last - first;
-  if (scratch.splats.size() < chunks) {
-    scratch.splats.resize(chunks);
-    scratch.bins.resize(chunks);
-    scratch.planes.resize(chunks);
+  // The quality pass's own setup and bands, kept for it (rasterize_quality_pieces).
+  const SetupConstants setup =
+      quality_setup(camera, settings, quality, stream.has_colors, pool.thread_count());
+  const int band_rows = setup.band_rows;
+  if (prepared.chunk_splats.size() < last) {
+    prepared.chunk_splats.resize(last);
+    prepared.chunk_bins.resize(last);
   }
+  if (prepared.chunk_planes.size() < last) prepared.chunk_planes.resize(last);
+  const std::size_t chunks = last - first;
   pool.run(chunks, [&](std::size_t c) {
-    prepare_chunk(stream.chunks[first + c], setup, false, scratch.splats[c], scratch.bins[c],
-                  scratch.planes[c]);
+    prepare_chunk(stream.chunks[first + c], setup, false, prepared.chunk_splats[first + c],
+                  prepared.chunk_bins[first + c], prepared.chunk_planes[first + c]);
   });
 
   const std::size_t bands = static_cast<std::size_t>(setup.band_count);
@@ -55,14 +58,14 @@ SoftwareQueries::Rect draw_quality_occluders(const SplatStream& stream, std::siz
   const float limit = 1.0f - kOccluderCoverMargin;
   const bool z_range = setup.rule.z_range;
   pool.run(bands, [&](std::size_t band) {
-    const int row0 = static_cast<int>(band) * kOccluderBandRows;
-    const int row1 = std::min(height, row0 + kOccluderBandRows);
+    const int row0 = static_cast<int>(band) * band_rows;
+    const int row1 = std::min(height, row0 + band_rows);
     SoftwareQueries::Rect& r = scratch.band_rects[band];
-    for (std::size_t c = 0; c < chunks; ++c) {
-      const std::vector<std::uint32_t>& bins = scratch.bins[c];
+    for (std::size_t c = first; c < last; ++c) {
+      const std::vector<std::uint32_t>& bins = prepared.chunk_bins[c];
       const std::size_t base = bands + 1;
       for (std::uint32_t k = bins[band]; k < bins[band + 1]; ++k) {
-        const float* s = &scratch.splats[c][kStride * bins[base + k]];
+        const float* s = &prepared.chunk_splats[c][kStride * bins[base + k]];
         const int i0 = static_cast<int>(s[kI0]), i1 = static_cast<int>(s[kI1]);
         const int j0 = std::max(static_cast<int>(s[kJ0]), row0);
         const int j1 = std::min(static_cast<int>(s[kJ1]), row1 - 1);
@@ -70,37 +73,44 @@ SoftwareQueries::Rect draw_quality_occluders(const SplatStream& stream, std::siz
         const float u_bound = z_range ? s[kBound] : s[kDepthHi] + s[kBound];
         const float nx = s[kNx], ny = s[kNy], nz = s[kNz], nc = s[kNc];
         const float cx = s[kCx], cy = s[kCy], cz = s[kCz], inv_r2 = s[kInvR2];
+        const Float4 lane{0.0f, 1.0f, 2.0f, 3.0f};
         for (int j = j0; j <= j1; ++j) {
           const float pcy = static_cast<float>(j) + 0.5f;
           const float b = (half_h - pcy) * inv_f;
           const float dy = pcy - s[kSy];
+          const float dy2 = dy * dy;
           float* row = bound.data() + static_cast<std::size_t>(j) * static_cast<std::size_t>(width);
           bool any = false;
-          for (int i = i0; i <= i1; ++i) {
-            const float pcx = static_cast<float>(i) + 0.5f;
-            const float a = (pcx - half_w) * inv_f;
-            float t, x, y;
+          // Four pixels at a time, as the rasterizer computes them.
+          for (int i = i0; i <= i1; i += 4) {
+            const Float4 iv = static_cast<float>(i) + lane;
+            const Float4 pcx = iv + 0.5f;
+            const Float4 a = (pcx - half_w) * inv_f;
+            Float4 t, x, y;
             if (camera.ortho) {
               t = (nc - nx * a - ny * b) / nz;
               x = a;
-              y = b;
+              y = splat4(b);
             } else {
               t = nc / ((nx * a + nz) + ny * b);
               x = t * a;
               y = t * b;
             }
-            const float dx = pcx - s[kSx];
-            const float sd = (dx * dx + dy * dy) * inv_rho2;
-            float m = sd;
-            if (t > 0.0f && t < inf) {
-              const float ex = x - cx, ey = y - cy, ez = t - cz;
-              m = std::min(m, (ex * ex + ey * ey + ez * ez) * inv_r2);
+            const Float4 dx = pcx - s[kSx];
+            const Float4 sd = (dx * dx + dy2) * inv_rho2;
+            const Int4 valid = (t > 0.0f) & (t < inf);
+            const Float4 ex = x - cx, ey = y - cy, ez = t - cz;
+            const Float4 u = (ex * ex + ey * ey + ez * ez) * inv_r2;
+            const Float4 m = select4(valid, min4(sd, u), sd);
+            const Int4 cover = (iv <= static_cast<float>(i1)) & (m <= limit);
+            if (!(cover[0] | cover[1] | cover[2] | cover[3])) continue;
+            for (int l = 0; l < 4; ++l) {
+              if (!cover[l] || !(u_bound < row[i + l])) continue;
+              row[i + l] = u_bound;
+              any = true;
+              r.x0 = std::min(r.x0, i + l);
+              r.x1 = std::max(r.x1, i + l + 1);
             }
-            if (!(m <= limit) || !(u_bound < row[i])) continue;
-            row[i] = u_bound;
-            any = true;
-            r.x0 = std::min(r.x0, i);
-            r.x1 = std::max(r.x1, i + 1);
           }
           if (any) {
             r.y0 = std::min(r.y0, j);

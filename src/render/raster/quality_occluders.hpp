@@ -15,15 +15,14 @@
 #include "pointillist/core/thread_pool.hpp"
 #include "pointillist/render/occlusion.hpp"
 #include "pointillist/render/quality.hpp"
+#include "pointillist/render/settings.hpp"
 #include "pointillist/render/splat_stream.hpp"
+#include "raster/quality_kernel.hpp"
 
 namespace pointillist::quality_detail {
 
 // Work buffers of the occluder pass, kept across batches and frames.
 struct OccluderScratch {
-  std::vector<std::vector<float>> splats;         // per chunk: the rasterizer's splat setup
-  std::vector<std::vector<std::uint32_t>> bins;  // per chunk: its splats by band of rows
-  std::vector<std::vector<float>> planes;        // per chunk: unused (no sharp features)
   std::vector<SoftwareQueries::Rect> band_rects;
 };
 
@@ -32,12 +31,15 @@ struct OccluderScratch {
 // features): at every pixel where rasterize_quality is certain to give a splat a fragment (its
 // kernel argument within 1 − 1e-3 of the disc or low-pass edge), to the largest bound that
 // fragment can have (ZRange: the splat's widened interval's end; ZThreshold: its deepest depth
-// plus ε·R). The smallest bound of a pixel's fragments is then never above `bound`. Returns the
-// rectangle of pixels lowered, [x0, x1) × [y0, y1) (empty when none).
+// plus ε·R). The smallest bound of a pixel's fragments is then never above `bound`. The chunks'
+// setup is left in `prepared` as rasterize_quality_pieces expects it (quality_kernel.hpp).
+// Returns the rectangle of pixels lowered, [x0, x1) × [y0, y1) (empty when none).
 SoftwareQueries::Rect draw_quality_occluders(const SplatStream& stream, std::size_t first,
                                              std::size_t last, const CameraFrame& camera,
+                                             const RenderSettings& settings,
                                              const QualitySettings& quality, ThreadPool& pool,
-                                             OccluderScratch& scratch, std::span<float> bound);
+                                             QualityScratch& prepared, OccluderScratch& scratch,
+                                             std::span<float> bound);
 
 // The footprint a query must assume of a node's splats in quality mode: every disc lies within
 // the node's sphere grown by radius_scale (and the splat scale), covers the low-pass disc, and

@@ -252,17 +252,32 @@ DrawFn pick(bool z_range) {
 }
 
 // Calls draw for every splat binned into band `b`, chunk by chunk in stream order.
-void band_pass(const SplatStream& stream, const QualityScratch& scratch, std::size_t b,
+// The splats of band b, in stream order or, with `pieces`, piece by piece (a chunk's bin of a
+// band lists its splats in ascending order, so a piece is a contiguous run of it).
+struct PassOrder {
+  std::size_t chunks = 0;
+  const std::span<const StreamPiece>* pieces = nullptr;
+};
+
+void band_pass(const PassOrder& order, const QualityScratch& scratch, std::size_t b,
                std::size_t band_count, const View& v, const Band& band, DrawFn draw) {
-  for (std::size_t c = 0; c < stream.chunk_count; ++c) {
+  const auto run = [&](std::size_t c, std::uint32_t begin, std::uint32_t end) {
     const std::vector<std::uint32_t>& bins = scratch.chunk_bins[c];
     const std::uint32_t* index = bins.data() + band_count + 1;
     const float* splats = scratch.chunk_splats[c].data();
     const float* planes = scratch.chunk_planes[c].data();
-    for (std::uint32_t k = bins[b]; k < bins[b + 1]; ++k) {
-      draw(splats + static_cast<std::size_t>(kStride) * index[k], planes, v, band);
+    const std::uint32_t* k = index + bins[b];
+    const std::uint32_t* last = index + bins[b + 1];
+    if (begin > 0) k = std::lower_bound(k, last, begin);
+    for (; k < last && *k < end; ++k) {
+      draw(splats + static_cast<std::size_t>(kStride) * *k, planes, v, band);
     }
+  };
+  if (order.pieces) {
+    for (const StreamPiece& p : *order.pieces) run(p.chunk, p.begin, p.end);
+    return;
   }
+  for (std::size_t c = 0; c < order.chunks; ++c) run(c, 0, UINT32_MAX);
 }
 
 struct Output {
@@ -438,40 +453,34 @@ BandLayout choose_bands(int width, int height, unsigned threads) {
   return l;
 }
 
-}  // namespace
-
-void rasterize_quality(const SplatStream& stream, const CameraFrame& camera, const RenderSettings& settings,
-                       const QualitySettings& quality, ThreadPool& pool, QualityScratch& scratch,
-                       std::span<Rgb8> color, std::span<float> depth) {
+void rasterize(const SplatStream& stream, const std::span<const StreamPiece>* pieces,
+               const CameraFrame& camera, const RenderSettings& settings,
+               const QualitySettings& quality, ThreadPool& pool, QualityScratch& scratch,
+               std::span<Rgb8> color, std::span<float> depth) {
   [[maybe_unused]] const std::size_t pixels =
       static_cast<std::size_t>(camera.width) * static_cast<std::size_t>(camera.height);
   assert(color.size() == pixels && depth.size() == pixels);
   validate_quality_settings(quality);
   const render_detail::Shader shader(settings, camera);
   const bool layered = quality.opacity < 1.0f;
-  const BandLayout bands = choose_bands(camera.width, camera.height, pool.thread_count());
-
-  SetupConstants setup;
-  setup.camera = camera;
-  setup.rule = rule_constants(quality);
-  setup.lowpass_radius_px = quality.lowpass_radius_px;
-  setup.radius_scale = quality.radius_scale;
-  setup.has_colors = stream.has_colors;
-  setup.base_color = settings.base_color;
-  setup.band_rows = bands.rows;
-  setup.band_count = bands.count;
-  if (scratch.chunk_splats.size() < stream.chunk_count) {
-    scratch.chunk_splats.resize(stream.chunk_count);
-    scratch.chunk_bins.resize(stream.chunk_count);
-  }
-  if (scratch.chunk_planes.size() < stream.chunk_count) {
-    scratch.chunk_planes.resize(stream.chunk_count);
-  }
+  const SetupConstants setup =
+      quality_setup(camera, settings, quality, stream.has_colors, pool.thread_count());
+  const BandLayout bands{setup.band_rows, setup.band_count};
   const bool features = stream.has_features;
-  pool.run(stream.chunk_count, [&](std::size_t c) {
-    prepare_chunk(stream.chunks[c], setup, features, scratch.chunk_splats[c],
-                  scratch.chunk_bins[c], scratch.chunk_planes[c]);
-  });
+  if (!pieces) {
+    if (scratch.chunk_splats.size() < stream.chunk_count) {
+      scratch.chunk_splats.resize(stream.chunk_count);
+      scratch.chunk_bins.resize(stream.chunk_count);
+    }
+    if (scratch.chunk_planes.size() < stream.chunk_count) {
+      scratch.chunk_planes.resize(stream.chunk_count);
+    }
+    pool.run(stream.chunk_count, [&](std::size_t c) {
+      prepare_chunk(stream.chunks[c], setup, features, scratch.chunk_splats[c],
+                    scratch.chunk_bins[c], scratch.chunk_planes[c]);
+    });
+  }
+  const PassOrder stream_order{stream.chunk_count, pieces};
 
   View v;
   v.half_w = 0.5f * static_cast<float>(camera.width);
@@ -512,20 +521,20 @@ void rasterize_quality(const SplatStream& stream, const CameraFrame& camera, con
                       &clipped_here, &other_here};
       clear_planes(band, layered, surface_rule);
       if (surface_rule) {
-        band_pass(stream, scratch, b, band_count, v, band,
+        band_pass(stream_order, scratch, b, band_count, v, band,
                   pick<false, false, false, kFindFront>(z_range));
-        band_pass(stream, scratch, b, band_count, v, band,
+        band_pass(stream_order, scratch, b, band_count, v, band,
                   pick<false, false, false, kSameSurface>(z_range));
-        band_pass(stream, scratch, b, band_count, v, band,
+        band_pass(stream_order, scratch, b, band_count, v, band,
                   pick<true, false, false, kSameSurface>(z_range));
         band_shader.shade<false>(band, out, true);
         continue;
       }
-      band_pass(stream, scratch, b, band_count, v, band,
+      band_pass(stream_order, scratch, b, band_count, v, band,
                 features ? pick<false, false, false, kClipOnly>(z_range)
                          : pick<false, false, false>(z_range));
       if (!layered) {
-        band_pass(stream, scratch, b, band_count, v, band, pick<true, false, false>(z_range));
+        band_pass(stream_order, scratch, b, band_count, v, band, pick<true, false, false>(z_range));
         band_shader.shade<false>(band, out, true);
         continue;
       }
@@ -541,7 +550,7 @@ void rasterize_quality(const SplatStream& stream, const CameraFrame& camera, con
                                         : pick<true, false, true>(z_range))
                                 : (last ? pick<true, true, false>(z_range)
                                         : pick<true, true, true>(z_range)));
-        band_pass(stream, scratch, b, band_count, v, band, draw);
+        band_pass(stream_order, scratch, b, band_count, v, band, draw);
         const bool more = band_shader.shade<true>(band, out, surface == 0);
         if (last || !more) break;
         next_surface(band);
@@ -553,6 +562,43 @@ void rasterize_quality(const SplatStream& stream, const CameraFrame& camera, con
   });
   scratch.clipped_fragments = clipped;
   scratch.other_surface_fragments = other_surface;
+}
+
+}  // namespace
+
+namespace quality_detail {
+
+SetupConstants quality_setup(const CameraFrame& camera, const RenderSettings& settings,
+                             const QualitySettings& quality, bool has_colors, unsigned threads) {
+  const BandLayout bands = choose_bands(camera.width, camera.height, threads);
+  SetupConstants setup;
+  setup.camera = camera;
+  setup.rule = rule_constants(quality);
+  setup.lowpass_radius_px = quality.lowpass_radius_px;
+  setup.radius_scale = quality.radius_scale;
+  setup.has_colors = has_colors;
+  setup.base_color = settings.base_color;
+  setup.band_rows = bands.rows;
+  setup.band_count = bands.count;
+  return setup;
+}
+
+void rasterize_quality_pieces(const SplatStream& stream, std::span<const StreamPiece> pieces,
+                              const CameraFrame& camera, const RenderSettings& settings,
+                              const QualitySettings& quality, ThreadPool& pool,
+                              QualityScratch& scratch, std::span<Rgb8> color,
+                              std::span<float> depth) {
+  assert(!stream.has_features && scratch.chunk_splats.size() >= stream.chunk_count);
+  rasterize(stream, &pieces, camera, settings, quality, pool, scratch, color, depth);
+}
+
+}  // namespace quality_detail
+
+void rasterize_quality(const SplatStream& stream, const CameraFrame& camera,
+                       const RenderSettings& settings, const QualitySettings& quality,
+                       ThreadPool& pool, QualityScratch& scratch, std::span<Rgb8> color,
+                       std::span<float> depth) {
+  rasterize(stream, nullptr, camera, settings, quality, pool, scratch, color, depth);
 }
 
 }  // namespace pointillist

@@ -81,7 +81,7 @@ namespace render_detail {
 
 void select_subtrees(std::span<const SphereNode> nodes, std::span<const SubtreeRoot> roots,
                      const ViewConstants& v, bool with_colors, SplatChunk& chunk,
-                     Counters& counters) {
+                     Counters& counters, std::vector<std::uint32_t>* ends) {
   const FlatAccess access(nodes);
   TaskState<FlatAccess> out;
   thread_local std::vector<FlatAccess::Item> stack;
@@ -89,6 +89,7 @@ void select_subtrees(std::span<const SphereNode> nodes, std::span<const SubtreeR
   chunk.reserve(kInitialChunkCapacity, with_colors, v.with_discs);
   for (const SubtreeRoot& r : roots) {
     walk_subtree(access, FlatAccess::Item{r.node, r.tests}, v, with_colors, stack, chunk, out);
+    if (ends) ends->push_back(static_cast<std::uint32_t>(chunk.count));
   }
   finish_chunk([&](std::uint32_t i) -> const SphereNode& { return nodes[i]; }, v, with_colors,
                chunk);

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <span>
+#include <vector>
 
 #include "pointillist/lod/sequential_point_tree.hpp"
 #include "pointillist/lod/sphere_tree.hpp"
@@ -24,10 +25,11 @@ struct SubtreeRoot {
 
 // Walks the subtrees `roots` of `nodes` one after the other into `chunk` (emptied first; its
 // buffers sized with colours and discs as asked), shaded as select_splats shades: the splats the
-// whole traversal would draw from those subtrees, in the same order. Adds to `counters`.
+// whole traversal would draw from those subtrees, in the same order. Adds to `counters`. With
+// `ends`, appends the chunk's splat count after each root (where each subtree's splats end).
 void select_subtrees(std::span<const SphereNode> nodes, std::span<const SubtreeRoot> roots,
                      const ViewConstants& v, bool with_colors, SplatChunk& chunk,
-                     Counters& counters);
+                     Counters& counters, std::vector<std::uint32_t>* ends = nullptr);
 
 // Sequential Point Trees (spt_selection.cpp): the sphere holding every splat of the top list,
 // whether a chunk's bounds are outside the view (the selection's chunk culling), and the
