@@ -9,6 +9,24 @@ namespace pointillist {
 
 namespace render_detail {
 
+// The smallest sphere around `a` and `b` (a sphere holding both).
+Sphere enclose(const Sphere& a, const Sphere& b) {
+  const Vec3f d = b.center - a.center;
+  const float dist = length(d);
+  if (dist + b.radius <= a.radius) return a;
+  if (dist + a.radius <= b.radius) return b;
+  const float r = 0.5f * (dist + a.radius + b.radius);
+  return {a.center + d * ((r - a.radius) / dist), r * (1.0f + 1e-6f)};
+}
+
+Sphere world_sphere(const InstanceTransform& t, const Sphere& s) {
+  return {t.apply(s.center), s.radius * t.scale * (1.0f + 1e-6f)};
+}
+Sphere world_sphere(const InstanceTransform& t, const SphereNode& n) {
+  return world_sphere(t, Sphere{n.center, n.radius});
+}
+
+
 ModelCullTree build_cull_tree(std::span<const SphereNode> nodes, std::uint32_t leaf_points) {
   ModelCullTree t;
   t.leaf_points = leaf_points;

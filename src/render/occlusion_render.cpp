@@ -30,23 +30,6 @@ using Clock = std::chrono::steady_clock;
 // Culling-hierarchy nodes of a scene at most (about 1 GB of hierarchy and per-frame state).
 constexpr std::uint64_t kMaxCullNodes = std::uint64_t{1} << 24;
 
-// The smallest sphere around `a` and `b` (a sphere holding both).
-Sphere enclose(const Sphere& a, const Sphere& b) {
-  const Vec3f d = b.center - a.center;
-  const float dist = length(d);
-  if (dist + b.radius <= a.radius) return a;
-  if (dist + a.radius <= b.radius) return b;
-  const float r = 0.5f * (dist + a.radius + b.radius);
-  return {a.center + d * ((r - a.radius) / dist), r * (1.0f + 1e-6f)};
-}
-
-Sphere world_sphere(const InstanceTransform& t, const Sphere& s) {
-  return {t.apply(s.center), s.radius * t.scale * (1.0f + 1e-6f)};
-}
-Sphere world_sphere(const InstanceTransform& t, const SphereNode& n) {
-  return world_sphere(t, Sphere{n.center, n.radius});
-}
-
 }  // namespace
 
 void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camera& camera,

@@ -80,6 +80,12 @@ inline void scale_splats(SplatChunk& chunk, float scale, bool with_discs) {
   }
 }
 
+// The smallest sphere around `a` and `b` (a sphere holding both), slightly grown for rounding.
+Sphere enclose(const Sphere& a, const Sphere& b);
+// A model-space sphere (or a node's) in the world of instance transform `t`.
+Sphere world_sphere(const InstanceTransform& t, const Sphere& s);
+Sphere world_sphere(const InstanceTransform& t, const SphereNode& n);
+
 // A model's hierarchy cut for occlusion culling: nodes down to subtrees of at most `leaf_points`
 // points (the culling leaves), in depth-first order, each with its children.
 struct ModelCullTree {

@@ -56,9 +56,6 @@ enum AccPlane : int {
 enum LayerPlane : int { kLower, kNext, kOutR, kOutG, kOutB, kTransmit, kLayerPlanes };
 constexpr int kGroupFloats = kAccPlanes * kLanes;
 constexpr int kLayerFloats = kLayerPlanes * kLanes;
-// Pixels per band: the accumulators (36 bytes per pixel) of a band stay in a core's L2 cache.
-constexpr int kBandPixels = 1 << 13;
-constexpr int kBandsPerThread = 4;
 
 inline bool any4(Int4 m) { return (m[0] | m[1] | m[2] | m[3]) != 0; }
 
@@ -437,22 +434,6 @@ void next_surface(const Band& band) {
   }
 }
 
-struct BandLayout {
-  int rows = 1, count = 1;
-};
-
-// About kBandPixels pixels per band, and at least kBandsPerThread bands per thread when the
-// image is tall enough. Changes speed only, never the image.
-BandLayout choose_bands(int width, int height, unsigned threads) {
-  BandLayout l;
-  const int groups = (width + kLanes - 1) / kLanes;
-  l.rows = std::max(1, kBandPixels / (groups * kLanes));
-  const int wanted = static_cast<int>(threads) * kBandsPerThread;
-  l.rows = std::max(1, std::min(l.rows, (height + wanted - 1) / wanted));
-  l.count = (height + l.rows - 1) / l.rows;
-  return l;
-}
-
 void rasterize(const SplatStream& stream, const std::span<const StreamPiece>* pieces,
                const CameraFrame& camera, const RenderSettings& settings,
                const QualitySettings& quality, ThreadPool& pool, QualityScratch& scratch,
@@ -465,7 +446,6 @@ void rasterize(const SplatStream& stream, const std::span<const StreamPiece>* pi
   const bool layered = quality.opacity < 1.0f;
   const SetupConstants setup =
       quality_setup(camera, settings, quality, stream.has_colors, pool.thread_count());
-  const BandLayout bands{setup.band_rows, setup.band_count};
   const bool features = stream.has_features;
   if (!pieces) {
     if (scratch.chunk_splats.size() < stream.chunk_count) {
@@ -495,27 +475,27 @@ void rasterize(const SplatStream& stream, const std::span<const StreamPiece>* pi
   const Output out{color, depth, camera.width};
 
   const int groups = (camera.width + kLanes - 1) / kLanes;
-  const std::size_t band_groups = static_cast<std::size_t>(bands.rows) * groups;
+  const std::size_t band_groups = static_cast<std::size_t>(setup.band_rows) * groups;
   // Opaque rendering with features finds each pixel's front surface first (spec §1.12: the
   // exact order-independent rule in three passes); layered rendering only clips.
   const bool surface_rule = features && !layered;
   const std::size_t buffer_floats =
       band_groups * (kGroupFloats + (layered ? kLayerFloats : 0) + (surface_rule ? kIdFloats : 0));
   const std::size_t workers =
-      std::min<std::size_t>(pool.thread_count(), static_cast<std::size_t>(bands.count));
+      std::min<std::size_t>(pool.thread_count(), static_cast<std::size_t>(setup.band_count));
   if (scratch.band_buffers.size() < workers) scratch.band_buffers.resize(workers);
   for (std::size_t w = 0; w < workers; ++w) {
     if (scratch.band_buffers[w].size() < buffer_floats) scratch.band_buffers[w].resize(buffer_floats);
   }
-  const std::size_t band_count = static_cast<std::size_t>(bands.count);
+  const std::size_t band_count = static_cast<std::size_t>(setup.band_count);
   std::atomic<std::size_t> next_band{0};
   std::atomic<std::uint64_t> clipped{0}, other_surface{0};
   pool.run(workers, [&](std::size_t worker) {
     float* buffer = scratch.band_buffers[worker].data();
     std::uint64_t clipped_here = 0, other_here = 0;
     for (std::size_t b = next_band++; b < band_count; b = next_band++) {
-      const int row0 = static_cast<int>(b) * bands.rows;
-      const Band band{row0, std::min(camera.height, row0 + bands.rows), groups, buffer,
+      const int row0 = static_cast<int>(b) * setup.band_rows;
+      const Band band{row0, std::min(camera.height, row0 + setup.band_rows), groups, buffer,
                       buffer + band_groups * kGroupFloats,
                       buffer + band_groups * (kGroupFloats + (layered ? kLayerFloats : 0)),
                       &clipped_here, &other_here};
@@ -567,21 +547,6 @@ void rasterize(const SplatStream& stream, const std::span<const StreamPiece>* pi
 }  // namespace
 
 namespace quality_detail {
-
-SetupConstants quality_setup(const CameraFrame& camera, const RenderSettings& settings,
-                             const QualitySettings& quality, bool has_colors, unsigned threads) {
-  const BandLayout bands = choose_bands(camera.width, camera.height, threads);
-  SetupConstants setup;
-  setup.camera = camera;
-  setup.rule = rule_constants(quality);
-  setup.lowpass_radius_px = quality.lowpass_radius_px;
-  setup.radius_scale = quality.radius_scale;
-  setup.has_colors = has_colors;
-  setup.base_color = settings.base_color;
-  setup.band_rows = bands.rows;
-  setup.band_count = bands.count;
-  return setup;
-}
 
 void rasterize_quality_pieces(const SplatStream& stream, std::span<const StreamPiece> pieces,
                               const CameraFrame& camera, const RenderSettings& settings,

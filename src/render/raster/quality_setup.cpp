@@ -42,7 +42,44 @@ Range pixel_span(float lo, float hi, int n) {
   return {std::max(0.0f, std::ceil(a)), std::min(nf - 1.0f, std::floor(b))};
 }
 
+// Pixels per band: the quality rasterizer's accumulators (36 bytes per pixel) of a band stay in
+// a core's L2 cache.
+constexpr int kBandPixels = 1 << 13;
+constexpr int kBandsPerThread = 4;
+
+struct BandLayout {
+  int rows = 1, count = 1;
+};
+
+// About kBandPixels pixels per band, and at least kBandsPerThread bands per thread when the
+// image is tall enough. Changes speed only, never the image.
+BandLayout choose_bands(int width, int height, unsigned threads) {
+  BandLayout l;
+  constexpr int kLanes = render_detail::kLanes;
+  const int groups = (width + kLanes - 1) / kLanes;
+  l.rows = std::max(1, kBandPixels / (groups * kLanes));
+  const int wanted = static_cast<int>(threads) * kBandsPerThread;
+  l.rows = std::max(1, std::min(l.rows, (height + wanted - 1) / wanted));
+  l.count = (height + l.rows - 1) / l.rows;
+  return l;
+}
+
 }  // namespace
+
+SetupConstants quality_setup(const CameraFrame& camera, const RenderSettings& settings,
+                             const QualitySettings& quality, bool has_colors, unsigned threads) {
+  const BandLayout bands = choose_bands(camera.width, camera.height, threads);
+  SetupConstants setup;
+  setup.camera = camera;
+  setup.rule = rule_constants(quality);
+  setup.lowpass_radius_px = quality.lowpass_radius_px;
+  setup.radius_scale = quality.radius_scale;
+  setup.has_colors = has_colors;
+  setup.base_color = settings.base_color;
+  setup.band_rows = bands.rows;
+  setup.band_count = bands.count;
+  return setup;
+}
 
 void prepare_chunk(const SplatChunk& chunk, const SetupConstants& k, bool features,
                    std::vector<float>& splats, std::vector<std::uint32_t>& bins,
