@@ -68,16 +68,34 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
     st.frame = frame_number_;
     if (spt) {
       if (!st.spt_cull_tree) st.spt_cull_tree = build_spt_cull_tree(*st.spt);
+    } else if (st.paged) {
+      // A paged model is one culling leaf: hidden, it selects nothing and requests no pages.
+      if (!st.cull_tree) {
+        st.cull_tree.emplace();
+        st.cull_tree->nodes.push_back(
+            {0, UINT32_MAX, 0, 0, 1,
+             static_cast<std::uint32_t>(std::min<std::uint64_t>(
+                 st.paged->summary().leaf_count, UINT32_MAX))});
+      }
     } else if (!st.cull_tree || st.cull_tree->leaf_points != os.leaf_points) {
       st.cull_tree = build_cull_tree(scene[i].model->tree.nodes, os.leaf_points);
     }
     states[i] = &st;
   }
+  // Paged models start their frame here: every selection of their instances adds to it.
+  for (ModelState* st : states) {
+    if (st->paged && st->frame_started != frame_number_) {
+      st->paged->begin_frame();
+      st->frame_started = frame_number_;
+    }
+  }
+  const auto paged = [&](std::uint32_t i) { return !spt && states[i]->paged.has_value(); };
   // The cull tree of instance i's model, and a node's sphere in model space.
   const auto cull_tree = [&](std::uint32_t i) -> const ModelCullTree& {
     return spt ? *states[i]->spt_cull_tree : *states[i]->cull_tree;
   };
   const auto model_bound = [&](std::uint32_t i, const ModelCullTree::Node& mn) -> Sphere {
+    if (paged(i)) return states[i]->paged->root_sphere();
     if (!spt) {
       const SphereNode& n = scene[i].model->tree.nodes[mn.tree_node];
       return {n.center, n.radius};
@@ -101,104 +119,7 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
     c.leaf_points = os.leaf_points;
     c.lod = fs.lod;
     for (const SceneInstance& inst : scene) c.scene.emplace_back(inst.model, inst.transform);
-    // BVH over the instances' world spheres: median split on the longest axis of the centres.
-    std::vector<std::uint32_t> order(scene.size());
-    std::iota(order.begin(), order.end(), 0u);
-    std::vector<Sphere> world(scene.size());
-    for (std::size_t i = 0; i < scene.size(); ++i) {
-      const ModelCullTree& t = cull_tree(static_cast<std::uint32_t>(i));
-      world[i] = t.nodes.empty()
-                     ? Sphere{scene[i].transform.translate, 0.0f}
-                     : world_sphere(scene[i].transform, model_bound(static_cast<std::uint32_t>(i),
-                                                                     t.nodes[0]));
-    }
-    c.instance_root.assign(scene.size(), UINT32_MAX);
-    struct Build {
-      std::uint32_t node, lo, hi;
-    };
-    const auto add_node = [&](std::uint32_t parent) {
-      c.h.nodes.push_back({});
-      c.h.nodes.back().parent = parent;
-      c.meta.push_back({});
-      return static_cast<std::uint32_t>(c.h.nodes.size() - 1);
-    };
-    // Splits first (parents before children), spheres afterwards bottom-up.
-    std::vector<std::vector<std::uint32_t>> kids;
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> leaf_instance;  // (bvh node, instance)
-    std::vector<Build> todo{{add_node(UINT32_MAX), 0, static_cast<std::uint32_t>(scene.size())}};
-    kids.emplace_back();
-    while (!todo.empty()) {
-      const Build b = todo.back();
-      todo.pop_back();
-      if (b.hi - b.lo == 1) {
-        leaf_instance.emplace_back(b.node, order[b.lo]);
-        continue;
-      }
-      Aabb box;
-      for (std::uint32_t k = b.lo; k < b.hi; ++k) box.extend(world[order[k]].center);
-      const Vec3f e = box.hi - box.lo;
-      const int axis = e.x >= e.y && e.x >= e.z ? 0 : (e.y >= e.z ? 1 : 2);
-      const std::uint32_t mid = b.lo + (b.hi - b.lo) / 2;
-      std::nth_element(order.begin() + b.lo, order.begin() + mid, order.begin() + b.hi,
-                       [&](std::uint32_t a, std::uint32_t b2) {
-                         const float ca = world[a].center[axis], cb = world[b2].center[axis];
-                         return ca < cb || (ca == cb && a < b2);
-                       });
-      for (const auto& [lo, hi] : {std::pair{mid, b.hi}, std::pair{b.lo, mid}}) {
-        const std::uint32_t child = add_node(b.node);
-        kids.emplace_back();
-        kids[b.node].push_back(child);
-        todo.push_back({child, lo, hi});
-      }
-    }
-    // Children lists of the BVH nodes (in split order: lower half first).
-    for (std::uint32_t n = 0; n < kids.size(); ++n) std::reverse(kids[n].begin(), kids[n].end());
-    // Each instance's model nodes, below its BVH leaf (which is the model's root itself).
-    for (const auto& leaf : leaf_instance) {
-      // Named copies: lambdas below use them (clang 14 cannot capture structured bindings).
-      const std::uint32_t bvh_leaf = leaf.first, i = leaf.second;
-      const ModelCullTree& t = cull_tree(i);
-      if (t.nodes.empty()) continue;
-      const std::uint32_t base = static_cast<std::uint32_t>(c.h.nodes.size()) - 1;
-      // Local node 0 is the BVH leaf; local k > 0 is base + k.
-      const auto global = [&](std::uint32_t local) { return local == 0 ? bvh_leaf : base + local; };
-      c.meta[bvh_leaf] = {i, 0};
-      c.instance_root[i] = bvh_leaf;
-      for (std::uint32_t k = 1; k < t.nodes.size(); ++k) {
-        c.h.nodes.push_back({});
-        c.meta.push_back({i, k});
-        kids.emplace_back();
-      }
-      for (std::uint32_t k = 0; k < t.nodes.size(); ++k) {
-        const ModelCullTree::Node& mn = t.nodes[k];
-        CullHierarchy::Node& hn = c.h.nodes[global(k)];
-        const Sphere s = world_sphere(scene[i].transform, model_bound(i, mn));
-        hn.bound = {s.center, s.radius};
-        hn.culling_leaves = mn.culling_leaves;
-        if (k > 0) hn.parent = global(mn.parent);
-        for (std::uint32_t j = 0; j < mn.child_count; ++j) {
-          kids[global(k)].push_back(global(t.children[mn.first_child + j]));
-        }
-      }
-    }
-    // Flatten children; BVH spheres and leaf counts bottom-up (children after parents).
-    for (std::uint32_t n = 0; n < c.h.nodes.size(); ++n) {
-      c.h.nodes[n].first_child = static_cast<std::uint32_t>(c.h.children.size());
-      c.h.nodes[n].child_count = static_cast<std::uint32_t>(kids[n].size());
-      c.h.children.insert(c.h.children.end(), kids[n].begin(), kids[n].end());
-    }
-    for (std::uint32_t n = static_cast<std::uint32_t>(c.h.nodes.size()); n-- > 0;) {
-      if (c.meta[n].instance != UINT32_MAX) continue;
-      CullHierarchy::Node& hn = c.h.nodes[n];
-      if (hn.child_count == 0) continue;  // an instance without nodes
-      Sphere s{c.h.nodes[kids[n][0]].bound.center, c.h.nodes[kids[n][0]].bound.radius};
-      hn.culling_leaves = 0;
-      for (const std::uint32_t k : kids[n]) {
-        s = enclose(s, {c.h.nodes[k].bound.center, c.h.nodes[k].bound.radius});
-        hn.culling_leaves += c.h.nodes[k].culling_leaves;
-      }
-      hn.bound = {s.center, s.radius};
-    }
+    build_scene_hierarchy(scene, cull_tree, model_bound, c);
   }
   SceneCull& c = *cull_;
 
@@ -252,15 +173,18 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
     const float z = dot(d, cam.forward);
     out.distance = std::max(0.0f, length(d) - hn.bound.radius);
     out.near = z - hn.bound.radius <= 0.0f;
-    if (m.instance == UINT32_MAX) {
-      // A BVH node: culled when outside a side plane of the view frustum or behind the eye.
+    const bool paged_leaf = m.instance != UINT32_MAX && paged(m.instance);
+    if (m.instance == UINT32_MAX || paged_leaf) {
+      // A BVH node or a paged model: culled when outside a side plane of the view frustum or
+      // behind the eye.
       if (settings.frustum_culling) {
         if (z <= -hn.bound.radius) return out;
         for (const Plane& p : cam.planes) {
           if (p.distance(hn.bound.center) <= -hn.bound.radius) return out;
         }
       }
-      out.kind = CullCallbacks::Kind::Interior;
+      out.kind = paged_leaf ? CullCallbacks::Kind::Leaf : CullCallbacks::Kind::Interior;
+      if (paged_leaf) c.weight[n] = static_cast<float>(cull_tree(m.instance).nodes[0].points);
       return out;
     }
     InstanceView& iv = view_of(m.instance);
@@ -311,8 +235,8 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
   std::vector<std::uint32_t> level, next;
   callbacks.bounds = [&](std::uint32_t n, std::vector<QueryBound>& out) {
     const SceneCull::Meta& m = c.meta[n];
-    if (spt && m.instance != UINT32_MAX) {
-      out.push_back(c.h.nodes[n].bound);
+    if (m.instance != UINT32_MAX && (spt || paged(m.instance))) {
+      out.push_back(c.h.nodes[n].bound);  // an SPT range, a paged model: its one sphere
       return;
     }
     if (m.instance == UINT32_MAX) {
@@ -396,13 +320,63 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
   // splat each do not make a thousand chunks. The fast rasterizer's image does not depend on
   // how the splats are grouped or ordered.
   constexpr float kGroupSplats = 4096.0f;
-  std::vector<std::uint32_t> order;
+  std::vector<std::uint32_t> order, paged_leaves;
   std::vector<std::pair<std::size_t, std::size_t>> groups;
   // Leaves in the order of the selection without culling: by instance, then depth first (an
   // instance's nodes are numbered depth first).
   const auto canonical = [&](std::uint32_t a, std::uint32_t b) {
     return c.meta[a].instance < c.meta[b].instance ||
            (c.meta[a].instance == c.meta[b].instance && a < b);
+  };
+  // Quality mode: every leaf drawn this frame, and where its splats are in the stream.
+  std::vector<std::pair<std::uint32_t, quality_detail::StreamPiece>>& drawn = c.drawn;
+  drawn.clear();
+  // A selected chunk of instance `instance` made ready for the rasterizers: into the world,
+  // its features (`f`, or from the pages), base colours, splat scale.
+  const auto finish = [&](std::uint32_t instance, bool colored, const TreeFeatures* f,
+                          bool page_features, SplatChunk& chunk) {
+    const SceneInstance& inst = scene[instance];
+    const InstanceView& iv = views[instance];
+    chunk.instance = instance;
+    if (!iv.identity) to_world(inst.transform, chunk, with_discs);
+    if (features) {
+      const InstanceTransform* t = iv.identity ? nullptr : &inst.transform;
+      if (page_features) {
+        place_features(t, iv.id_base, chunk);
+      } else {
+        attach_features(f, t, iv.id_base, chunk);
+      }
+    }
+    if (any_colors && !colored) fill_base_color(chunk, settings, with_discs);
+    scale_splats(chunk, fs.splat_scale, with_discs);
+  };
+  // A paged model's visible instance: its selection (which requests the pages it needs) moved
+  // behind the stream's chunks; in the fast mode each chunk's pixel rectangle goes to `rects`,
+  // in the quality mode each chunk is a piece of leaf n.
+  const auto select_paged = [&](std::uint32_t n) {
+    const std::uint32_t instance = c.meta[n].instance;
+    ModelState& st = *states[instance];
+    const bool page_features = features && st.pages->features();
+    scratch_stream_.with_discs = with_discs;
+    const SelectionStats sel = st.paged->select(views[instance].cam, settings, pool,
+                                                scratch_stream_, true, page_features);
+    counters.visited += sel.nodes_visited;
+    counters.culled_frustum += sel.culled_frustum;
+    counters.culled_backface += sel.culled_backface;
+    for (std::size_t k = 0; k < scratch_stream_.chunk_count; ++k) {
+      SplatChunk& chunk = scratch_stream_.chunks[k];
+      finish(instance, scratch_stream_.has_colors, nullptr, page_features, chunk);
+      const std::size_t at = stream.chunk_count++;
+      if (stream.chunks.size() < stream.chunk_count) stream.chunks.resize(stream.chunk_count);
+      std::swap(stream.chunks[at], chunk);
+      const SplatChunk& placed = stream.chunks[at];
+      if (quality) {
+        drawn.push_back({n, {static_cast<std::uint32_t>(at), 0,
+                             static_cast<std::uint32_t>(placed.count)}});
+      } else {
+        rects.push_back(chunk_pixel_rect(placed, cam));
+      }
+    }
   };
   // Selects the leaves of `order` (in canonical order) into chunks appended to the stream, in
   // that order, adds the selection's counts to the frame's and, in the fast mode, writes the
@@ -460,33 +434,10 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
         select_subtrees(inst.model->tree.nodes, roots, iv.v, inst.model->tree.has_colors, chunk,
                         task_counters[g], quality ? &group_ends[g] : nullptr);
       }
-      chunk.instance = instance;
-      const bool colored = spt ? st.spt->has_colors : inst.model->tree.has_colors;
-      if (!iv.identity) to_world(inst.transform, chunk, with_discs);
-      if (features) {
-        const TreeFeatures* f =
-            spt ? (st.spt_features ? &*st.spt_features : nullptr) : inst.model->tree.features;
-        attach_features(f, iv.identity ? nullptr : &inst.transform, iv.id_base, chunk);
-      }
-      if (any_colors && !colored) fill_base_color(chunk, settings, with_discs);
-      scale_splats(chunk, fs.splat_scale, with_discs);
-      if (!with_rects) return;
-      // The pixels the chunk may touch (a splat covers its disc or the pixel of its centre).
-      float x0 = std::numeric_limits<float>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
-      for (std::size_t i = 0; i < chunk.count; ++i) {
-        const float r = 0.5f * chunk.size_px[i] + 1.0f;
-        x0 = std::min(x0, chunk.x_px[i] - r);
-        x1 = std::max(x1, chunk.x_px[i] + r);
-        y0 = std::min(y0, chunk.y_px[i] - r);
-        y1 = std::max(y1, chunk.y_px[i] + r);
-      }
-      if (chunk.count > 0) {
-        const auto clampi = [](float v, int hi) {
-          return static_cast<int>(std::clamp(v, 0.0f, static_cast<float>(hi)));
-        };
-        rects[g] = {clampi(std::floor(x0), cam.width), clampi(std::floor(y0), cam.height),
-                    clampi(std::ceil(x1) + 1, cam.width), clampi(std::ceil(y1) + 1, cam.height)};
-      }
+      const TreeFeatures* f =
+          spt ? (st.spt_features ? &*st.spt_features : nullptr) : inst.model->tree.features;
+      finish(instance, spt ? st.spt->has_colors : inst.model->tree.has_colors, f, false, chunk);
+      if (with_rects) rects[g] = chunk_pixel_rect(chunk, cam);
     });
     stream.chunk_count = first + groups.size();
     for (std::size_t g = 0; g < groups.size(); ++g) {
@@ -497,14 +448,22 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
     }
     return first;
   };
-  // Quality mode: every leaf drawn this frame, and where its splats are in the stream.
-  std::vector<std::pair<std::uint32_t, quality_detail::StreamPiece>>& drawn = c.drawn;
-  drawn.clear();
   const SoftwareQueries::Draw draw = [&](std::span<const std::uint32_t> batch) {
     const auto t0 = Clock::now();
     order.assign(batch.begin(), batch.end());
     std::sort(order.begin(), order.end(), canonical);
+    // Paged models select on the pool themselves: one after the other, after the groups.
+    const auto split = std::stable_partition(order.begin(), order.end(), [&](std::uint32_t n) {
+      return !paged(c.meta[n].instance);
+    });
+    paged_leaves.assign(split, order.end());
+    order.erase(split, order.end());
     const std::size_t first = select_order();
+    for (const std::uint32_t n : paged_leaves) {
+      view_of(c.meta[n].instance);
+      instance_drawn[c.meta[n].instance] = 1;
+      select_paged(n);
+    }
     const auto t1 = Clock::now();
     SoftwareQueries::Rect dirty{cam.width, cam.height, 0, 0};
     if (quality) {
@@ -521,12 +480,12 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
                                                      settings, fs.quality, pool, quality_scratch_,
                                                      c.occluders, frame.depth);
     } else {
-      for (std::size_t g = 0; g < groups.size(); ++g) {
-        if (rects[g].x1 > rects[g].x0 && rects[g].y1 > rects[g].y0) {
-          dirty.x0 = std::min(dirty.x0, rects[g].x0);
-          dirty.y0 = std::min(dirty.y0, rects[g].y0);
-          dirty.x1 = std::max(dirty.x1, rects[g].x1);
-          dirty.y1 = std::max(dirty.y1, rects[g].y1);
+      for (const SoftwareQueries::Rect& r : rects) {
+        if (r.x1 > r.x0 && r.y1 > r.y0) {
+          dirty.x0 = std::min(dirty.x0, r.x0);
+          dirty.y0 = std::min(dirty.y0, r.y0);
+          dirty.x1 = std::max(dirty.x1, r.x1);
+          dirty.y1 = std::max(dirty.y1, r.y1);
         }
       }
       draw_splats(stream, first, stream.chunk_count, cam, settings, pool, frame.scratch,
@@ -545,8 +504,10 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
     // The quality pass over the visible leaves' splats in the order of no culling (the setup of
     // every chunk is the occluder pass's).
     const auto t0 = Clock::now();
-    std::sort(drawn.begin(), drawn.end(),
-              [&](const auto& a, const auto& b) { return canonical(a.first, b.first); });
+    std::sort(drawn.begin(), drawn.end(), [&](const auto& a, const auto& b) {
+      return canonical(a.first, b.first) ||
+             (a.first == b.first && a.second.chunk < b.second.chunk);  // a paged model's chunks
+    });
     std::vector<quality_detail::StreamPiece>& pieces = c.pieces;
     pieces.clear();
     for (const auto& d : drawn) {

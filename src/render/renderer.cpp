@@ -101,13 +101,11 @@ void Renderer::render(std::span<const SceneInstance> scene, const Camera& camera
   if (occlusion) {
     const bool quality = fs.rasterizer == Rasterizer::Quality;
     const char* drop = fs.rasterizer == Rasterizer::Reference ? "--mode reference"
-                       : options_.page_all                    ? "--memory and --progressive"
                        : quality && fs.lod == LodScheme::Spt  ? "--lod spt with --mode quality"
                        : quality && fs.quality.opacity < 1.0f
                            ? "--opacity below 1 (what shows through is not hidden)"
                            : nullptr;
     for (const SceneInstance& inst : scene) {
-      if (!drop && inst.model->pages) drop = "the paged model (open it whole)";
       if (!drop && quality && fs.features && model_features(*inst.model)) {
         drop = "sharp features with --mode quality (add --no-features)";
       }
@@ -116,13 +114,15 @@ void Renderer::render(std::span<const SceneInstance> scene, const Camera& camera
       throw OptionError(std::string("occlusion culling (--occlusion ") +
                         name(fs.occlusion.method) +
                         ") works with the fast mode, and the quality mode of opaque surfaces "
-                        "without sharp features, on models held whole so far; drop " +
+                        "without sharp features; drop " +
                         drop + ", or --occlusion");
     }
   }
   last_frame_.clear();
   spt_stats_ = {};
   ++frame_number_;
+  frame.splats.trim();
+  scratch_stream_.trim();
   if (occlusion) {
     render_occluded(scene, camera, settings, fs, pool, frame);
   } else if (fs.rasterizer == Rasterizer::Reference) {

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <memory>
 #include <optional>
 
@@ -86,6 +87,9 @@ Sphere enclose(const Sphere& a, const Sphere& b);
 Sphere world_sphere(const InstanceTransform& t, const Sphere& s);
 Sphere world_sphere(const InstanceTransform& t, const SphereNode& n);
 
+// The pixels [x0, x1) × [y0, y1) the fast rasterizer may touch drawing `chunk`.
+SoftwareQueries::Rect chunk_pixel_rect(const SplatChunk& chunk, const CameraFrame& cam);
+
 // A model's hierarchy cut for occlusion culling: nodes down to subtrees of at most `leaf_points`
 // points (the culling leaves), in depth-first order, each with its children.
 struct ModelCullTree {
@@ -116,6 +120,26 @@ ModelCullTree build_cull_tree(std::span<const SphereNode> nodes, std::uint32_t l
 inline constexpr std::uint32_t kSptTopList = UINT32_MAX - 1;
 ModelCullTree build_spt_cull_tree(const SequentialPointTree& spt);
 
+// Occlusion culling's hierarchy over a scene: a BVH over the instances (median splits on the
+// longest axis of their world spheres' centres), each instance's model cull tree below its BVH
+// leaf (the leaf is the model's root itself), parents before children.
+struct CullMeta {
+  std::uint32_t instance = UINT32_MAX;  // UINT32_MAX: a BVH node
+  std::uint32_t local = 0;              // the node in the instance's model cull tree
+};
+struct SceneHierarchy {
+  CullHierarchy h;
+  std::vector<CullMeta> meta;                // per node
+  std::vector<std::uint32_t> instance_root;  // the node of each instance's model root
+};
+// Builds `h` (empty) for `scene`: `cull_tree(i)` is instance i's model cull tree,
+// `model_bound(i, node)` a node's sphere in model space.
+void build_scene_hierarchy(std::span<const SceneInstance> scene,
+                           const std::function<const ModelCullTree&(std::uint32_t)>& cull_tree,
+                           const std::function<Sphere(std::uint32_t, const ModelCullTree::Node&)>&
+                               model_bound,
+                           SceneHierarchy& h);
+
 }  // namespace pointillist::render_detail
 
 namespace pointillist {
@@ -131,22 +155,17 @@ struct Renderer::ModelState {
   std::uint64_t model_bytes = 0;  // storage bytes of a paged model (open + every page)
   std::optional<render_detail::ModelCullTree> cull_tree;      // occlusion culling (QSplat)
   std::optional<render_detail::ModelCullTree> spt_cull_tree;  // occlusion culling (SPT)
+  std::uint64_t frame_started = 0;  // occlusion culling: the frame a paged model last began
 };
 
 
 // The scene's culling hierarchy (BVH nodes first, then each instance's model nodes) and its
 // state across frames.
-struct Renderer::SceneCull {
-  struct Meta {
-    std::uint32_t instance = UINT32_MAX;  // UINT32_MAX: a BVH node
-    std::uint32_t local = 0;              // the node in the instance's model cull tree
-  };
+struct Renderer::SceneCull : render_detail::SceneHierarchy {
+  using Meta = render_detail::CullMeta;
   std::vector<std::pair<const RenderModel*, InstanceTransform>> scene;  // what it was built for
   std::uint32_t leaf_points = 0;
   LodScheme lod = LodScheme::QSplat;
-  CullHierarchy h;
-  std::vector<Meta> meta;
-  std::vector<std::uint32_t> instance_root;  // the node of each instance's model root
   CullState state;
   DepthPyramid pyramid;
   // Work buffers of a frame, kept for the next: per node the per-node tests left when it is

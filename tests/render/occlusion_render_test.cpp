@@ -311,6 +311,69 @@ TEST(OcclusionRender, QualityModeCullsSingleSplatLeavesWithTheSameImage) {
   }
 }
 
+TEST(OcclusionRender, PagedModelsAreCulledWholeAndHiddenOnesLoadNoPages) {
+  // Every model drawn page by page: each instance of a paged model is one culling leaf. Balls of
+  // a model seen nowhere else stand well behind the wall: found hidden, they select nothing, so
+  // their model loads no page beyond its root page, and the settled image (every page the view
+  // needs resident) is the one of no culling.
+  const TestScene scene(false);
+  ThreadPool pool(2);
+  SphereTree hidden_tree = build_sphere_tree(ball_points(3000, false), pool);
+  RenderModel hidden;
+  hidden.tree = hidden_tree.view();
+  hidden.name = "hidden";
+  std::vector<SceneInstance> instances{scene.instances[0], scene.instances.back()};
+  const std::vector<SceneInstance> without_hidden = instances;
+  for (int i = 0; i < 4; ++i) {
+    instances.push_back({&hidden, make_transform({-2.0f + 1.3f * float(i), 1.5f, -5.0f},
+                                                 {0, 20.0f * float(i), 0}, 0.4f)});
+  }
+  const Camera camera = path_camera(0, 4);
+  struct Settled {
+    Image image;
+    std::uint64_t pages_loaded = 0;
+  };
+  // Frames until every page the view needs is resident, then `more` frames (CHC++ keeps
+  // drawing what was visible until its next query).
+  const auto settle = [&](std::span<const SceneInstance> scene_instances, const FrameSettings& fs,
+                          int more) {
+    Renderer renderer({.page_all = true});
+    Frame frame;
+    for (int k = 0; k < 60 && more >= 0; ++k) {
+      renderer.render(scene_instances, camera, {}, fs, pool, frame);
+      if (renderer.complete()) --more;
+      renderer.load_requested(pool);
+    }
+    EXPECT_TRUE(renderer.complete());
+    Settled out;
+    out.image = {std::vector<Rgb8>(frame.color.begin(), frame.color.end()),
+                 std::vector<float>(frame.depth.begin(), frame.depth.end()), frame.stats.splats,
+                 frame.stats.occlusion};
+    out.pages_loaded = renderer.paging_stats().cache.pages_loaded;
+    return out;
+  };
+  for (Rasterizer mode : {Rasterizer::Fast, Rasterizer::Quality}) {
+    FrameSettings none;
+    none.rasterizer = mode;
+    const Settled plain = settle(instances, none, 0);
+    const Settled visible_only = settle(without_hidden, none, 0);
+    for (OcclusionMethod m : {OcclusionMethod::StopAndWait, OcclusionMethod::ChcPlusPlus}) {
+      FrameSettings fs = none;
+      fs.occlusion.method = m;
+      const Settled culled = settle(instances, fs, 12);
+      EXPECT_TRUE(same_bits(culled.image, plain.image)) << name(m) << " mode " << int(mode);
+      EXPECT_EQ(culled.image.splats, visible_only.image.splats) << name(m) << " " << int(mode);
+      EXPECT_GE(culled.image.occlusion.leaves_culled, 4u) << name(m) << " " << int(mode);
+      if (m == OcclusionMethod::StopAndWait) {
+        // Hidden from the first frame: the hidden model's root page (loaded when the model is
+        // first met) and nothing more.
+        EXPECT_EQ(culled.pages_loaded, visible_only.pages_loaded + 1) << int(mode);
+        EXPECT_GT(plain.pages_loaded, culled.pages_loaded + 4) << int(mode);
+      }
+    }
+  }
+}
+
 TEST(OcclusionRender, AnEmptySceneIsTheBackground) {
   ThreadPool pool(2);
   Renderer renderer;
@@ -365,8 +428,4 @@ TEST(OcclusionRender, CombinationsNotYetSupportedAreRefusedWithAMessage) {
       EXPECT_NE(std::string(e.what()).find("--cull-leaf"), std::string::npos) << e.what();
     }
   }
-  Renderer paging({.page_all = true});
-  fs.rasterizer = Rasterizer::Fast;
-  EXPECT_THROW(paging.render(scene.instances, path_camera(0, 2), {}, fs, pool, frame),
-               OptionError);
 }

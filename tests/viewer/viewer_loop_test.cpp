@@ -161,7 +161,8 @@ TEST(ViewerLoop, PagedModelSettlesWithItsPagesAndRefusesWhatPagesCannotDraw) {
   ASSERT_TRUE(model.paged());
   const std::vector<SceneInstance> scene{{.model = &model.renderable()}};
   Navigator nav(fx.home, fx.tree.view_sphere, {0, 1, 0});
-  // SPT and occlusion culling are not drawn from pages: refused, undone, the viewer goes on.
+  // SPT is not drawn from pages: refused, undone, the viewer goes on. Occlusion culling is (each
+  // instance of a paged model one culling leaf): the screenshot below is taken with it on.
   ViewerOptions o = scripted(
       dir, "settle\nkey l\nsettle\nkey c\nsettle\nscreenshot " + dir.file("p.png") + "\n");
   Renderer renderer({.page_all = true, .memory_cap = 1u << 20});

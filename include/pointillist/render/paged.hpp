@@ -57,6 +57,12 @@ class PagedRenderer {
                         ThreadPool& pool, SplatStream& stream, bool same_frame = false,
                         bool features = false);
 
+  // Starts a frame whose selections all pass same_frame (occlusion culling selects a model's
+  // instances only when they are visible): drops the last frame's page requests, so a model
+  // found hidden requests none.
+  void begin_frame();
+  // The sphere of the hierarchy's root (page 0's first node): it holds every splat's disc.
+  Sphere root_sphere() const;
   // Loading between frames: see PageCache (the requests are the last render's).
   std::size_t load_requested(ThreadPool& pool, std::size_t max_pages = SIZE_MAX,
                              std::uint64_t max_storage_bytes = UINT64_MAX) {

@@ -85,6 +85,13 @@ struct SplatStream {
     for (std::size_t c = 0; c < chunk_count; ++c) n += chunks[c].count;
     return n;
   }
+  // Called before a new selection: frees the buffers of chunks much larger than what they held
+  // in the last frame (over 4× its count plus kTrimSlack splats; the chunks past chunk_count
+  // held nothing). A chunk's index gets other parts of the scene from frame to frame, so
+  // without this every index would keep the largest chunk it ever held: gigabytes for scenes
+  // of thousands of instances.
+  void trim();
+  static constexpr std::size_t kTrimSlack = 1024;
 };
 
 }  // namespace pointillist

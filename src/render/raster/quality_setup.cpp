@@ -85,7 +85,13 @@ void prepare_chunk(const SplatChunk& chunk, const SetupConstants& k, bool featur
                    std::vector<float>& splats, std::vector<std::uint32_t>& bins,
                    std::vector<float>& planes) {
   const std::size_t n = chunk.count;
-  if (splats.size() < kStride * n) splats.resize(std::max(kStride * n, 2 * splats.size()));
+  // Grown by half again when short; released when far larger than needed (a chunk's index
+  // gets other parts of the scene from frame to frame: see SplatStream::trim).
+  const std::size_t need = kStride * n;
+  if (splats.size() > 4 * need + kStride * SplatStream::kTrimSlack) {
+    std::vector<float>().swap(splats);
+  }
+  if (splats.size() < need) splats.resize(std::max(need, splats.size() + splats.size() / 2));
   const CameraFrame& cam = k.camera;
   const float f = cam.focal_px;
   const float half_w = 0.5f * static_cast<float>(cam.width);

@@ -237,6 +237,20 @@ SelectionStats PagedRenderer::select(const CameraFrame& cam, const RenderSetting
           .culled_backface = counters.culled_backface};
 }
 
+void PagedRenderer::begin_frame() {
+  cache_.begin_frame();
+  cache_.end_frame();
+}
+
+Sphere PagedRenderer::root_sphere() const {
+  const PageTable& pages = cache_.pages();
+  // Page 0 stays resident (begin_frame keeps it in use); a sphere holding anything otherwise.
+  if (pages.empty() || !pages[0]) return {summary_.view_sphere.center, 1e30f};
+  if (!pages[0]->is_packed()) return {pages[0]->nodes[0].center, pages[0]->nodes[0].radius};
+  const SphereNode root = PackedAccess(pages, summary_.has_colors, false).root(0).node;
+  return {root.center, root.radius};
+}
+
 void PagedRenderer::render_frame(const Camera& camera, const RenderSettings& settings,
                                  const QualitySettings* quality, QualityScratch* scratch,
                                  ThreadPool& pool, Frame& frame) {

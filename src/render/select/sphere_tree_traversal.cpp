@@ -39,6 +39,15 @@ void SplatChunk::reserve(std::size_t n, bool with_colors, bool with_discs) {
   }
 }
 
+void SplatStream::trim() {
+  for (std::size_t c = 0; c < chunks.size(); ++c) {
+    SplatChunk& chunk = chunks[c];
+    const std::size_t held = c < chunk_count ? chunk.count : 0;
+    if (chunk.capacity() <= 4 * held + kTrimSlack) continue;
+    chunk = SplatChunk{};
+  }
+}
+
 namespace {
 
 using namespace render_detail;
