@@ -163,7 +163,8 @@ int run_render(const RenderOptions& o) {
   open.features = o.features;
   open.stored_features = o.frame.features;
   if (o.features) open.paging = Paging::Never;  // features need the hierarchy held whole
-  // Occlusion culling draws from hierarchies held whole (so far).
+  // Occlusion culling culls inside models held whole, a paged model only as a whole: decode
+  // them unless paging is asked for.
   if (o.frame.occlusion.method != OcclusionMethod::None && !paging_asked) {
     open.paging = Paging::Never;
   }

@@ -102,6 +102,28 @@ TEST(OcclusionCli, QualityModeWritesTheFramesOfNoCullingAndCullsTheHiddenStatues
   }
 }
 
+TEST(OcclusionCli, PagedModelsAreCulledWholeWithTheSameImage) {
+  // --memory draws every model page by page: each statue is one culling leaf (which pages a
+  // hidden model does not load is tested in the renderer's tests).
+  pointillist::testing::TempDir dir;
+  auto r = run_cli("generate --scene wall --spacing-scale 8 --points 400 --quiet -o " +
+                   dir.file("wall.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string common = "render " + dir.file("wall.json") +
+                             " --size 320x180 --view 0,5 --memory 256M --quiet ";
+  r = run_cli(common + "-o " + dir.file("none.png") + " --stats " + dir.file("none.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = run_cli(common + "--occlusion stop-and-wait -o " + dir.file("saw.png") + " --stats " +
+              dir.file("saw.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(bytes(dir.file("saw.png")), bytes(dir.file("none.png")));
+  const auto plain = nlohmann::json::parse(bytes(dir.file("none.json")));
+  const auto culled = nlohmann::json::parse(bytes(dir.file("saw.json")));
+  ASSERT_TRUE(culled.value("paged", false)) << culled.dump();
+  EXPECT_GT(culled["occlusion"]["leaves_culled"].get<int>(), 0) << culled.dump();
+  EXPECT_LT(culled["splats"].get<std::uint64_t>(), plain["splats"].get<std::uint64_t>());
+}
+
 TEST(OcclusionCli, OptionsThatCannotApplyAreNamed) {
   pointillist::testing::TempDir dir;
   auto r = run_cli("generate --scene row --points 200 --quiet -o " + dir.file("row.json"));
