@@ -252,6 +252,13 @@ void make_xyz(const fs::path& dir) {
   write_gzip(dir / "colors.xyz.gz", blank);
 }
 
+void make_path(const fs::path& dir) {
+  write_file(dir / "walk.path",
+             "# a walk toward the wall, then past its end\nfov 40\n0 0.6 4   0 0.6 0\n"
+             "0.5 0.6 2   0.5 0.6 -1\n3 1 1   -1 0.5 -2   0 1 0\n");
+  write_file(dir / "close.path", "0 0.5 0.05  0 0.5 -3\n0 10 0.01  0 0 0  0 0 -1\n");
+}
+
 void make_models(const fs::path& root, ThreadPool& pool) {
   const PointSet small = sphere_points(40, true, pool);
   const PointSet plain = sphere_points(40, false, pool);
@@ -296,13 +303,14 @@ int main(int argc, char** argv) {
   }
   try {
     const fs::path root = argv[1];
-    for (const char* harness : {"ply", "las", "obj", "xyz", "qs", "ptl_v1", "ptl_v2"})
+    for (const char* harness : {"ply", "las", "obj", "xyz", "qs", "ptl_v1", "ptl_v2", "path"})
       fs::create_directories(root / harness);
     ThreadPool pool(1);
     make_ply(root / "ply", pool);
     make_las(root / "las");
     make_obj(root / "obj");
     make_xyz(root / "xyz");
+    make_path(root / "path");
     make_models(root, pool);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "make_corpus: %s\n", e.what());
