@@ -11,6 +11,7 @@
 #include "fuzz_support.hpp"
 #include "pointillist/io/camera_path.hpp"
 #include "pointillist/lod/sphere_tree.hpp"
+#include "pointillist/pipeline/scene.hpp"
 
 using namespace pointillist;
 
@@ -20,12 +21,12 @@ constexpr const char* kName = "fuzz.path";
 constexpr std::size_t kMaxFrames = 3;  // frames rendered per input (each in four ways)
 
 // A wall with two small grids behind and one in front: something to hide, something hidden.
-struct Scene {
+struct TinyScene {
   ThreadPool pool{1};
   SphereTree wall_tree, block_tree;
   RenderModel wall, block;
   std::vector<SceneInstance> instances;
-  Scene() {
+  TinyScene() {
     const auto grid = [](int nx, int ny, float step) {
       PointSet p;
       for (int j = 0; j < ny; ++j) {
@@ -52,7 +53,7 @@ struct Scene {
   }
 };
 
-void render_all_ways(Scene& scene, const Camera& camera) {
+void render_all_ways(TinyScene& scene, const Camera& camera) {
   for (Rasterizer mode : {Rasterizer::Fast, Rasterizer::Quality}) {
     FrameSettings none;
     none.rasterizer = mode;
@@ -83,7 +84,7 @@ void render_all_ways(Scene& scene, const Camera& camera) {
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  static Scene scene;
+  static TinyScene scene;
   const std::string_view text(reinterpret_cast<const char*>(data), size);
   CameraPath path;
   try {
