@@ -409,6 +409,7 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
       const InstanceView& iv = views[instance];
       SplatChunk& chunk = stream.chunks[first + g];
       const ModelState& st = *states[instance];
+      group_ends[g].clear();
       if (spt) {
         chunk.count = 0;
         for (std::size_t k = groups[g].first; k < groups[g].second; ++k) {
@@ -422,6 +423,7 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
             select_spt_range(t, sc.begin, sc.end, sc.bounds, iv.cam, settings, fs.epsilon_px,
                              *iv.shader, with_discs, chunk, spt_counters[g]);
           }
+          if (quality) group_ends[g].push_back(static_cast<std::uint32_t>(chunk.count));
         }
       } else {
         thread_local std::vector<SubtreeRoot> roots;
@@ -430,7 +432,6 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
           const std::uint32_t n = order[k];
           roots.push_back({st.cull_tree->nodes[c.meta[n].local].tree_node, tests_in[n]});
         }
-        group_ends[g].clear();
         select_subtrees(inst.model->tree.nodes, roots, iv.v, inst.model->tree.has_colors, chunk,
                         task_counters[g], quality ? &group_ends[g] : nullptr);
       }

@@ -101,7 +101,6 @@ void Renderer::render(std::span<const SceneInstance> scene, const Camera& camera
   if (occlusion) {
     const bool quality = fs.rasterizer == Rasterizer::Quality;
     const char* drop = fs.rasterizer == Rasterizer::Reference ? "--mode reference"
-                       : quality && fs.lod == LodScheme::Spt  ? "--lod spt with --mode quality"
                        : quality && fs.quality.opacity < 1.0f
                            ? "--opacity below 1 (what shows through is not hidden)"
                            : nullptr;

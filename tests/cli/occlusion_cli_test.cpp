@@ -138,8 +138,7 @@ TEST(OcclusionCli, OptionsThatCannotApplyAreNamed) {
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_THAT(r.output, HasSubstr("--chc-batch is ignored: it applies with --occlusion chc++"));
   for (const auto& [args, message] :
-       {std::pair{"--mode quality --lod spt", "drop --lod spt with --mode quality"},
-        std::pair{"--mode quality --opacity 0.5", "drop --opacity below 1"}}) {
+       {std::pair{"--mode quality --opacity 0.5", "drop --opacity below 1"}}) {
     r = run_cli(common + "--occlusion chc++ " + args);
     EXPECT_EQ(r.exit_code, 2) << r.output;
     EXPECT_THAT(r.output, HasSubstr(message));

@@ -216,14 +216,16 @@ TEST(OcclusionRender, NothingThatWinsAPixelWithoutCullingIsCulled) {
 
 TEST(OcclusionRender, SptChunksAreCulledWithTheSameImage) {
   // With --lod spt the culling leaves are the Sequential Point Tree's list ranges (the top list
-  // and the chunks).
+  // and the chunks), in the fast mode (two kernels) and the quality mode.
   const TestScene scene(false);
   constexpr int kFrames = 4;
-  for (SplatShape shape : {SplatShape::Square, SplatShape::Ellipse}) {
+  for (int variant = 0; variant < 3; ++variant) {
     RenderSettings settings;
-    settings.shape = shape;
+    settings.shape = variant == 0 ? SplatShape::Square : SplatShape::Ellipse;
+    const SplatShape shape = settings.shape;
     FrameSettings none;
     none.lod = LodScheme::Spt;
+    if (variant == 2) none.rasterizer = Rasterizer::Quality;
     const std::vector<Image> want = render_path(scene, settings, none, 2, kFrames);
     for (OcclusionMethod m : {OcclusionMethod::StopAndWait, OcclusionMethod::ChcPlusPlus}) {
       for (unsigned threads : {1u, 2u}) {
@@ -231,8 +233,9 @@ TEST(OcclusionRender, SptChunksAreCulledWithTheSameImage) {
         fs.occlusion.method = m;
         const std::vector<Image> got = render_path(scene, settings, fs, threads, kFrames);
         for (int k = 0; k < kFrames; ++k) {
-          EXPECT_TRUE(same_bits(got[k], want[k]))
-              << name(m) << " shape " << int(shape) << " threads " << threads << " frame " << k;
+          EXPECT_TRUE(same_bits(got[k], want[k])) << name(m) << " variant " << variant
+                                                  << " shape " << int(shape) << " threads "
+                                                  << threads << " frame " << k;
           EXPECT_LT(got[k].splats, want[k].splats) << name(m) << " frame " << k;
           EXPECT_GT(got[k].occlusion.leaves_culled, 0u);
         }
@@ -407,14 +410,6 @@ TEST(OcclusionRender, CombinationsNotYetSupportedAreRefusedWithAMessage) {
     EXPECT_NE(std::string(e.what()).find("--opacity"), std::string::npos) << e.what();
   }
   fs.quality.opacity = 1.0f;
-  fs.lod = LodScheme::Spt;
-  try {
-    renderer.render(scene.instances, path_camera(0, 2), {}, fs, pool, frame);
-    FAIL() << "quality mode of a Sequential Point Tree with occlusion culling was accepted";
-  } catch (const OptionError& e) {
-    EXPECT_NE(std::string(e.what()).find("--lod spt"), std::string::npos) << e.what();
-  }
-  fs.lod = LodScheme::QSplat;
   // A hierarchy too large for the scene (culling leaves of one point: 4,000 instances of a 4,500-node tree).
   {
     FrameSettings tiny;
