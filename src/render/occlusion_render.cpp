@@ -449,7 +449,7 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
     }
     return first;
   };
-  const SoftwareQueries::Draw draw = [&](std::span<const std::uint32_t> batch) {
+  const SoftwareQueries::Draw draw = [&](std::span<const std::uint32_t> batch, bool last) {
     const auto t0 = Clock::now();
     order.assign(batch.begin(), batch.end());
     std::sort(order.begin(), order.end(), canonical);
@@ -477,9 +477,10 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
           begin = end;
         }
       }
+      // The quality setup of the new chunks, and their occluders unless no query follows.
       dirty = quality_detail::draw_quality_occluders(stream, first, stream.chunk_count, cam,
                                                      settings, fs.quality, pool, quality_scratch_,
-                                                     c.occluders, frame.depth);
+                                                     c.occluders, frame.depth, !last);
     } else {
       for (const SoftwareQueries::Rect& r : rects) {
         if (r.x1 > r.x0 && r.y1 > r.y0) {
@@ -512,7 +513,13 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
     std::vector<quality_detail::StreamPiece>& pieces = c.pieces;
     pieces.clear();
     for (const auto& d : drawn) {
-      if (d.second.end > d.second.begin) pieces.push_back(d.second);
+      const quality_detail::StreamPiece& p = d.second;
+      if (p.end <= p.begin) continue;
+      if (!pieces.empty() && pieces.back().chunk == p.chunk && pieces.back().end == p.begin) {
+        pieces.back().end = p.end;  // the next leaf of the same group: one run
+      } else {
+        pieces.push_back(p);
+      }
     }
     quality_detail::rasterize_quality_pieces(stream, pieces, cam, settings, fs.quality, pool,
                                              quality_scratch_, frame.color, frame.depth);

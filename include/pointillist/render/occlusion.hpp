@@ -145,17 +145,21 @@ class OcclusionQueries {
   virtual void enqueue_render(std::uint32_t node) = 0;
   // Draws the render queue (possibly nothing) and counts one flush toward pending answers.
   virtual void flush() = 0;
+  // The frame's last flush: no query follows, so a backend need not make what it draws
+  // testable (the software one skips refreshing its pyramid).
+  virtual void finish() { flush(); }
 };
 
 // The software backend: the render queue is handed to `draw` (which draws the nodes' splats into
 // the depth buffer the pyramid reads and returns the pixel rectangle it touched, [x0, x1) ×
-// [y0, y1)), the pyramid is refreshed there, and queries are answered from it.
+// [y0, y1)), the pyramid is refreshed there, and queries are answered from it. At finish(),
+// `draw` is told (`last`) that nothing will test what it draws.
 class SoftwareQueries final : public OcclusionQueries {
  public:
   struct Rect {
     int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
   };
-  using Draw = std::function<Rect(std::span<const std::uint32_t> nodes)>;
+  using Draw = std::function<Rect(std::span<const std::uint32_t> nodes, bool last)>;
   SoftwareQueries(DepthPyramid& pyramid, const CameraFrame& camera, QueryFootprint footprint,
                   unsigned latency, Draw draw, OcclusionStats& stats);
   QueryId issue(std::span<const QueryBound> bounds) override;
@@ -163,9 +167,10 @@ class SoftwareQueries final : public OcclusionQueries {
   std::uint32_t result(QueryId id) override;
   void enqueue_render(std::uint32_t node) override { queue_.push_back(node); }
   void flush() override;
+  void finish() override;
 
  private:
-  void draw_queue();
+  void draw_queue(bool last = false);
   DepthPyramid& pyramid_;
   const CameraFrame& camera_;
   QueryFootprint footprint_;

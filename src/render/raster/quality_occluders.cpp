@@ -29,7 +29,7 @@ SoftwareQueries::Rect draw_quality_occluders(const SplatStream& stream, std::siz
                                              const RenderSettings& settings,
                                              const QualitySettings& quality, ThreadPool& pool,
                                              QualityScratch& prepared, OccluderScratch& scratch,
-                                             std::span<float> bound) {
+                                             std::span<float> bound, bool occluders) {
   const int width = camera.width, height = camera.height;
   SoftwareQueries::Rect out{width, height, 0, 0};
   if (last <= first || width <= 0 || height <= 0) return out;
@@ -48,6 +48,7 @@ SoftwareQueries::Rect draw_quality_occluders(const SplatStream& stream, std::siz
                   prepared.chunk_bins[first + c], prepared.chunk_planes[first + c]);
   });
 
+  if (!occluders) return out;
   const std::size_t bands = static_cast<std::size_t>(setup.band_count);
   scratch.band_rects.assign(bands, out);
   const float half_w = 0.5f * static_cast<float>(width);

@@ -33,13 +33,14 @@ struct OccluderScratch {
 // fragment can have (ZRange: the splat's widened interval's end; ZThreshold: its deepest depth
 // plus ε·R). The smallest bound of a pixel's fragments is then never above `bound`. The chunks'
 // setup is left in `prepared` as rasterize_quality_pieces expects it (quality_kernel.hpp).
-// Returns the rectangle of pixels lowered, [x0, x1) × [y0, y1) (empty when none).
+// Returns the rectangle of pixels lowered, [x0, x1) × [y0, y1) (empty when none). Without
+// `occluders` (nothing will test them), only the setup is made.
 SoftwareQueries::Rect draw_quality_occluders(const SplatStream& stream, std::size_t first,
                                              std::size_t last, const CameraFrame& camera,
                                              const RenderSettings& settings,
                                              const QualitySettings& quality, ThreadPool& pool,
                                              QualityScratch& prepared, OccluderScratch& scratch,
-                                             std::span<float> bound);
+                                             std::span<float> bound, bool occluders = true);
 
 // The footprint a query must assume of a node's splats in quality mode: every disc lies within
 // the node's sphere grown by radius_scale (and the splat scale), covers the low-pass disc, and

@@ -61,7 +61,7 @@ class Culler {
       v_queue_.pop_front();
     }
     while (!pending_.empty()) handle_front();
-    q_.flush();
+    q_.finish();
   }
 
  private:

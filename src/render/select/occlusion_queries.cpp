@@ -154,11 +154,12 @@ SoftwareQueries::SoftwareQueries(DepthPyramid& pyramid, const CameraFrame& camer
     : pyramid_(pyramid), camera_(camera), footprint_(footprint), latency_(latency),
       draw_(std::move(draw)), stats_(stats) {}
 
-void SoftwareQueries::draw_queue() {
+void SoftwareQueries::draw_queue(bool last) {
   if (queue_.empty()) return;
-  const Rect r = draw_(queue_);
+  const Rect r = draw_(queue_, last);
   queue_.clear();
   ++stats_.flushes;
+  if (last) return;
   const auto start = Clock::now();
   pyramid_.refresh(r.x0, r.y0, r.x1, r.y1);
   stats_.ms_hiz += ms_since(start);
@@ -166,6 +167,11 @@ void SoftwareQueries::draw_queue() {
 
 void SoftwareQueries::flush() {
   draw_queue();
+  ++flushes_;
+}
+
+void SoftwareQueries::finish() {
+  draw_queue(true);
   ++flushes_;
 }
 
