@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "pointillist/core/camera.hpp"
@@ -93,6 +94,7 @@ class PagedRenderer {
 
   PageCache cache_;
   SphereTreeView summary_;
+  mutable std::optional<Sphere> root_;  // root_sphere(), once page 0 was read
   std::unique_ptr<Tasks> tasks_;
 };
 

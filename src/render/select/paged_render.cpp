@@ -220,7 +220,13 @@ SelectionStats PagedRenderer::select(const CameraFrame& cam, const RenderSetting
       v,
       static_cast<std::uint8_t>((settings.frustum_culling ? kTestFrustum : 0) |
                                 (settings.culls_backfaces() ? kTestBackface : 0)),
-      with_colors, expected_splats(summary_.leaf_count, cam), stream, {}};
+      with_colors, 0, stream, {}};
+  // Splats expected, for sizing new chunks: at most what the model's sphere covers on screen (an
+  // instance far away draws few; sizing each of thousands of instances for the whole model
+  // took gigabytes).
+  const Sphere root = root_sphere();
+  selection.expected =
+      expected_splats(summary_.leaf_count, cam, &root, settings.threshold_px);
   if (!pages.empty() && pages[0]) {
     if (pages[0]->is_packed()) {
       select_pages(PackedAccess(pages, with_colors, features), selection, pool, tasks_->packed);
@@ -243,12 +249,17 @@ void PagedRenderer::begin_frame() {
 }
 
 Sphere PagedRenderer::root_sphere() const {
+  if (root_) return *root_;
   const PageTable& pages = cache_.pages();
   // Page 0 stays resident (begin_frame keeps it in use); a sphere holding anything otherwise.
   if (pages.empty() || !pages[0]) return {summary_.view_sphere.center, 1e30f};
-  if (!pages[0]->is_packed()) return {pages[0]->nodes[0].center, pages[0]->nodes[0].radius};
-  const SphereNode root = PackedAccess(pages, summary_.has_colors, false).root(0).node;
-  return {root.center, root.radius};
+  if (!pages[0]->is_packed()) {
+    root_ = Sphere{pages[0]->nodes[0].center, pages[0]->nodes[0].radius};
+  } else {
+    const SphereNode root = PackedAccess(pages, summary_.has_colors, false).root(0).node;
+    root_ = Sphere{root.center, root.radius};
+  }
+  return *root_;
 }
 
 void PagedRenderer::render_frame(const Camera& camera, const RenderSettings& settings,
