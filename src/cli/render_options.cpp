@@ -112,7 +112,8 @@ void add_occlusion(CLI::App* cmd, RenderOptions& o, RenderText& t) {
                             "Skip what is hidden behind what is already drawn (the same image): "
                             "none, stop-and-wait (query each node and wait), chc (coherent "
                             "hierarchical culling) or chc++ (with batched queries, multiqueries, "
-                            "spread re-queries and tight bounds). Fast mode, models held whole",
+                            "spread re-queries and tight bounds). Fast and quality modes (quality: opaque, "
+                            "without sharp features); a paged model is culled whole",
                             "none")
       ->group(kGroup);
   cmd->add_option("--query-latency", oc.query_latency,
