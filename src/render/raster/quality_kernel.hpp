@@ -58,6 +58,23 @@ inline Float4 exp_neg4(Float4 x) {
   return out;
 }
 
+// Where four pixels' rays meet a splat's plane (unit normal n and n·c in eye coordinates):
+// depth t and the eye-space X, Y of the hit. Perspective rays t·(a, b, 1) (na = n_x·a + n_z,
+// computed once per column); orthographic rays along +z from (a, b, 0). The occluder pass
+// computes its hits with this too, so that it agrees with the rasterizer.
+inline void ray_hits(bool ortho, Float4 a, Float4 na, float b, float nx, float ny, float nz,
+                     float nc, Float4& t, Float4& x, Float4& y) {
+  if (ortho) {
+    t = (nc - nx * a - ny * b) / nz;
+    x = a;
+    y = render_detail::splat4(b);
+  } else {
+    t = nc / (na + ny * b);
+    x = t * a;
+    y = t * b;
+  }
+}
+
 // Per-splat setup, kStride floats per splat (quality_setup.cpp writes it).
 enum SplatField : int {
   kI0, kI1, kJ0, kJ1,     // pixel box (inclusive, clipped to the image; i1 < i0 when empty)

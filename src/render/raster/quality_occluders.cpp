@@ -16,7 +16,6 @@ using render_detail::Float4;
 using render_detail::Int4;
 using render_detail::min4;
 using render_detail::select4;
-using render_detail::splat4;
 
 // A pixel counts as covered only when its kernel argument is this far inside the edge: the
 // rasterizer's lane arithmetic may round differently from this scalar loop right at the edge.
@@ -88,15 +87,7 @@ SoftwareQueries::Rect draw_quality_occluders(const SplatStream& stream, std::siz
             const Float4 pcx = iv + 0.5f;
             const Float4 a = (pcx - half_w) * inv_f;
             Float4 t, x, y;
-            if (camera.ortho) {
-              t = (nc - nx * a - ny * b) / nz;
-              x = a;
-              y = splat4(b);
-            } else {
-              t = nc / ((nx * a + nz) + ny * b);
-              x = t * a;
-              y = t * b;
-            }
+            ray_hits(camera.ortho, a, nx * a + nz, b, nx, ny, nz, nc, t, x, y);
             const Float4 dx = pcx - s[kSx];
             const Float4 sd = (dx * dx + dy2) * inv_rho2;
             const Int4 valid = (t > 0.0f) & (t < inf);

@@ -148,15 +148,7 @@ void draw_splat(const float* s, const float* planes, const View& v, const Band& 
       const float dy = pcy - s[kSy];
       // Where the pixel's ray meets the splat's plane: (X, Y, t) in eye space, t the depth.
       Float4 t, X, Y;
-      if (v.ortho) {
-        t = (nc - nx * a - ny * b) / nz;
-        X = a;
-        Y = splat4(b);
-      } else {
-        t = nc / (na + ny * b);
-        X = t * a;
-        Y = t * b;
-      }
+      ray_hits(v.ortho, a, na, b, nx, ny, nz, nc, t, X, Y);
       const Int4 valid = (t > zero) & (t < inf);
       const Float4 ex = X - cx, ey = Y - cy, ez = t - cz;
       const Float4 u = (ex * ex + ey * ey + ez * ez) * inv_r2;
