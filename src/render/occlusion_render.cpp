@@ -64,7 +64,11 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
   std::vector<ModelState*> states(scene.size());
   for (std::size_t i = 0; i < scene.size(); ++i) {
     ModelState& st = state_for(*scene[i].model, pool, fs);
-    if (st.frame != frame_number_) last_frame_.push_back(&st);
+    if (st.frame != frame_number_) {
+      last_frame_.push_back(&st);
+      // A paged model starts its frame here: every selection of its instances adds to it.
+      if (st.paged) st.paged->begin_frame();
+    }
     st.frame = frame_number_;
     if (spt) {
       if (!st.spt_cull_tree) st.spt_cull_tree = build_spt_cull_tree(*st.spt);
@@ -81,13 +85,6 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
       st.cull_tree = build_cull_tree(scene[i].model->tree.nodes, os.leaf_points);
     }
     states[i] = &st;
-  }
-  // Paged models start their frame here: every selection of their instances adds to it.
-  for (ModelState* st : states) {
-    if (st->paged && st->frame_started != frame_number_) {
-      st->paged->begin_frame();
-      st->frame_started = frame_number_;
-    }
   }
   const auto paged = [&](std::uint32_t i) { return !spt && states[i]->paged.has_value(); };
   // The cull tree of instance i's model, and a node's sphere in model space.
@@ -331,24 +328,21 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
   // Quality mode: every leaf drawn this frame, and where its splats are in the stream.
   std::vector<std::pair<std::uint32_t, quality_detail::StreamPiece>>& drawn = c.drawn;
   drawn.clear();
-  // A selected chunk of instance `instance` made ready for the rasterizers: into the world,
-  // its features (`f`, or from the pages), base colours, splat scale.
-  const auto finish = [&](std::uint32_t instance, bool colored, const TreeFeatures* f,
-                          bool page_features, SplatChunk& chunk) {
-    const SceneInstance& inst = scene[instance];
+  // How a chunk of instance `instance` is made ready for the rasterizers (place_chunk).
+  const auto placement = [&](std::uint32_t instance, bool colored, const TreeFeatures* f,
+                             bool from_pages) {
     const InstanceView& iv = views[instance];
-    chunk.instance = instance;
-    if (!iv.identity) to_world(inst.transform, chunk, with_discs);
-    if (features) {
-      const InstanceTransform* t = iv.identity ? nullptr : &inst.transform;
-      if (page_features) {
-        place_features(t, iv.id_base, chunk);
-      } else {
-        attach_features(f, t, iv.id_base, chunk);
-      }
-    }
-    if (any_colors && !colored) fill_base_color(chunk, settings, with_discs);
-    scale_splats(chunk, fs.splat_scale, with_discs);
+    ChunkPlacement p;
+    p.instance = instance;
+    p.transform = iv.identity ? nullptr : &scene[instance].transform;
+    p.features = features;
+    p.from_pages = from_pages;
+    p.tree_features = f;
+    p.id_base = iv.id_base;
+    p.base_color = any_colors && !colored;
+    p.splat_scale = fs.splat_scale;
+    p.with_discs = with_discs;
+    return p;
   };
   // A paged model's visible instance: its selection (which requests the pages it needs) moved
   // behind the stream's chunks; in the fast mode each chunk's pixel rectangle goes to `rects`,
@@ -363,12 +357,12 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
     counters.visited += sel.nodes_visited;
     counters.culled_frustum += sel.culled_frustum;
     counters.culled_backface += sel.culled_backface;
+    const ChunkPlacement place =
+        placement(instance, scratch_stream_.has_colors, nullptr, page_features);
     for (std::size_t k = 0; k < scratch_stream_.chunk_count; ++k) {
-      SplatChunk& chunk = scratch_stream_.chunks[k];
-      finish(instance, scratch_stream_.has_colors, nullptr, page_features, chunk);
-      const std::size_t at = stream.chunk_count++;
-      if (stream.chunks.size() < stream.chunk_count) stream.chunks.resize(stream.chunk_count);
-      std::swap(stream.chunks[at], chunk);
+      place_chunk(scratch_stream_.chunks[k], place, settings);
+    }
+    for (std::size_t at = append_chunks(stream, scratch_stream_); at < stream.chunk_count; ++at) {
       const SplatChunk& placed = stream.chunks[at];
       if (quality) {
         drawn.push_back({n, {static_cast<std::uint32_t>(at), 0,
@@ -437,7 +431,10 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
       }
       const TreeFeatures* f =
           spt ? (st.spt_features ? &*st.spt_features : nullptr) : inst.model->tree.features;
-      finish(instance, spt ? st.spt->has_colors : inst.model->tree.has_colors, f, false, chunk);
+      place_chunk(chunk,
+                  placement(instance, spt ? st.spt->has_colors : inst.model->tree.has_colors, f,
+                            false),
+                  settings);
       if (with_rects) rects[g] = chunk_pixel_rect(chunk, cam);
     });
     stream.chunk_count = first + groups.size();

@@ -184,46 +184,29 @@ SelectionStats Renderer::select(std::span<const SceneInstance> scene, const Came
     }
     add(total, selected);
     const TreeFeatures* model_f = model_features(*inst.model);
-    const bool colors = into.has_colors;
+    ChunkPlacement place;
+    place.instance = static_cast<std::uint32_t>(i);
+    place.transform = identity ? nullptr : &inst.transform;
+    place.features = features;
+    // Paged models fill their features from the pages during selection (or none: mixed,
+    // unclipped); the others look them up by node.
+    place.from_pages = fs.lod == LodScheme::QSplat && state.paged && state.pages->features();
+    place.tree_features = fs.lod == LodScheme::Spt
+                              ? (state.spt_features ? &*state.spt_features : nullptr)
+                          : state.paged ? nullptr
+                                        : inst.model->tree.features;
+    place.id_base = id_base;
+    place.base_color = any_colors && !into.has_colors;
+    place.splat_scale = fs.splat_scale;
+    place.with_discs = with_discs;
     for (std::size_t c = 0; c < into.chunk_count; ++c) {
-      SplatChunk& chunk = into.chunks[c];
-      chunk.instance = static_cast<std::uint32_t>(i);
-      if (!identity) to_world(inst.transform, chunk, with_discs);
-      if (features) {
-        const InstanceTransform* t = identity ? nullptr : &inst.transform;
-        if (fs.lod == LodScheme::QSplat && state.paged) {
-          // Filled from the pages during selection (or none: mixed, unclipped).
-          if (state.pages->features()) {
-            render_detail::place_features(t, id_base, chunk);
-          } else {
-            render_detail::attach_features(nullptr, t, id_base, chunk);
-          }
-        } else {
-          const TreeFeatures* f = fs.lod == LodScheme::Spt
-                                      ? (state.spt_features ? &*state.spt_features : nullptr)
-                                      : inst.model->tree.features;
-          render_detail::attach_features(f, t, id_base, chunk);
-        }
-      }
-      if (any_colors && !colors) fill_base_color(chunk, settings, with_discs);
+      place_chunk(into.chunks[c], place, settings);
     }
     if (model_f) id_base += model_f->surface_count;
-    if (i > 0) {
-      const std::size_t base = stream.chunk_count;
-      if (stream.chunks.size() < base + into.chunk_count) {
-        stream.chunks.resize(base + into.chunk_count);
-      }
-      for (std::size_t c = 0; c < into.chunk_count; ++c) {
-        std::swap(stream.chunks[base + c], into.chunks[c]);
-      }
-      stream.chunk_count = base + into.chunk_count;
-    }
+    if (i > 0) append_chunks(stream, into);
   }
   stream.has_colors = any_colors;
   stream.has_features = features;
-  for (std::size_t c = 0; c < stream.chunk_count; ++c) {
-    scale_splats(stream.chunks[c], fs.splat_scale, with_discs);
-  }
   return total;
 }
 

@@ -13,6 +13,7 @@
 #include "pointillist/render/paged.hpp"
 #include "pointillist/render/renderer.hpp"
 #include "raster/quality_occluders.hpp"
+#include "select/stream_features.hpp"
 #include "select/traversal_common.hpp"
 #include "shading.hpp"
 
@@ -79,6 +80,46 @@ inline void scale_splats(SplatChunk& chunk, float scale, bool with_discs) {
   if (with_discs) {
     for (std::size_t i = 0; i < chunk.count; ++i) chunk.radius[i] *= scale;
   }
+}
+
+// What makes a selected chunk of one instance ready for the rasterizers (place_chunk).
+struct ChunkPlacement {
+  std::uint32_t instance = 0;
+  const InstanceTransform* transform = nullptr;  // null: the identity
+  bool features = false;     // the stream carries sharp features:
+  bool from_pages = false;   // filled from a paged model's pages during selection,
+  const TreeFeatures* tree_features = nullptr;  // or looked up here (null: mixed, unclipped)
+  std::uint32_t id_base = 0;  // the instance's first surface id
+  bool base_color = false;    // the stream has colours and the model none
+  float splat_scale = 1.0f;
+  bool with_discs = false;
+};
+
+// The chunk into the world, its sharp features, base colours, splat scale.
+inline void place_chunk(SplatChunk& chunk, const ChunkPlacement& p,
+                        const RenderSettings& settings) {
+  chunk.instance = p.instance;
+  if (p.transform) to_world(*p.transform, chunk, p.with_discs);
+  if (p.features) {
+    if (p.from_pages) {
+      place_features(p.transform, p.id_base, chunk);
+    } else {
+      attach_features(p.tree_features, p.transform, p.id_base, chunk);
+    }
+  }
+  if (p.base_color) fill_base_color(chunk, settings, p.with_discs);
+  scale_splats(chunk, p.splat_scale, p.with_discs);
+}
+
+// Moves the chunks of `from` behind those of `to` (their buffers swapped, not copied; `from`'s
+// count is left as it was, so SplatStream::trim keeps the buffers it now holds). Returns the
+// index in `to` of the first one moved.
+inline std::size_t append_chunks(SplatStream& to, SplatStream& from) {
+  const std::size_t base = to.chunk_count;
+  if (to.chunks.size() < base + from.chunk_count) to.chunks.resize(base + from.chunk_count);
+  for (std::size_t c = 0; c < from.chunk_count; ++c) std::swap(to.chunks[base + c], from.chunks[c]);
+  to.chunk_count = base + from.chunk_count;
+  return base;
 }
 
 // The smallest sphere around `a` and `b` (a sphere holding both), slightly grown for rounding.
@@ -155,7 +196,6 @@ struct Renderer::ModelState {
   std::uint64_t model_bytes = 0;  // storage bytes of a paged model (open + every page)
   std::optional<render_detail::ModelCullTree> cull_tree;      // occlusion culling (QSplat)
   std::optional<render_detail::ModelCullTree> spt_cull_tree;  // occlusion culling (SPT)
-  std::uint64_t frame_started = 0;  // occlusion culling: the frame a paged model last began
 };
 
 

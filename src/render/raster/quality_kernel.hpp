@@ -120,6 +120,13 @@ struct SetupConstants {
 SetupConstants quality_setup(const CameraFrame& camera, const RenderSettings& settings,
                              const QualitySettings& quality, bool has_colors, unsigned threads);
 
+// Grows the per-chunk setup buffers of `scratch` to at least `chunks` chunks.
+inline void fit_chunks(QualityScratch& scratch, std::size_t chunks) {
+  if (scratch.chunk_splats.size() < chunks) scratch.chunk_splats.resize(chunks);
+  if (scratch.chunk_bins.size() < chunks) scratch.chunk_bins.resize(chunks);
+  if (scratch.chunk_planes.size() < chunks) scratch.chunk_planes.resize(chunks);
+}
+
 // Splats [begin, end) of chunk `chunk` of a stream.
 struct StreamPiece {
   std::uint32_t chunk = 0, begin = 0, end = 0;

@@ -36,11 +36,7 @@ SoftwareQueries::Rect draw_quality_occluders(const SplatStream& stream, std::siz
   const SetupConstants setup =
       quality_setup(camera, settings, quality, stream.has_colors, pool.thread_count());
   const int band_rows = setup.band_rows;
-  if (prepared.chunk_splats.size() < last) {
-    prepared.chunk_splats.resize(last);
-    prepared.chunk_bins.resize(last);
-  }
-  if (prepared.chunk_planes.size() < last) prepared.chunk_planes.resize(last);
+  fit_chunks(prepared, last);
   const std::size_t chunks = last - first;
   pool.run(chunks, [&](std::size_t c) {
     prepare_chunk(stream.chunks[first + c], setup, false, prepared.chunk_splats[first + c],

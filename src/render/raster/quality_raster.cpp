@@ -440,13 +440,7 @@ void rasterize(const SplatStream& stream, const std::span<const StreamPiece>* pi
       quality_setup(camera, settings, quality, stream.has_colors, pool.thread_count());
   const bool features = stream.has_features;
   if (!pieces) {
-    if (scratch.chunk_splats.size() < stream.chunk_count) {
-      scratch.chunk_splats.resize(stream.chunk_count);
-      scratch.chunk_bins.resize(stream.chunk_count);
-    }
-    if (scratch.chunk_planes.size() < stream.chunk_count) {
-      scratch.chunk_planes.resize(stream.chunk_count);
-    }
+    fit_chunks(scratch, stream.chunk_count);
     pool.run(stream.chunk_count, [&](std::size_t c) {
       prepare_chunk(stream.chunks[c], setup, features, scratch.chunk_splats[c],
                     scratch.chunk_bins[c], scratch.chunk_planes[c]);
