@@ -12,6 +12,21 @@
 namespace pointillist {
 namespace {
 
+// Whether an edge of the graph is sharp (normals apart), continuous (one smooth surface), or
+// neither: parallel discs stacked above each other (two surfaces side by side, such as the
+// nearly parallel parts of two crossed cylinders, or the two faces of a thin slab), whose
+// normals agree but whose centres are not on each other's planes.
+struct EdgeKinds {
+  std::span<const Vec3f> centers, normals;
+  std::span<const float> drawn;
+  float w_s;
+  bool sharp(std::size_t i, std::size_t j) const { return dot(normals[i], normals[j]) < w_s; }
+  bool continuous(std::size_t i, std::size_t j) const {
+    return !sharp(i, j) && on_planes_of_each_other(centers[i], normals[i], drawn[i], centers[j],
+                                                   normals[j], drawn[j], w_s);
+  }
+};
+
 struct Block {
   std::vector<ClipMode> modes;
   std::vector<std::uint32_t> plane_counts;
@@ -36,7 +51,7 @@ void add(FeatureStats& to, const FeatureStats& from) {
 
 // Breadth-first search over the continuous edges, seeded in increasing splat index (spec §1.8
 // [P]): ids are numbered in the order of each surface's smallest splat index.
-std::uint64_t segment(const NeighbourGraph& graph, std::span<const Vec3f> normals, float w_s,
+std::uint64_t segment(const NeighbourGraph& graph, const EdgeKinds& kinds,
                       std::vector<std::uint32_t>& ids, std::uint64_t& large) {
   const std::size_t n = graph.vertex_count();
   constexpr std::uint32_t kNone = 0xffffffffu;
@@ -53,7 +68,7 @@ std::uint64_t segment(const NeighbourGraph& graph, std::span<const Vec3f> normal
     while (head < tail) {
       const std::uint32_t s = queue[head++];
       for (std::uint32_t j : graph.row(s)) {
-        if (ids[j] == kNone && dot(normals[s], normals[j]) >= w_s) {
+        if (ids[j] == kNone && kinds.continuous(s, j)) {
           ids[j] = next_id;
           queue[tail++] = j;
         }
@@ -104,6 +119,33 @@ FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec
       options.edge_test == EdgeTest::Side && options.clip_rule == ClipRule::Classified;
   constexpr std::size_t kBlock = 4096;
   std::vector<Block> blocks((n + kBlock - 1) / kBlock);
+  // The surface's shape at every splat with a sharp edge (a possible partner), from its
+  // continuous neighbours: Pointillist's rule corrects partner planes at curved creases.
+  const EdgeKinds kinds{centers, normals, drawn, options.sharp_threshold};
+  std::vector<Shape> shapes;
+  if (options.clip_rule == ClipRule::Classified) {
+    shapes.resize(n);
+    pool.run(blocks.size(), [&](std::size_t b) {
+      std::vector<Vec3f> around, around_normals;
+      for (std::size_t i = b * kBlock, end = std::min(n, i + kBlock); i < end; ++i) {
+        around.clear();
+        around_normals.clear();
+        bool sharp = false;
+        for (std::uint32_t j : graph.row(i)) {
+          if (kinds.sharp(i, j)) {
+            sharp = true;
+          } else if (kinds.continuous(i, j)) {
+            around.push_back(centers[j]);
+            around_normals.push_back(normals[j]);
+          }
+        }
+        if (sharp) shapes[i] = fit_shape(centers[i], normals[i], around, around_normals);
+      }
+    });
+  }
+  const auto disc = [&](std::size_t j) {
+    return Disc{centers[j], normals[j], drawn[j], shapes.empty() ? Shape{} : shapes[j]};
+  };
   {
     ProgressPhase phase(progress, "sharp features", n);
     pool.run(blocks.size(), [&](std::size_t b) {
@@ -115,17 +157,17 @@ FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec
       std::vector<std::uint32_t> crossing;
       std::vector<Disc> partners, through;
       for (std::size_t i = first; i < end; ++i) {
-        const Disc s{centers[i], normals[i], drawn[i]};
+        const Disc s = disc(i);
         continuous.clear();
         crossing.clear();
         bool candidate = false;
         for (std::uint32_t j : graph.row(i)) {
-          if (dot(normals[i], normals[j]) >= options.sharp_threshold) {
-            continuous.push_back(centers[j]);
+          if (!kinds.sharp(i, j)) {
+            if (kinds.continuous(i, j)) continuous.push_back(centers[j]);
             continue;
           }
           candidate = true;
-          const Crossing x = disc_crossing(s, Disc{centers[j], normals[j], drawn[j]});
+          const Crossing x = disc_crossing(s, disc(j));
           if (j > i) {
             ++block.stats.sharp_edges;
             block.stats.crossing_edges += x == Crossing::Cross;
@@ -140,7 +182,7 @@ FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec
         partners.clear();
         through.clear();
         for (std::uint32_t j : crossing) {
-          const Disc p{centers[j], normals[j], drawn[j]};
+          const Disc p = disc(j);
           const bool ends = options.edge_test == EdgeTest::Linsen ? boundary
                                                                    : surface_ends_at(s, continuous, p);
           (ends ? partners : through).push_back(p);
@@ -193,8 +235,7 @@ FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec
     }
     out.clip_planes.insert(out.clip_planes.end(), block.planes.begin(), block.planes.end());
   }
-  out.stats.segments = segment(graph, normals, options.sharp_threshold, out.surface_id,
-                               out.stats.large_segments);
+  out.stats.segments = segment(graph, kinds, out.surface_id, out.stats.large_segments);
   return out;
 }
 

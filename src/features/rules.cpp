@@ -54,6 +54,35 @@ bool keep_positive_side(const Disc& s, const Disc& partner, std::span<const Vec3
   return false;
 }
 
+// How far the plane of `partner`, kept on its positive side when keep_positive, moves onto its
+// clipped side so that it reaches the partner's curved surface where it cuts s: the largest
+// sag ½ wᵀ S w of that surface toward the clipped side at the two ends of s's chord on the
+// line where the planes meet (w: the end's offset from the partner's centre in its tangent
+// plane). 0 where the surface curves toward the kept side, or is flat.
+int concavity(const Disc& s, const Disc& partner);
+float sag_shift(const Disc& s, const Disc& partner, bool keep_positive) {
+  const Shape& k = partner.shape;
+  if (k.xx == 0 && k.xy == 0 && k.yy == 0) return 0;
+  const Vec3f e_raw = partner.n - s.n * dot(partner.n, s.n);
+  const float e_len = length(e_raw);
+  if (e_len < 1e-3f) return 0;
+  const Vec3f e = e_raw / e_len;                           // in s's plane, toward the line
+  const Vec3f along = normalized(cross(s.n, partner.n));  // the line's direction
+  const Vec3f to_partner = partner.c - s.c;
+  const float t = dot(partner.n, to_partner) / e_len;     // s's centre to the line
+  const float half = std::fabs(t) < s.r ? std::sqrt(s.r * s.r - t * t) : 0.0f;
+  const TangentFrame f = tangent_frame(partner.n);
+  const float sign = keep_positive ? 1.0f : -1.0f;
+  float shift = 0;
+  for (float end : {-half, half}) {
+    const Vec3f w = e * t + along * end - to_partner;
+    const float a = dot(w, f.u), b = dot(w, f.v);
+    const float sag = 0.5f * (k.xx * a * a + 2.0f * k.xy * a * b + k.yy * b * b);
+    shift = std::max(shift, sign * sag);
+  }
+  return std::min(shift, kMaxSagShift * s.r);
+}
+
 // Sign of eq. 4.14's term for one partner: +1 concave, −1 convex, 0 within the tolerance.
 int concavity(const Disc& s, const Disc& partner) {
   const float v = dot(partner.c - s.c, s.n);
@@ -176,6 +205,35 @@ Classification classify_4_15(const Disc& s, std::span<const Disc> partners) {
 
 }  // namespace
 
+TangentFrame tangent_frame(Vec3f n) {
+  const Vec3f helper = std::fabs(n.x) < 0.9f ? Vec3f{1, 0, 0} : Vec3f{0, 1, 0};
+  const Vec3f u = normalized(cross(n, helper));
+  return {u, cross(n, u)};
+}
+
+Shape fit_shape(Vec3f c, Vec3f n, std::span<const Vec3f> neighbour_centres,
+                std::span<const Vec3f> neighbour_normals) {
+  const TangentFrame f = tangent_frame(n);
+  // Normal equations of dn ≈ S dp in the frame: A = Σ a aᵀ, B = Σ b aᵀ, S = B A⁻¹.
+  double a11 = 0, a12 = 0, a22 = 0, b11 = 0, b12 = 0, b21 = 0, b22 = 0;
+  for (std::size_t k = 0; k < neighbour_centres.size(); ++k) {
+    const Vec3f dp = neighbour_centres[k] - c, dn = neighbour_normals[k] - n;
+    const double p1 = dot(dp, f.u), p2 = dot(dp, f.v), q1 = dot(dn, f.u), q2 = dot(dn, f.v);
+    a11 += p1 * p1, a12 += p1 * p2, a22 += p2 * p2;
+    b11 += q1 * p1, b12 += q1 * p2, b21 += q2 * p1, b22 += q2 * p2;
+  }
+  const double trace = a11 + a22;
+  if (trace <= 0) return {};
+  const double det = a11 * a22 - a12 * a12;
+  if (det < 1e-2 * trace * trace) {  // neighbours along a line: the mean curvature over them
+    const float mean = static_cast<float>((b11 + b22) / trace);
+    return {mean, 0, mean};
+  }
+  const double s11 = (b11 * a22 - b12 * a12) / det, s12 = (b12 * a11 - b11 * a12) / det;
+  const double s21 = (b21 * a22 - b22 * a12) / det, s22 = (b22 * a11 - b21 * a12) / det;
+  return {static_cast<float>(s11), static_cast<float>(0.5 * (s12 + s21)), static_cast<float>(s22)};
+}
+
 Crossing disc_crossing(const Disc& a, const Disc& b) {
   const Vec3f d = cross(a.n, b.n);
   const float dd = dot(d, d);
@@ -209,9 +267,7 @@ bool linsen_boundary(const Disc& s, std::span<const Vec3f> continuous, float alp
   if (continuous.size() < 2) return true;
   // A frame (u, v) of the splat's plane; v′_j = (c_j − c) × n (eq. 4.2) has the angular order of
   // the projections.
-  const Vec3f helper = std::fabs(s.n.x) < 0.9f ? Vec3f{1, 0, 0} : Vec3f{0, 1, 0};
-  const Vec3f u = normalized(cross(s.n, helper));
-  const Vec3f v = cross(s.n, u);
+  const auto [u, v] = tangent_frame(s.n);
   std::vector<float> angles;
   angles.reserve(continuous.size());
   for (Vec3f c : continuous) {
@@ -298,7 +354,10 @@ ClipResult classify_partners(const Disc& s, std::span<const Disc> partners,
   switch (rule) {
     case ClipRule::Classified:
       for (const Disc& p : partners) {
-        planes.push_back(oriented_plane(p, keep_positive_side(s, p, continuous)));
+        const bool keep = keep_positive_side(s, p, continuous);
+        ClipPlane plane = oriented_plane(p, keep);
+        if (concavity(s, p) > 0) plane.h -= sag_shift(s, p, keep);
+        planes.push_back(plane);
         centres.push_back(p.c);
       }
       for (const Disc& p : reflex) {

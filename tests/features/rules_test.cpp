@@ -232,3 +232,123 @@ TEST(ClassifyPartners, PlanesAreScaledToInPlaneDistances) {
 }
 
 }  // namespace
+
+namespace {
+
+// Points and outward normals of a sphere around the splat at `c` (on the sphere), on a ring of
+// radius `d` in its tangent plane lifted onto the sphere: what fit_shape sees of a smooth
+// neighbourhood.
+void sphere_ring(Vec3f centre, float radius, Vec3f c, float d, std::vector<Vec3f>& points,
+                 std::vector<Vec3f>& normals) {
+  const Vec3f n = normalized(c - centre);
+  const TangentFrame f = tangent_frame(n);
+  for (int k = 0; k < 8; ++k) {
+    const float a = k * kPi / 4;
+    const Vec3f p = centre + normalized(c + (f.u * std::cos(a) + f.v * std::sin(a)) * d - centre) * radius;
+    points.push_back(p);
+    normals.push_back(normalized(p - centre));
+  }
+}
+
+float normal_curvature(const Shape& s, float a, float b) {
+  return (s.xx * a * a + 2 * s.xy * a * b + s.yy * b * b) / (a * a + b * b);
+}
+
+TEST(FitShape, MatchesTheCurvatureOfASphereACylinderAndAPlane) {
+  std::vector<Vec3f> p, n;
+  const Vec3f c = Vec3f{1, 2, 3} + normalized(Vec3f{0.3f, 0.9f, -0.2f}) * 2.0f;
+  sphere_ring({1, 2, 3}, 2.0f, c, 0.05f, p, n);
+  const Shape sphere = fit_shape(c, normalized(c - Vec3f{1, 2, 3}), p, n);
+  for (float deg : {0.0f, 30.0f, 90.0f, 135.0f}) {
+    const float a = std::cos(deg_to_rad(deg)), b = std::sin(deg_to_rad(deg));
+    EXPECT_NEAR(normal_curvature(sphere, a, b), 0.5f, 0.01f) << deg;
+  }
+  // A cylinder of radius 0.5 around the z axis, seen from the point (0.5, 0, 0): curvature 2
+  // around it, 0 along it; and inward normals (a hole's wall) flip the sign.
+  for (float sign : {1.0f, -1.0f}) {
+    std::vector<Vec3f> cp, cn;
+    for (int k = 0; k < 8; ++k) {
+      const float a = k * kPi / 4, phi = 0.1f * std::cos(a), z = 0.05f * std::sin(a);
+      cp.push_back({0.5f * std::cos(phi), 0.5f * std::sin(phi), z});
+      cn.push_back(Vec3f{std::cos(phi), std::sin(phi), 0} * sign);
+    }
+    const Vec3f n0 = Vec3f{1, 0, 0} * sign;
+    const Shape cyl = fit_shape({0.5f, 0, 0}, n0, cp, cn);
+    const TangentFrame f = tangent_frame(n0);
+    const auto along = [&](Vec3f w) { return normal_curvature(cyl, dot(w, f.u), dot(w, f.v)); };
+    EXPECT_NEAR(along({0, 1, 0}), 2.0f * sign, 0.05f);
+    EXPECT_NEAR(along({0, 0, 1}), 0.0f, 0.05f);
+  }
+  std::vector<Vec3f> flat, up(8, kY);
+  for (int k = 0; k < 8; ++k) flat.push_back({std::cos(k * 0.7f), 0, std::sin(k * 0.7f)});
+  const Shape plane = fit_shape({0, 0, 0}, kY, flat, up);
+  EXPECT_EQ(plane.xx, 0.0f);
+  EXPECT_EQ(plane.xy, 0.0f);
+  EXPECT_EQ(plane.yy, 0.0f);
+}
+
+// The crease of a union of two spheres of radius 1 (centres x = ±0.6, T5): a splat of the left
+// sphere just before the crease circle x = 0, its partner on the right sphere just after it.
+// The face to keep is the disc's part outside the right sphere.
+struct SphereUnion {
+  Vec3f a{-0.6f, 0, 0}, b{0.6f, 0, 0};
+  Disc s, p;
+  SphereUnion(float offset) {
+    const auto on = [](Vec3f centre, Vec3f dir) {
+      return Disc{centre + normalized(dir), normalized(dir), kR};
+    };
+    s = on(a, {0.6f - offset, 0.8f, 0});
+    p = on(b, {-0.6f + offset, 0.8f, 0});
+    std::vector<Vec3f> pts, nrm;
+    sphere_ring(b, 1.0f, p.c, 0.05f, pts, nrm);
+    p.shape = fit_shape(p.c, p.n, pts, nrm);
+  }
+  float depth_in_b(Vec3f x) const { return 1.0f - length(x - b); }  // > 0 inside
+};
+
+TEST(ClassifyPartners, CurvedConcavePartnerLeavesNoGapAtTheCrease) {
+  for (float offset : {0.03f, 0.06f}) {
+    const SphereUnion u(offset);
+    const std::vector<Vec3f> around = ring(u.s, [&](Vec3f x) { return u.depth_in_b(x) < 0; });
+    Disc flat = u.p;
+    flat.shape = {};
+    const ClipResult tangent = classify_partners(u.s, {&flat, 1}, around, ClipRule::Classified);
+    const ClipResult curved = classify_partners(u.s, {&u.p, 1}, around, ClipRule::Classified);
+    ASSERT_EQ(curved.planes.size(), 1u);
+    // Sample the disc: a point outside the right sphere that is discarded is a gap.
+    const TangentFrame f = tangent_frame(u.s.n);
+    int gaps_tangent = 0, gaps_curved = 0;
+    float deepest_kept = 0;
+    for (int i = -100; i <= 100; ++i) {
+      for (int j = -100; j <= 100; ++j) {
+        const float du = i * kR / 100, dv = j * kR / 100;
+        if (du * du + dv * dv > kR * kR) continue;
+        const Vec3f x = u.s.c + f.u * du + f.v * dv;
+        const float inside = u.depth_in_b(x);
+        if (inside < -1e-5f) {
+          gaps_tangent += clip_discards(tangent.planes, tangent.mode, x);
+          gaps_curved += clip_discards(curved.planes, curved.mode, x);
+        } else if (!clip_discards(curved.planes, curved.mode, x)) {
+          deepest_kept = std::max(deepest_kept, inside);
+        }
+      }
+    }
+    EXPECT_GT(gaps_tangent, 0) << offset;  // the tangent plane alone stops short
+    EXPECT_EQ(gaps_curved, 0) << offset;
+    // What it keeps past the crease is just under the partner's surface.
+    EXPECT_LT(deepest_kept, 0.1f * kR) << offset;
+  }
+}
+
+TEST(ClassifyPartners, CurvatureDoesNotMoveConvexPartners) {
+  // The hole's rim: the wall (normals toward the axis) curves away from its tangent planes
+  // too, but the crease is convex; the planes stay the tangent planes.
+  Config c = hole_rim();
+  const ClipResult before = classify(c, ClipRule::Classified);
+  for (Disc& p : c.partners) p.shape = {-2.0f, 0, 0};
+  const ClipResult after = classify(c, ClipRule::Classified);
+  ASSERT_EQ(before.planes.size(), after.planes.size());
+  for (std::size_t k = 0; k < before.planes.size(); ++k) EXPECT_EQ(before.planes[k].h, after.planes[k].h);
+}
+
+}  // namespace

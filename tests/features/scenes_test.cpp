@@ -203,6 +203,37 @@ TEST(FeatureScenes, InterpenetratingSpheresAreSeparatedButNotClipped) {
   }
 }
 
+TEST(FeatureScenes, CrossedCylindersAreSixSurfacesWithLargeDiscs) {
+  // T10's cylinders (radii 0.5 and 0.35) have parallel normals 0.15 apart where one passes
+  // inside the other; random sampling's discs make those splats neighbours, and their edges
+  // must not join the two lateral surfaces (spec §4.6 A9: segment count exact, purity).
+  for (SamplingMode mode : {SamplingMode::Jittered, SamplingMode::Random}) {
+    for (unsigned seed : {17u, 1u, 9u}) {
+      Prepared p;
+      p.scene = csg_scene("T10");
+      p.samples = sample_csg(p.scene, mode, seed);
+      ThreadPool pool(2);
+      CloudRadiusOptions radius;
+      radius.coverage = mode == SamplingMode::Jittered ? 1.0f : kDefaultCloudCoverage;
+      p.radii = cloud_radii(p.samples.points.positions, pool, Progress::none(), radius);
+      p.features = compute_features(p.samples.points.positions, p.samples.points.normals, p.radii,
+                                    pool);
+      EXPECT_EQ(p.features.stats.large_segments, 6u) << seed;
+      std::map<std::uint32_t, std::map<std::uint32_t, std::size_t>> votes;
+      for (std::size_t i = 0; i < p.features.size(); ++i) {
+        ++votes[p.features.surface_id[i]][p.samples.labels[i]];
+      }
+      std::size_t mixed = 0;
+      for (const auto& [id, labels] : votes) {
+        std::size_t best = 0, size = 0;
+        for (const auto& [l, n] : labels) best = std::max(best, n), size += n;
+        mixed += size - best;
+      }
+      EXPECT_LE(mixed, p.features.size() / 200) << seed;  // purity >= 99.5 %
+    }
+  }
+}
+
 TEST(FeatureScenes, ThinSlabFacesNeverClipEachOther) {
   const Prepared p = prepare("T11", SamplingMode::Jittered);
   EXPECT_GT(p.features.stats.antiparallel_edges, 1000u);  // front and back splats are neighbours

@@ -3,6 +3,8 @@
 // splat of a model). Equation numbers refer to specs/sharp-features.md.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -12,18 +14,60 @@
 
 namespace pointillist {
 
-// A circular splat as drawn: centre, unit normal, drawn radius.
+// The surface's second-order shape at a splat: the derivative of the unit normal along the
+// surface (the shape operator, symmetric) in the tangent frame of tangent_frame(n), so that the
+// normal curvature along a tangent direction w = a·u + b·v is (xx a² + 2 xy a b + yy b²) / |w|²
+// and the surface lies −½ wᵀ S w along n from the tangent plane at offset w. Positive on a
+// convex surface with outward normals (a sphere of radius R: xx = yy = 1/R), 0 on a plane.
+struct Shape {
+  float xx = 0, xy = 0, yy = 0;
+};
+
+// A circular splat as drawn: centre, unit normal, drawn radius, and (optional) the shape of
+// its surface there, which corrects a partner's plane at curved creases (classify_partners).
 struct Disc {
   Vec3f c;
   Vec3f n;
   float r = 0;
+  Shape shape{};
 };
+
+// The tangent frame (u, v) of a unit normal n that Shape refers to (deterministic in n).
+struct TangentFrame {
+  Vec3f u, v;
+};
+TangentFrame tangent_frame(Vec3f n);
+
+// The shape operator at a splat (centre c, unit normal n) fitted by least squares to its
+// continuous neighbours: normal differences against centre differences, projected into the
+// tangent plane. Isotropic (the mean over the neighbours) where the neighbours do not span the
+// plane; zero without neighbours.
+Shape fit_shape(Vec3f c, Vec3f n, std::span<const Vec3f> neighbour_centres,
+                std::span<const Vec3f> neighbour_normals);
 
 enum class Crossing {
   Cross,     // the two discs meet (closed intervals: touching chords count)
   Apart,     // they lie side by side (a false-positive sharp edge)
   Parallel,  // the planes are (anti)parallel, |n_a × n_b|² < 1e-6: no line, never partners
 };
+
+// Whether two neighbouring splats whose normals agree (n_i·n_j >= w_s) lie on one smooth
+// surface: each centre within reach of the other's plane. On a smooth surface the chord d
+// between two centres makes about half the normals' angle with each tangent plane, on
+// opposite sides (n_i·d ≈ −n_j·d ≈ −½ dᵀ S d), so a chord steeper than the normals' largest
+// angle (sine sqrt(1 − w_s²)), or two offsets of one sign that add up to that much, mean two
+// surfaces side by side (the nearly parallel parts of two crossed cylinders). Offsets up to
+// kStackedOffset of the smaller radius are allowed whatever the chord (noise, quantized
+// centres).
+inline constexpr float kStackedOffset = 0.5f;
+inline bool on_planes_of_each_other(Vec3f ci, Vec3f ni, float ri, Vec3f cj, Vec3f nj, float rj,
+                                    float w_s) {
+  const Vec3f d = cj - ci;
+  const float sin_s = std::sqrt(std::max(0.0f, 1.0f - w_s * w_s));
+  const float allowed = std::max(sin_s * length(d), kStackedOffset * std::min(ri, rj));
+  const float oi = dot(ni, d), oj = dot(nj, d);
+  return std::fabs(oi) <= allowed && std::fabs(oj) <= allowed && std::fabs(oi + oj) <= allowed;
+}
 
 // The exact disc–disc test (eqs. 4.3–4.12): the line where the two planes meet, its chord
 // through each disc on one shared parameterisation, and whether the chords overlap.
@@ -64,6 +108,16 @@ struct ClipResult {
 // by the side s lies on (s's surface is on both sides of each).
 // `margin` (FeatureOptions::clip_margin) moves every plane's line that many radii of s onto
 // its clipped side.
+// ClipRule::Classified also corrects the plane of a concave partner (eq. 4.14: it lies above
+// s's plane, a valley) for the partner's curvature (Disc::shape): the plane is the partner
+// surface's tangent at its centre, and where that surface curves away from it onto the clipped
+// side (the crease of a union of two spheres), the disc stops short of the surface it meets
+// and opens a thin gap. The plane moves onto its clipped side by the largest sag of the
+// partner's surface at the ends of the chord where it cuts s (at most kMaxSagShift radii of
+// s); what the disc then reaches past the true crease lies behind the partner's surface. It
+// never moves the other way, and convex creases are left alone: there the extra part would be
+// in view (the rim of a hole, whose wall curves away from its tangent planes too).
+inline constexpr float kMaxSagShift = 0.5f;
 ClipResult classify_partners(const Disc& s, std::span<const Disc> partners,
                              std::span<const Vec3f> continuous, ClipRule rule,
                              std::span<const Disc> reflex = {}, float margin = 0.0f);
