@@ -12,20 +12,12 @@
 namespace pointillist {
 namespace {
 
-// Whether an edge of the graph is sharp (normals apart), continuous (one smooth surface), or
+// What an edge of the graph is: sharp (normals apart), continuous (one smooth surface), or
 // neither: parallel discs stacked above each other (two surfaces side by side, such as the
 // nearly parallel parts of two crossed cylinders, or the two faces of a thin slab), whose
-// normals agree but whose centres are not on each other's planes.
-struct EdgeKinds {
-  std::span<const Vec3f> centers, normals;
-  std::span<const float> drawn;
-  float w_s;
-  bool sharp(std::size_t i, std::size_t j) const { return dot(normals[i], normals[j]) < w_s; }
-  bool continuous(std::size_t i, std::size_t j) const {
-    return !sharp(i, j) && on_planes_of_each_other(centers[i], normals[i], drawn[i], centers[j],
-                                                   normals[j], drawn[j], w_s);
-  }
-};
+// normals agree but whose centres are not on each other's planes (on_planes_of_each_other).
+// One byte per directed edge, in the graph's order.
+enum EdgeKind : std::uint8_t { kStacked, kContinuous, kSharp };
 
 struct Block {
   std::vector<ClipMode> modes;
@@ -51,7 +43,7 @@ void add(FeatureStats& to, const FeatureStats& from) {
 
 // Breadth-first search over the continuous edges, seeded in increasing splat index (spec §1.8
 // [P]): ids are numbered in the order of each surface's smallest splat index.
-std::uint64_t segment(const NeighbourGraph& graph, const EdgeKinds& kinds,
+std::uint64_t segment(const NeighbourGraph& graph, std::span<const std::uint8_t> kinds,
                       std::vector<std::uint32_t>& ids, std::uint64_t& large) {
   const std::size_t n = graph.vertex_count();
   constexpr std::uint32_t kNone = 0xffffffffu;
@@ -67,8 +59,9 @@ std::uint64_t segment(const NeighbourGraph& graph, const EdgeKinds& kinds,
     ids[seed] = next_id;
     while (head < tail) {
       const std::uint32_t s = queue[head++];
-      for (std::uint32_t j : graph.row(s)) {
-        if (ids[j] == kNone && kinds.continuous(s, j)) {
+      for (std::uint64_t e = graph.offsets[s]; e < graph.offsets[s + 1]; ++e) {
+        const std::uint32_t j = graph.neighbours[e];
+        if (ids[j] == kNone && kinds[e] == kContinuous) {
           ids[j] = next_id;
           queue[tail++] = j;
         }
@@ -119,30 +112,37 @@ FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec
       options.edge_test == EdgeTest::Side && options.clip_rule == ClipRule::Classified;
   constexpr std::size_t kBlock = 4096;
   std::vector<Block> blocks((n + kBlock - 1) / kBlock);
-  // The surface's shape at every splat with a sharp edge (a possible partner), from its
-  // continuous neighbours: Pointillist's rule corrects partner planes at curved creases.
-  const EdgeKinds kinds{centers, normals, drawn, options.sharp_threshold};
+  // Each edge's kind, and the surface's shape at every splat with a sharp edge (a possible
+  // partner) from its continuous neighbours: Pointillist's rule corrects partner planes at
+  // curved creases.
+  std::vector<std::uint8_t> kinds(graph.neighbours.size());
   std::vector<Shape> shapes;
-  if (options.clip_rule == ClipRule::Classified) {
-    shapes.resize(n);
-    pool.run(blocks.size(), [&](std::size_t b) {
-      std::vector<Vec3f> around, around_normals;
-      for (std::size_t i = b * kBlock, end = std::min(n, i + kBlock); i < end; ++i) {
-        around.clear();
-        around_normals.clear();
-        bool sharp = false;
-        for (std::uint32_t j : graph.row(i)) {
-          if (kinds.sharp(i, j)) {
-            sharp = true;
-          } else if (kinds.continuous(i, j)) {
-            around.push_back(centers[j]);
-            around_normals.push_back(normals[j]);
-          }
+  const bool fit = options.clip_rule == ClipRule::Classified;
+  if (fit) shapes.resize(n);
+  const float w_s = options.sharp_threshold;
+  pool.run(blocks.size(), [&](std::size_t b) {
+    std::vector<Vec3f> around, around_normals;
+    for (std::size_t i = b * kBlock, end = std::min(n, i + kBlock); i < end; ++i) {
+      around.clear();
+      around_normals.clear();
+      bool sharp = false;
+      for (std::uint64_t e = graph.offsets[i]; e < graph.offsets[i + 1]; ++e) {
+        const std::uint32_t j = graph.neighbours[e];
+        if (dot(normals[i], normals[j]) < w_s) {
+          kinds[e] = kSharp;
+          sharp = true;
+        } else if (on_planes_of_each_other(centers[i], normals[i], drawn[i], centers[j],
+                                           normals[j], drawn[j], w_s)) {
+          kinds[e] = kContinuous;
+          around.push_back(centers[j]);
+          around_normals.push_back(normals[j]);
+        } else {
+          kinds[e] = kStacked;
         }
-        if (sharp) shapes[i] = fit_shape(centers[i], normals[i], around, around_normals);
       }
-    });
-  }
+      if (fit && sharp) shapes[i] = fit_shape(centers[i], normals[i], around, around_normals);
+    }
+  });
   const auto disc = [&](std::size_t j) {
     return Disc{centers[j], normals[j], drawn[j], shapes.empty() ? Shape{} : shapes[j]};
   };
@@ -161,9 +161,10 @@ FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec
         continuous.clear();
         crossing.clear();
         bool candidate = false;
-        for (std::uint32_t j : graph.row(i)) {
-          if (!kinds.sharp(i, j)) {
-            if (kinds.continuous(i, j)) continuous.push_back(centers[j]);
+        for (std::uint64_t e = graph.offsets[i]; e < graph.offsets[i + 1]; ++e) {
+          const std::uint32_t j = graph.neighbours[e];
+          if (kinds[e] != kSharp) {
+            if (kinds[e] == kContinuous) continuous.push_back(centers[j]);
             continue;
           }
           candidate = true;

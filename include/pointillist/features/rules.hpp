@@ -63,10 +63,11 @@ inline constexpr float kStackedOffset = 0.5f;
 inline bool on_planes_of_each_other(Vec3f ci, Vec3f ni, float ri, Vec3f cj, Vec3f nj, float rj,
                                     float w_s) {
   const Vec3f d = cj - ci;
-  const float sin_s = std::sqrt(std::max(0.0f, 1.0f - w_s * w_s));
-  const float allowed = std::max(sin_s * length(d), kStackedOffset * std::min(ri, rj));
-  const float oi = dot(ni, d), oj = dot(nj, d);
-  return std::fabs(oi) <= allowed && std::fabs(oj) <= allowed && std::fabs(oi + oj) <= allowed;
+  const float r = kStackedOffset * std::min(ri, rj);
+  // Squared: allowed² = max(sin² θ_s · |d|², r²).
+  const float allowed2 = std::max((1.0f - w_s * w_s) * dot(d, d), r * r);
+  const float oi = dot(ni, d), oj = dot(nj, d), sum = oi + oj;
+  return oi * oi <= allowed2 && oj * oj <= allowed2 && sum * sum <= allowed2;
 }
 
 // The exact disc–disc test (eqs. 4.3–4.12): the line where the two planes meet, its chord
