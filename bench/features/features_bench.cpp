@@ -3,6 +3,7 @@
 // P4). Baseline: a plain pass over the same positions.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <memory>
@@ -122,10 +123,11 @@ void BM_FeaturesCloud(benchmark::State& state) {
   time_features(state, cloud.positions, cloud.normals, cloud.radii, pool);
 }
 
-// P3/P4: a quality frame of T1 at the corner close-up (V2, 1024×1024), range(0): 1 = features.
+// P3/P4: a quality frame of T1 at the corner close-up (V2, 1024×1024), range(0): 0 = without
+// features, 1 = features, 2 = surface ids without clip planes (what clipping adds is 1 − 2).
 void BM_QualityFrameT1(benchmark::State& state) {
   static std::unique_ptr<SphereTree> tree;
-  static std::unique_ptr<TreeFeatures> features;
+  static std::unique_ptr<TreeFeatures> features, ids_only;
   ThreadPool pool(2);
   if (!tree) {
     CsgSamples s = sample_csg(csg_scene("T1"), SamplingMode::Jittered, 1);
@@ -134,9 +136,13 @@ void BM_QualityFrameT1(benchmark::State& state) {
     s.points.radii = cloud_radii(s.points.positions, pool, Progress::none(), radius);
     tree = std::make_unique<SphereTree>(build_sphere_tree(s.points, pool));
     features = std::make_unique<TreeFeatures>(compute_tree_features(tree->view(), pool));
+    ids_only = std::make_unique<TreeFeatures>(*features);
+    std::fill(ids_only->clip_mode.begin(), ids_only->clip_mode.end(), ClipMode::None);
+    std::fill(ids_only->clip_offset.begin(), ids_only->clip_offset.end(), 0u);
+    ids_only->clip_planes.clear();
   }
   RenderModel model{.tree = tree->view()};
-  model.tree.features = features.get();
+  model.tree.features = state.range(0) == 2 ? ids_only.get() : features.get();
   Camera cam;
   cam.eye = {2.0f, 2.1f, 1.9f};
   cam.target = {1, 1, 1};
@@ -178,5 +184,5 @@ BENCHMARK(BM_Features)
 BENCHMARK(BM_FeaturesDragon)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FeaturesCloud)->Arg(1'000'000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QualityFrameT1)->Name("BM_QualityFrameT1/Small")->Arg(1)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_QualityFrameT1)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_QualityFrameT1)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_BaselineTouchPositions)->Arg(41737)->Unit(benchmark::kMicrosecond);

@@ -116,6 +116,7 @@ struct QualityScratch {
   std::vector<std::vector<std::uint32_t>> chunk_bins;  // per chunk: its splats by band of rows
   std::vector<std::vector<float>> chunk_planes;        // per chunk: clip planes, eye space
   std::vector<std::vector<float>> band_buffers;        // per-pixel accumulators, one per worker
+  std::vector<std::vector<std::uint32_t>> band_tiles;  // sharp features: surfaces per column
   // The last frame's counts (RenderStats::clipped_fragments, other_surface_fragments).
   std::uint64_t clipped_fragments = 0, other_surface_fragments = 0;
 };

@@ -78,6 +78,15 @@ constexpr std::int32_t kMixedId = static_cast<std::int32_t>(kMixedSurface);
 // only fragments of that id); the pass that finds that id.
 enum Features : int { kNoFeatures, kClipOnly, kSameSurface, kFindFront };
 
+// Columns of 16 pixels (4 groups) across a band, for the surface rule: the one surface id of
+// the splats that reach into the column (inner nodes' mixed id aside), or kMultiTile when they
+// carry several. Where only one surface (and mixed nodes) reaches, every fragment belongs to the
+// front surface whatever its depth, so the pass that finds the front surface skips the column
+// and leaves its ids mixed (every fragment takes part): the same image as finding them.
+constexpr int kTileShift = 2;  // groups per tile column: 1 << kTileShift
+constexpr std::uint32_t kEmptyTile = kMixedSurface;
+constexpr std::uint32_t kMultiTile = kMixedSurface - 1;
+
 struct Band {
   int row0, row1;  // rows [row0, row1)
   int groups;      // 4-pixel groups per row
@@ -89,6 +98,7 @@ struct Band {
   // in the accumulation pass.
   std::uint64_t* clipped;
   std::uint64_t* other_surface;
+  std::uint32_t* tiles = nullptr;  // the surface rule's tile columns (see kMultiTile)
   float* ids_at(int j, int k) const {
     return ids + (static_cast<std::size_t>(j - row0) * groups + k) * kIdFloats;
   }
@@ -135,6 +145,9 @@ void draw_splat(const float* s, const float* planes, const View& v, const Band& 
   const float lo = s[kDepthLo], hi = s[kDepthHi];
   const Float4 one = splat4(1.0f), zero = splat4(0.0f), inf = splat4(kInf);
   for (int k = i0 >> 2; k <= (i1 >> 2); ++k) {
+    if constexpr (kFeat == kFindFront) {
+      if (band.tiles[k >> kTileShift] != kMultiTile) continue;
+    }
     const Float4 iv = static_cast<float>(k * kLanes) + lane;
     const Int4 in_box = (iv >= static_cast<float>(i0)) & (iv <= static_cast<float>(i1));
     const Float4 pcx = iv + 0.5f;
@@ -159,8 +172,9 @@ void draw_splat(const float* s, const float* planes, const View& v, const Band& 
       if constexpr (kFeat != kNoFeatures) {
         if (float_to_bits(s[kClipCode]) & 31u) {
           const Int4 cut = cover & clipped_lanes(s, planes, t, X, Y, u, valid);
-          // Counted once a frame: in the first pass of the opaque or the layered rule.
-          if (kFeat == kFindFront || (kFeat == kClipOnly && !kAccumulate)) {
+          // Counted once a frame: in the visibility pass (the front-surface pass skips
+          // columns), or the first pass of the layered rule.
+          if (!kAccumulate && (kFeat == kSameSurface || kFeat == kClipOnly)) {
             *band.clipped += render_detail::lane_count(cut);
           }
           cover &= ~cut;
@@ -229,6 +243,19 @@ void draw_splat(const float* s, const float* planes, const View& v, const Band& 
       add(kSumNy, w * s[kWy]);
       add(kSumNz, w * s[kWz]);
     }
+  }
+}
+
+// The surface rule's first look at a band: which tile columns several surfaces reach.
+void mark_tiles(const float* s, const float*, const View&, const Band& band) {
+  const std::uint32_t id = float_to_bits(s[kSurface]);
+  if (id == kMixedSurface) return;
+  const int i0 = static_cast<int>(s[kI0]), i1 = static_cast<int>(s[kI1]);
+  if (i1 < i0) return;
+  const int shift = kTileShift + 2;  // pixels -> tile columns
+  for (int t = i0 >> shift; t <= (i1 >> shift); ++t) {
+    std::uint32_t& tile = band.tiles[t];
+    tile = tile == kEmptyTile || tile == id ? id : kMultiTile;
   }
 }
 
@@ -470,6 +497,11 @@ void rasterize(const SplatStream& stream, const std::span<const StreamPiece>* pi
   const std::size_t workers =
       std::min<std::size_t>(pool.thread_count(), static_cast<std::size_t>(setup.band_count));
   if (scratch.band_buffers.size() < workers) scratch.band_buffers.resize(workers);
+  const std::size_t tile_count = (static_cast<std::size_t>(groups) >> kTileShift) + 1;
+  if (surface_rule) {
+    if (scratch.band_tiles.size() < workers) scratch.band_tiles.resize(workers);
+    for (std::size_t w = 0; w < workers; ++w) scratch.band_tiles[w].resize(tile_count);
+  }
   for (std::size_t w = 0; w < workers; ++w) {
     if (scratch.band_buffers[w].size() < buffer_floats) scratch.band_buffers[w].resize(buffer_floats);
   }
@@ -481,12 +513,19 @@ void rasterize(const SplatStream& stream, const std::span<const StreamPiece>* pi
     std::uint64_t clipped_here = 0, other_here = 0;
     for (std::size_t b = next_band++; b < band_count; b = next_band++) {
       const int row0 = static_cast<int>(b) * setup.band_rows;
-      const Band band{row0, std::min(camera.height, row0 + setup.band_rows), groups, buffer,
+      const Band band{row0,
+                      std::min(camera.height, row0 + setup.band_rows),
+                      groups,
+                      buffer,
                       buffer + band_groups * kGroupFloats,
                       buffer + band_groups * (kGroupFloats + (layered ? kLayerFloats : 0)),
-                      &clipped_here, &other_here};
+                      &clipped_here,
+                      &other_here,
+                      surface_rule ? scratch.band_tiles[worker].data() : nullptr};
       clear_planes(band, layered, surface_rule);
       if (surface_rule) {
+        std::fill(band.tiles, band.tiles + tile_count, kEmptyTile);
+        band_pass(stream_order, scratch, b, band_count, v, band, &mark_tiles);
         band_pass(stream_order, scratch, b, band_count, v, band,
                   pick<false, false, false, kFindFront>(z_range));
         band_pass(stream_order, scratch, b, band_count, v, band,
