@@ -10,6 +10,7 @@
 #include <exception>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,7 @@
 #include "pointillist/prep/radii.hpp"
 #include "pointillist/scene/csg.hpp"
 #include "pointillist/format/qs.hpp"
+#include "pointillist/io/pfm.hpp"
 #include "pointillist/io/ply.hpp"
 #include "pointillist/lod/sphere_tree.hpp"
 #include "pointillist/prep/prepare.hpp"
@@ -294,6 +296,13 @@ void make_models(const fs::path& root, ThreadPool& pool) {
   write_qs((root / "qs" / "plain.qs").string(), plain, {.write_comments = false});
 }
 
+// Depth images: a small one with the background's infinities, and a single pixel.
+void make_pfm(const fs::path& dir) {
+  const float inf = std::numeric_limits<float>::infinity();
+  write_pfm((dir / "depth.pfm").string(), 3, 2, std::vector<float>{1.5f, 2.0f, inf, 0.25f, inf, 7.0f});
+  write_pfm((dir / "one.pfm").string(), 1, 1, std::vector<float>{3.0f});
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -303,7 +312,8 @@ int main(int argc, char** argv) {
   }
   try {
     const fs::path root = argv[1];
-    for (const char* harness : {"ply", "las", "obj", "xyz", "qs", "ptl_v1", "ptl_v2", "path"})
+    for (const char* harness :
+         {"ply", "las", "obj", "xyz", "qs", "ptl_v1", "ptl_v2", "path", "pfm"})
       fs::create_directories(root / harness);
     ThreadPool pool(1);
     make_ply(root / "ply", pool);
@@ -311,6 +321,7 @@ int main(int argc, char** argv) {
     make_obj(root / "obj");
     make_xyz(root / "xyz");
     make_path(root / "path");
+    make_pfm(root / "pfm");
     make_models(root, pool);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "make_corpus: %s\n", e.what());

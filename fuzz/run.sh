@@ -24,7 +24,7 @@ while getopts "s:j:b:k" opt; do
 done
 shift $((OPTIND - 1))
 harnesses=("$@")
-[ ${#harnesses[@]} -gt 0 ] || harnesses=(ply las obj xyz qs ptl_v1 ptl_v2 path)
+[ ${#harnesses[@]} -gt 0 ] || harnesses=(ply las obj xyz qs ptl_v1 ptl_v2 path pfm)
 
 logs=$build/fuzz-logs
 mkdir -p "$logs"

@@ -127,6 +127,7 @@ struct GenerateOptions {
   // Test scenes T*: also write the exact label image here (empty = none), seen with `view` (as
   // `render` would see the written .ply) on `background`.
   std::string reference_output;
+  std::string reference_depth_output;  // with it: its depth (PFM, scene units; empty = none)
   ViewOptions view;
   Rgb8 background{0, 0, 0};
   std::vector<std::string> warnings;  // options given that do not apply (printed by run_generate)
@@ -142,6 +143,9 @@ struct CompareOptions {
   std::string json_output;         // empty = none, "-" = stdout (instead of the text)
   bool labels = false;             // --labels: the label metrics too (eval/label_metrics.hpp)
   int label_tolerance = 2;         // levels per channel at which a pixel still shows a face
+  // --labels --depth REF.pfm TEST.pfm --see-through-gap G: the SEE-THROUGH count.
+  std::vector<std::string> depth_images;
+  float see_through_gap = 0;
 };
 int run_compare(const CompareOptions& options);
 

@@ -12,6 +12,7 @@
 #include "options.hpp"
 #include "util.hpp"
 #include "pointillist/core/error.hpp"
+#include "pointillist/io/pfm.hpp"
 #include "pointillist/io/png.hpp"
 #include "pointillist/eval/image_compare.hpp"
 #include "pointillist/eval/label_metrics.hpp"
@@ -49,7 +50,8 @@ std::string labels_to_json(const LabelComparison& l, int tolerance) {
                 "    \"edge_displacement_mean_px\": %.6f,\n"
                 "    \"edge_displacement_max_px\": %.6f,\n"
                 "    \"transition_width_mean_px\": %.6f,\n"
-                "    \"transition_width_max_px\": %.6f\n"
+                "    \"transition_width_max_px\": %.6f,\n"
+                "    \"see_through_pixels\": %s\n"
                 "  }",
                 tolerance, ull(l.covered_count), ull(l.interior_count), ull(l.boundary_count),
                 ull(l.hole_count), ull(l.far_background_count), ull(l.overshoot_count),
@@ -58,7 +60,8 @@ std::string labels_to_json(const LabelComparison& l, int tolerance) {
                 ull(l.mixed_count), ull(l.mix_band_count), ull(l.mixed_band_count),
                 l.mixed_per_boundary_px, ull(l.mixed_outside_count), ull(l.profile_count),
                 ull(l.unmatched_profile_count), l.displacement_mean_px, l.displacement_max_px,
-                l.transition_mean_px, l.transition_max_px);
+                l.transition_mean_px, l.transition_max_px,
+                l.depth_compared ? std::to_string(l.see_through_count).c_str() : "null");
   return buf;
 }
 
@@ -100,6 +103,11 @@ void print_labels(const LabelComparison& l, int tolerance) {
               tolerance, ull(l.covered_count), ull(l.interior_count), ull(l.boundary_count));
   std::printf("  HOLE:         %llu of %llu interior pixels\n", ull(l.hole_count),
               ull(l.interior_count));
+  if (l.depth_compared) {
+    std::printf("  SEE-THROUGH:  %llu interior pixels show another surface behind the "
+                "reference's (by more than the gap)\n",
+                ull(l.see_through_count));
+  }
   std::printf("  OVERSHOOT:    %llu of %llu background pixels more than 1 px from the reference\n",
               ull(l.overshoot_count), ull(l.far_background_count));
   std::printf("  LER:          %.3f%% in B_4 (%llu of %llu), %.3f%% of covered (%llu of %llu); "
@@ -161,11 +169,27 @@ int run_compare(const CompareOptions& o) {
   const ImageComparison c = compare_images(ref_view, test_view, {.background = background});
   std::optional<LabelComparison> labels;
   if (o.labels) {
+    ImageFloat ref_depth, test_depth;
+    if (!o.depth_images.empty()) {
+      ref_depth = read_pfm(o.depth_images[0]);
+      test_depth = read_pfm(o.depth_images[1]);
+      for (const auto* d : {&ref_depth, &test_depth}) {
+        if (d->width != reference.width || d->height != reference.height) {
+          throw Error(o.depth_images[d == &ref_depth ? 0 : 1] + " is " + std::to_string(d->width) +
+                      "x" + std::to_string(d->height) + " but the images are " +
+                      std::to_string(reference.width) + "x" + std::to_string(reference.height) +
+                      "; give the depth images written with them");
+        }
+      }
+    }
     labels = compare_labels(ref_view, test_view,
                             {.palette = kLabelPalette,
                              .background = background,
                              .tolerance = o.label_tolerance,
-                             .reference_name = o.reference});
+                             .reference_name = o.reference,
+                             .reference_depth = ref_depth.pixels,
+                             .test_depth = test_depth.pixels,
+                             .see_through_gap = o.see_through_gap});
   }
 
   if (!o.json_output.empty()) {
@@ -214,7 +238,26 @@ Command add_compare_command(CLI::App& app) {
                   "colour shows that face; farther, it blends faces")
       ->default_val(2)
       ->check(CLI::Range(0, 64));
+  cmd->add_option("--depth", o->depth_images,
+                  "With --labels: the depth images of the reference and the test (PFM: "
+                  "generate --reference-depth, render --depth D.pfm) for the SEE-THROUGH count")
+      ->expected(2)
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--see-through-gap", o->see_through_gap,
+                  "With --depth: how far (scene units) behind the reference a test pixel of "
+                  "another surface must lie to count as see-through (the spec: 2 mean splat "
+                  "radii; info prints the radii)");
   return {cmd, [o, background, cmd] {
+            if (!o->depth_images.empty() && !o->labels) {
+              throw OptionError("--depth applies with --labels (the SEE-THROUGH count)");
+            }
+            if (!o->depth_images.empty() && !(o->see_through_gap > 0)) {
+              throw OptionError("--depth needs --see-through-gap G, a depth in scene units > 0 "
+                                "(the spec takes 2 mean splat radii)");
+            }
+            if (o->depth_images.empty() && cmd->count("--see-through-gap") > 0) {
+              throw OptionError("--see-through-gap applies with --depth REF.pfm TEST.pfm");
+            }
             if (!background->empty()) o->background = parse_rgb8(*background, "--background");
             if (!o->labels && cmd->count("--label-tolerance") > 0) {
               std::fprintf(stderr, "pointillist compare: warning: --label-tolerance is ignored: "

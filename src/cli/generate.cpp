@@ -16,6 +16,7 @@
 #include "pointillist/core/atomic_file.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/io/ply.hpp"
+#include "pointillist/io/pfm.hpp"
 #include "pointillist/io/png.hpp"
 #include "pointillist/pipeline/generate_scene.hpp"
 #include "pointillist/prep/radii.hpp"
@@ -31,15 +32,19 @@ namespace {
 // .ply with the same camera options: the orbit around the samples' view sphere (the centre of
 // their bounding box and the largest distance to a sample, as the hierarchy built from the file
 // computes it), +Y up (the samples record no other up axis).
-std::vector<Rgb8> reference_image(const GenerateOptions& o, const CsgScene& scene,
-                                  const PointSet& samples, std::span<const std::uint32_t> group) {
+struct Reference {
+  std::vector<Rgb8> pixels;
+  std::vector<float> depth;  // along the view direction, +inf where the ray misses
+};
+Reference reference_image(const GenerateOptions& o, const CsgScene& scene,
+                          const PointSet& samples, std::span<const std::uint32_t> group) {
   const Camera camera = make_camera(o.view, view_sphere(samples.positions), samples.up);
-  const CsgImage image = ray_cast_csg_image(scene, camera);
+  CsgImage image = ray_cast_csg_image(scene, camera);
   std::vector<Rgb8> pixels(image.label.size(), o.background);
   for (std::size_t i = 0; i < pixels.size(); ++i) {
     if (image.label[i] != kNoLabel) pixels[i] = kLabelPalette[group[image.label[i]] % 8];
   }
-  return pixels;
+  return {std::move(pixels), std::move(image.depth)};
 }
 
 // A CSG test scene of the sharp-features spec: exact normals, a colour per face; J-mode samples
@@ -60,12 +65,14 @@ int generate_csg(const GenerateOptions& o) {
     s.points.radii = cloud_radii(s.points.positions, pool, Progress::none(), radius);
   }
   // The image first: a bad camera option then leaves no file behind.
-  const std::vector<Rgb8> reference =
-      o.reference_output.empty() ? std::vector<Rgb8>{}
-                                 : reference_image(o, scene, s.points, group);
+  const Reference reference =
+      o.reference_output.empty() ? Reference{} : reference_image(o, scene, s.points, group);
   write_ply(o.output, s.points);
   if (!o.reference_output.empty()) {
-    write_png_rgb8(o.reference_output, o.view.width, o.view.height, reference);
+    write_png_rgb8(o.reference_output, o.view.width, o.view.height, reference.pixels);
+  }
+  if (!o.reference_depth_output.empty()) {
+    write_pfm(o.reference_depth_output, o.view.width, o.view.height, reference.depth);
   }
   if (!o.quiet) {
     std::printf("generated %zu samples of test scene %s (%s sampling, exact normals, a colour "
@@ -118,7 +125,22 @@ int generate_occlusion_scene(const GenerateOptions& o) {
 }
 
 void check_options(const GenerateOptions& o) {
-  check_outputs({}, {{"-o", o.output}, {"--reference", o.reference_output}});
+  check_outputs({}, {{"-o", o.output},
+                     {"--reference", o.reference_output},
+                     {"--reference-depth", o.reference_depth_output}});
+  if (!o.reference_depth_output.empty()) {
+    if (o.reference_output.empty()) {
+      throw OptionError("--reference-depth writes the depth of the --reference image; give "
+                        "--reference R.png too");
+    }
+    std::string ext = std::filesystem::path(o.reference_depth_output).extension().string();
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (ext != ".pfm") {
+      throw OptionError("--reference-depth " + o.reference_depth_output +
+                        ": the depth image is a PFM (float depth in scene units); give a path "
+                        "ending in .pfm");
+    }
+  }
   if (is_occlusion_scene(o.scene) && !o.reference_output.empty()) {
     throw OptionError("--reference writes the exact image of a sharp-features test scene (T*); "
                       "it does not apply to --scene " + o.scene);
@@ -258,6 +280,10 @@ Command add_generate_command(CLI::App& app) {
                   "Test scenes T*: also write the exact ray-cast image of the scene, unlit, each "
                   "pixel its face's colour, with the camera `render` uses for the .ply and the "
                   "same camera options")
+      ->group(kGroupOutput);
+  cmd->add_option("--reference-depth", o->reference_depth_output,
+                  "With --reference: also its depth along the view direction, a PFM in scene "
+                  "units (compare --labels --depth)")
       ->group(kGroupOutput);
   auto camera = std::make_shared<CameraText>();
   add_camera_options(cmd, o->view, *camera);

@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -147,6 +148,19 @@ int run_info(const InfoOptions& o) {
   std::printf("view sphere: centre (%g, %g, %g), radius %g (used by --view)\n",
               t.view_sphere.center.x, t.view_sphere.center.y, t.view_sphere.center.z,
               t.view_sphere.radius);
+  if (!t.nodes.empty()) {
+    // Splat radii of the leaves (compare's --see-through-gap is 2 mean radii in the spec).
+    double sum = 0;
+    float lo = INFINITY, hi = 0;
+    std::uint64_t count = 0;
+    for (const SphereNode& n : t.nodes) {
+      if (n.child_count != 0) continue;
+      sum += n.radius, lo = std::min(lo, n.radius), hi = std::max(hi, n.radius), ++count;
+    }
+    if (count > 0) {
+      std::printf("splat radii: mean %g, min %g, max %g (leaves)\n", sum / double(count), lo, hi);
+    }
+  }
   std::printf("file size:   %s (%.2f bytes/point)\n",
               human_bytes(double(model.file_size())).c_str(),
               leaves > 0 ? double(model.file_size()) / leaves : 0.0);

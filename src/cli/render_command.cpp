@@ -15,6 +15,7 @@
 #include "pointillist/core/atomic_file.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/io/camera_path.hpp"
+#include "pointillist/io/pfm.hpp"
 #include "pointillist/io/png.hpp"
 #include "pointillist/pipeline/report.hpp"
 #include "pointillist/pipeline/scene.hpp"
@@ -99,9 +100,14 @@ void check_options(const RenderOptions& o) {
                                      {"--depth", o.depth_output}}) {
     std::string ext = std::filesystem::path(path).extension().string();
     for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    if (!path.empty() && ext != ".png") {
+    const bool depth_pfm = std::string(option) == "--depth" && ext == ".pfm";
+    if (!path.empty() && ext != ".png" && !depth_pfm) {
       throw OptionError(std::string(option) + " " + path +
-                        ": render writes PNG images; give a path ending in .png");
+                        (std::string(option) == "--depth"
+                             ? ": the depth image is a PNG (16-bit, scaled to the frame's depth "
+                               "range) or a PFM (float depth in scene units); give a path ending "
+                               "in .png or .pfm"
+                             : ": render writes PNG images; give a path ending in .png"));
     }
   }
   if (o.orbit_frames > 0 && (o.view.eye || o.view.target)) {
@@ -203,8 +209,14 @@ int run_render(const RenderOptions& o) {
   }
   write_png_rgb8(o.output, frame.width, frame.height, frame.color);
   if (!o.depth_output.empty()) {
-    const auto depth16 = depth_to_gray16(frame);
-    write_png_gray16(o.depth_output, frame.width, frame.height, depth16);
+    std::string ext = std::filesystem::path(o.depth_output).extension().string();
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (ext == ".pfm") {
+      write_pfm(o.depth_output, frame.width, frame.height, frame.depth);
+    } else {
+      const auto depth16 = depth_to_gray16(frame);
+      write_png_gray16(o.depth_output, frame.width, frame.height, depth16);
+    }
   }
   const float finest = std::min(1.0f, initial_detail(o.settings, o.frame));
   if (!o.stats_output.empty()) {

@@ -266,7 +266,9 @@ Command add_render_command(CLI::App& app) {
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", o->output, "Output PNG")->required()->group(kGroupOutput);
-  cmd->add_option("--depth", o->depth_output, "Also write a 16-bit depth PNG")
+  cmd->add_option("--depth", o->depth_output,
+                  "Also write the depth image: D.png 16-bit, scaled to the frame's depth range; "
+                  "D.pfm float depth along the view direction in scene units (compare --depth)")
       ->group(kGroupOutput);
   cmd->add_option("--stats", o->stats_output, "Write statistics as JSON (- = stdout)")
       ->group(kGroupOutput);

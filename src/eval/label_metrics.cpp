@@ -282,6 +282,20 @@ LabelComparison compare_labels(ImageRgb8View reference, ImageRgb8View test,
   LabelComparison out;
   out.background = o.background.value_or(reference.pixels[0]);
   check_options(o, out.background);
+  out.depth_compared = !o.reference_depth.empty() || !o.test_depth.empty();
+  if (out.depth_compared) {
+    const std::size_t pixels = reference.pixels.size();
+    if (o.reference_depth.size() != pixels || o.test_depth.size() != pixels) {
+      throw Error("label comparison: depth images of " + std::to_string(o.reference_depth.size()) +
+                  " and " + std::to_string(o.test_depth.size()) + " pixels for " +
+                  std::to_string(pixels) + "-pixel images; give both depth images, of the "
+                  "colour images' size");
+    }
+    if (!(o.see_through_gap > 0) || !std::isfinite(o.see_through_gap)) {
+      throw Error("label comparison: the see-through gap must be a positive depth (2 mean splat "
+                  "radii in the spec), not " + std::to_string(o.see_through_gap));
+    }
+  }
   const int w = reference.width, h = reference.height;
   const std::vector<std::uint8_t> ref = reference_label_image(reference, o, out.background);
   const std::vector<std::uint8_t> got = label_image(test, o.palette, out.background, o.tolerance);
@@ -319,6 +333,11 @@ LabelComparison compare_labels(ImageRgb8View reference, ImageRgb8View test,
     }
     ++out.interior_count;
     out.mixed_count += mixed;
+    if (out.depth_compared && error && got[i] != kLabelBackground) {
+      // NaN or +inf (nothing drawn) compares false: not a farther surface.
+      out.see_through_count += o.test_depth[i] > o.reference_depth[i] + o.see_through_gap &&
+                               std::isfinite(o.test_depth[i]);
+    }
     if (mix_band[i]) ++out.mix_band_count, out.mixed_band_count += mixed;
   }
   assert(out.interior_count == holes.interior_count);

@@ -3,6 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -10,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/cli_run.hpp"
+#include "pointillist/io/pfm.hpp"
 #include "pointillist/io/png.hpp"
 #include "testing/testing.hpp"
 
@@ -126,4 +128,73 @@ TEST(LabelsCli, ReferenceNeedsATestSceneAndAPng) {
   r = run_cli("generate --scene T1 -o " + dir.file("c.ply") + " --view 10,10");
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_THAT(r.output, HasSubstr("--view is ignored: it applies to the --reference image"));
+}
+
+TEST(LabelsCli, DepthImagesGiveTheSeeThroughCount) {
+  // The reference's depth (exact ray cast) and the render's (--depth D.pfm, blended splat
+  // depth) agree where the labels do; the cube with features shows no farther surface, and a
+  // test depth pushed behind where the labels were swapped counts as see-through.
+  pointillist::testing::TempDir dir;
+  const std::string ply = dir.file("cube.ply"), ref = dir.file("ref.png"),
+                    ref_depth = dir.file("ref.pfm"), img = dir.file("t.png"),
+                    depth = dir.file("t.pfm");
+  const std::string camera = " --size 128x128 --eye 2,2.1,1.9 --target 1,1,1";
+  auto r = run_cli("generate --scene T1 -q -o " + ply + " --reference " + ref +
+                   " --reference-depth " + ref_depth + camera);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = run_cli("render " + ply + " -q --mode quality --unlit --features -o " + img + " --depth " +
+              depth + camera);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const ImageFloat rd = read_pfm(ref_depth), td = read_pfm(depth);
+  ASSERT_EQ(rd.pixels.size(), 128u * 128u);
+  ASSERT_EQ(td.pixels.size(), rd.pixels.size());
+  std::size_t both = 0, close = 0;
+  for (std::size_t i = 0; i < rd.pixels.size(); ++i) {
+    if (!std::isfinite(rd.pixels[i]) || !std::isfinite(td.pixels[i])) continue;
+    ++both;
+    close += std::fabs(rd.pixels[i] - td.pixels[i]) < 0.01f;  // the cube's side is 2
+  }
+  EXPECT_GT(both, 5000u);
+  EXPECT_GT(close, both * 99 / 100);
+  const auto json = [&](const std::string& test, const std::string& test_depth) {
+    const auto c = run_cli("compare " + ref + " " + test + " --labels --json - --depth " +
+                           ref_depth + " " + test_depth + " --see-through-gap 0.05");
+    EXPECT_EQ(c.exit_code, 0) << c.output;
+    return nlohmann::json::parse(c.output)["labels"];
+  };
+  EXPECT_EQ(json(img, depth)["see_through_pixels"].get<int>(), 0);
+  // The reference itself with a block of one face shown in another face's colour, 1 behind.
+  ImageRgb8 swapped = read_png_rgb8(ref);
+  std::vector<float> behind = rd.pixels;
+  const Rgb8 face = swapped.pixels[45 * 128 + 45];
+  Rgb8 other = face;
+  for (const Rgb8 p : swapped.pixels) {
+    if (!(p == face) && !(p == Rgb8{0, 0, 0})) other = p;
+  }
+  ASSERT_FALSE(other == face);
+  int changed = 0;
+  for (int y = 40; y < 50; ++y) {
+    for (int x = 40; x < 50; ++x) {
+      Rgb8& p = swapped.pixels[y * 128 + x];
+      if (!(p == face)) continue;
+      p = other;
+      behind[y * 128 + x] += 1.0f;
+      ++changed;
+    }
+  }
+  ASSERT_GT(changed, 10);
+  write_png_rgb8(dir.file("s.png"), 128, 128, swapped.pixels);
+  write_pfm(dir.file("s.pfm"), 128, 128, behind);
+  EXPECT_EQ(json(dir.file("s.png"), dir.file("s.pfm"))["see_through_pixels"].get<int>(), changed);
+  // Without depth images the field is null; half the options are refused.
+  EXPECT_TRUE(label_metrics(ref, img)["see_through_pixels"].is_null());
+  r = run_cli("compare " + ref + " " + img + " --labels --depth " + ref_depth + " " + depth);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("--see-through-gap"));
+  r = run_cli("generate --scene T1 -q -o " + ply + " --reference-depth " + ref_depth);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("give --reference R.png too"));
+  r = run_cli("render " + ply + " -q -o " + img + " --depth " + dir.file("d.tif"));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr(".png or .pfm"));
 }

@@ -76,7 +76,7 @@ TEST(UntrustedCli, MessagesSayWhatIsWrong) {
        "must be a positive number, found -1"},
       {"render " + a + " -o " + dir.file("x.jpg"), "render writes PNG images"},
       {"render " + a + " -o " + dir.file("x.png") + " --depth " + dir.file("d.tif"),
-       "--depth " + dir.file("d.tif") + ": render writes PNG images"},
+       "--depth " + dir.file("d.tif") + ": the depth image is a PNG"},
   };
   for (const Case& c : cases) {
     const auto r = run_cli(c.args);

@@ -2,6 +2,7 @@
 // two labels split by a straight boundary, and test images that move, blend, hole or overshoot it.
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -227,4 +228,63 @@ TEST(LabelMetrics, RejectsPaletteThatCannotBeToldApartAndSizeMismatch) {
   std::vector<Rgb8> small(32 * 32, kBlack);
   EXPECT_THROW(compare_labels(ref.view(), {32, 32, small}, {.palette = kPalette}), Error);
   EXPECT_THROW(compare_labels(ref.view(), ref.view(), {}), Error);  // no palette
+}
+
+namespace {
+
+// Depth images for the square: every covered pixel at depth 2, the background +inf.
+std::vector<float> flat_depth(const Image& img, float d = 2.0f) {
+  std::vector<float> out(img.pixels.size(), std::numeric_limits<float>::infinity());
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    if (!(img.pixels[i] == kBlack)) out[i] = d;
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST(LabelMetrics, SeeThroughCountsOtherSurfacesFartherThanTheGap) {
+  const Image ref = two_labels(32);
+  Image test = ref;
+  std::vector<float> test_depth = flat_depth(ref);
+  // 3×2 pixels of label 0 show label 1 from 0.5 behind: see-through at a gap of 0.1.
+  for (int y = 20; y < 22; ++y) {
+    for (int x = 12; x < 15; ++x) test.at(x, y) = kPalette[1], test_depth[y * kSize + x] = 2.5f;
+  }
+  // 4 pixels show label 1 only 0.05 behind (within the gap), 2 a blend far behind (MIXED
+  // counts), 5 are holes (background: HOLE, not see-through), and 1 shows the right label far
+  // behind (not another surface).
+  for (int x = 40; x < 44; ++x) test.at(x, 12) = kPalette[0], test_depth[12 * kSize + x] = 2.05f;
+  for (int x = 40; x < 42; ++x) {
+    test.at(x, 30) = blend(kPalette[0], kPalette[1], 0.5), test_depth[30 * kSize + x] = 4.0f;
+  }
+  for (int x = 20; x < 25; ++x) test.at(x, 40) = kBlack, test_depth[40 * kSize + x] = 9.0f;
+  test_depth[45 * kSize + 20] = 9.0f;
+  const std::vector<float> ref_depth = flat_depth(ref);
+  const LabelComparison c =
+      compare_labels(ref.view(), test.view(),
+                     {.palette = kPalette, .reference_depth = ref_depth, .test_depth = test_depth,
+                      .see_through_gap = 0.1f});
+  EXPECT_TRUE(c.depth_compared);
+  EXPECT_EQ(c.see_through_count, 6u + 2u);
+  EXPECT_EQ(c.hole_count, 5u);
+  // Without depth it is not measured.
+  const LabelComparison plain = compare(ref, test);
+  EXPECT_FALSE(plain.depth_compared);
+  EXPECT_EQ(plain.see_through_count, 0u);
+}
+
+TEST(LabelMetrics, DepthImagesMustComeInPairsOfTheImageSizeWithAGap) {
+  const Image ref = two_labels(32);
+  const std::vector<float> d = flat_depth(ref), short_d(10, 1.0f);
+  EXPECT_THROW(compare_labels(ref.view(), ref.view(),
+                              {.palette = kPalette, .reference_depth = d, .see_through_gap = 1}),
+               Error);
+  EXPECT_THROW(compare_labels(ref.view(), ref.view(),
+                              {.palette = kPalette, .reference_depth = d, .test_depth = short_d,
+                               .see_through_gap = 1}),
+               Error);
+  EXPECT_THROW(compare_labels(ref.view(), ref.view(),
+                              {.palette = kPalette, .reference_depth = d, .test_depth = d}),
+               Error);
 }

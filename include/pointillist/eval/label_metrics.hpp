@@ -54,9 +54,14 @@
 //       (0.1, 0.9), w the least-squares fit of the sample's colour c ≈ w·c_a + (1 − w)·c_b
 //       clamped to [0, 1] (mean and max over the measured profiles).
 //
-// Left out: the see-through part of HOLE (L ≠ L* and the test's depth behind the reference's by
-// more than 2 mean splat radii) needs depth, which colour images do not carry; normal error and
-// the weight of a second label (MIX's 2 % threshold) need the renderer's debug output. The
+//   SEE-THROUGH (with depth images of both, LabelCompareOptions::reference_depth/test_depth):
+//               interior pixels whose test label is neither L* nor background (another label,
+//               or MIXED) and whose test depth lies behind the reference depth by more than
+//               see_through_gap (the spec's 2 mean splat radii): the render shows a farther
+//               surface there. The spec counts them into HOLE; they are reported apart.
+//
+// Left out: normal error and the weight of a second label (MIX's 2 % threshold) need the
+// renderer's debug output. The
 // tolerance decides which blends show: one whose second colour carries weight w moves some
 // channel by w·d levels, d the largest channel difference of the two colours, so it is MIXED
 // when w·d > tolerance + 0.5.
@@ -89,6 +94,10 @@ struct LabelCompareOptions {
   int profile_length_px = 40;    // samples per profile (one a pixel)
   // Names the reference in error messages (e.g. its path).
   std::string reference_name = "the reference";
+  // SEE-THROUGH: depth along the view direction of every pixel of each image (row-major, +inf
+  // or NaN for none), both given or neither, and the depth gap that counts (> 0, scene units).
+  std::span<const float> reference_depth, test_depth;
+  float see_through_gap = 0;
 };
 
 // Codes of label_image: palette indices are 0 … palette.size() − 1.
@@ -118,6 +127,8 @@ struct LabelComparison {
   std::uint64_t unmatched_profile_count = 0;  // valid profiles whose test lacks a or b
   double displacement_mean_px = 0, displacement_max_px = 0;  // EDGE DISPLACEMENT |Δ|
   double transition_mean_px = 0, transition_max_px = 0;      // TRANSITION WIDTH
+  bool depth_compared = false;            // depth images were given
+  std::uint64_t see_through_count = 0;    // SEE-THROUGH (0 without depth)
 };
 
 // The label of every pixel of `image` (row-major): a palette index, kLabelBackground or
@@ -134,8 +145,9 @@ std::vector<std::uint8_t> reference_label_image(ImageRgb8View reference,
 
 // Every metric above for `test` against `reference` (same size). Throws Error when the sizes
 // differ or are empty, the options are out of range (palette, tolerance, band widths, profile
-// length), the palette colours are not told apart at this tolerance (naming the two entries), or
-// the reference holds a colour that is not background or a palette colour (naming the pixel).
+// length), the palette colours are not told apart at this tolerance (naming the two entries),
+// the reference holds a colour that is not background or a palette colour (naming the pixel), or
+// the depth images are given alone, at another size, or without a positive gap.
 LabelComparison compare_labels(ImageRgb8View reference, ImageRgb8View test,
                                const LabelCompareOptions& options);
 
