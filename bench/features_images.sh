@@ -17,8 +17,9 @@
 #   --keep DIR             keep the reference and test images (and the JSON) in DIR
 #   --tsv FILE             also write the rows tab-separated
 #
-# One row per (scene, sampling, view, variant): HOLE, OVERSHOOT, LER in B_4 and over the covered
-# pixels (%), MIX (interior mixed pixels, and mixed pixels in B_8 per reference boundary pixel),
+# One row per (scene, sampling, view, variant): HOLE, SEE (see-through: interior pixels showing
+# another face more than 2 mean splat radii behind the reference, from both depth images),
+# OVERSHOOT, LER in B_4 and over the covered pixels (%), MIX (interior mixed pixels, and mixed pixels in B_8 per reference boundary pixel),
 # edge displacement mean/max (px), transition width mean/max (px) ("-" when no profile has both
 # faces in the test; the note counts the profiles that lack one), whole-image PSNR (dB), the
 # render's wall time and its raster time from --stats (ms). A combination that fails prints its
@@ -92,9 +93,9 @@ now_ms() { echo $(( $(date +%s%N) / 1000000 )); }
 oneline() { tr '\n\t' '  ' <"$1" | sed 's/  */ /g; s/^ //; s/ $//' | cut -c1-160; }
 
 rows=$work/rows.tsv
-header="scene\tsamp\tview\tvariant\tHOLE\tOVERSHOOT\tLER_B4%\tLER_cov%\tMIX\tMIX/bpx\tdisp_mean\tdisp_max\ttw_mean\ttw_max\tPSNR\twall_ms\traster_ms\tnote"
+header="scene\tsamp\tview\tvariant\tHOLE\tSEE\tOVERSHOOT\tLER_B4%\tLER_cov%\tMIX\tMIX/bpx\tdisp_mean\tdisp_max\ttw_mean\ttw_max\tPSNR\twall_ms\traster_ms\tnote"
 printf '%b\n' "$header" >"$rows"
-blank="\t\t\t\t\t\t\t\t\t\t\t"  # the 11 metric columns, empty
+blank="\t\t\t\t\t\t\t\t\t\t\t\t"  # the 12 metric columns, empty
 total=0
 for scene in $scenes; do
   for mode in $modes; do
@@ -103,20 +104,24 @@ for scene in $scenes; do
       tag=${scene}_${mode}_${view}
       ply=$work/${scene}_${mode}.ply
       ref=$work/${tag}_ref.png
+      ref_depth=$work/${tag}_ref.pfm
       if ! "$bin" generate -q --scene "$scene" --sampling "$mode" -o "$ply" --reference "$ref" \
-          --size "${size}x${size}" "${cam[@]}" 2>"$work/err"; then
+          --reference-depth "$ref_depth" --size "${size}x${size}" "${cam[@]}" 2>"$work/err"; then
         printf '%s\t%s\t%s\t%s%b\t\t\tgenerate failed: %s\n' "$scene" "$mode" "$view" "-" "$blank" \
           "$(oneline "$work/err")" >>"$rows"
         continue
       fi
       [[ -z $keep ]] || cp "$ref" "$keep/"
+      # SEE-THROUGH's gap: 2 mean splat radii (spec §4.5), as info reports them for the samples.
+      gap=$("$bin" info "$ply" | awk '/^splat radii:/ { gsub(",", "", $4); print 2 * $4 }')
       for v in "${variants[@]}"; do
         IFS='|' read -r name rmode flags <<<"$v"
         read -r -a fl <<<"$flags"
         img=$work/${tag}_${name}.png
         t0=$(now_ms)
-        if ! "$bin" render -q "$ply" -o "$img" --size "${size}x${size}" "${cam[@]}" \
-            --mode "$rmode" --unlit "${fl[@]}" --stats "$work/stats.json" 2>"$work/err"; then
+        if ! "$bin" render -q "$ply" -o "$img" --depth "$work/test.pfm" --size "${size}x${size}" \
+            "${cam[@]}" --mode "$rmode" --unlit "${fl[@]}" --stats "$work/stats.json" \
+            2>"$work/err"; then
           printf '%s\t%s\t%s\t%s%b\t\t\trender failed: %s\n' "$scene" "$mode" "$view" "$name" "$blank" \
             "$(oneline "$work/err")" >>"$rows"
           continue
@@ -126,7 +131,8 @@ for scene in $scenes; do
         raster=$(jq -r '.ms.raster // empty' "$work/stats.json" 2>/dev/null || true)
         note=""
         [[ -s $work/err ]] && note="stderr: $(oneline "$work/err")"
-        if ! "$bin" compare "$ref" "$img" --labels --json "$work/cmp.json" >/dev/null 2>"$work/err"; then
+        if ! "$bin" compare "$ref" "$img" --labels --json "$work/cmp.json" --depth "$ref_depth" \
+            "$work/test.pfm" --see-through-gap "$gap" >/dev/null 2>"$work/err"; then
           printf '%s\t%s\t%s\t%s%b\t%s\t%s\tcompare failed: %s\n' "$scene" "$mode" "$view" "$name" \
             "$blank" "$wall" "$raster" "$(oneline "$work/err")" >>"$rows"
           continue
@@ -137,7 +143,7 @@ for scene in $scenes; do
           def n: if . == null then "-" else tostring end;
           .labels as $l |
           [$s, $m, $v, $n,
-           ($l.hole_pixels | n), ($l.overshoot_pixels | n),
+           ($l.hole_pixels | n), ($l.see_through_pixels | n), ($l.overshoot_pixels | n),
            ($l.ler_band | if . == null then null else . * 100 end | n),
            ($l.ler_covered | if . == null then null else . * 100 end | n),
            ($l.mixed_pixels | n), ($l.mixed_per_boundary_pixel | n),
@@ -159,9 +165,9 @@ awk -F'\t' -v OFS='\t' '
   NR > 1 {
     for (i = 5; i < NF; i++) {
       if ($i !~ /^-?[0-9.]+(e[-+]?[0-9]+)?$/) continue
-      if (i == 7 || i == 8 || i == 10) $i = sprintf("%.3f", $i)
-      else if (i == 11 || i == 13 || i == 15) $i = sprintf("%.2f", $i)
-      else if (i == 12 || i == 17) $i = sprintf("%.1f", $i)
+      if (i == 8 || i == 9 || i == 11) $i = sprintf("%.3f", $i)
+      else if (i == 12 || i == 14 || i == 16) $i = sprintf("%.2f", $i)
+      else if (i == 13 || i == 18) $i = sprintf("%.1f", $i)
     }
   }
   { print }' "$rows" >"$rows.fmt" && mv "$rows.fmt" "$rows"
