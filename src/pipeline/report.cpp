@@ -55,6 +55,7 @@ std::string render_report_json(const RenderReport& r) {
     j["clipped_splats"] = s.clipped_splats;
     j["clipped_fragments"] = s.clipped_fragments;
     j["other_surface_fragments"] = s.other_surface_fragments;
+    j["surface_switch_pixels"] = s.surface_switch_pixels;
   }
   j["width"] = s.width;
   j["height"] = s.height;

@@ -249,6 +249,38 @@ TEST(FeaturesRender, InterpenetratingSpheresShowNoMagenta) {
   }
 }
 
+TEST(FeaturesRender, SurfaceSwitchesAreWhereTheSpheresWouldBlend) {
+  // The pixels where the per-surface rule kept the other sphere out of the blend are the
+  // pixels that blend without features (a fragment of the other sphere within the front
+  // surface's depth window there too: the front surface's window is at least as wide as the
+  // window over all fragments); none on the smooth sphere, none without features.
+  ThreadPool pool(2);
+  const auto m = make_model("T9", pool);
+  Renderer renderer;
+  Frame frame;
+  const SceneInstance instance{&m->render, {}};
+  FrameSettings fs;
+  fs.rasterizer = Rasterizer::Quality;
+  for (const Camera& cam : {look({0.3f, 0.6f, 2.05f}, {0, 0, 0.8f}), look({1.2f, 1.5f, 3.4f}, {0, 0, 0})}) {
+    const LabelMetrics without = measure(*m, cam, render(*m, cam, pool, false));
+    renderer.render({&instance, 1}, cam, unlit(), fs, pool, frame);
+    const std::uint64_t switches = frame.stats.surface_switch_pixels;
+    std::cout << "surface switches " << switches << ", blended without features "
+              << without.mixed << "\n";
+    EXPECT_GE(double(switches), 0.95 * double(without.mixed));
+    EXPECT_LE(double(switches), 1.1 * double(without.mixed) + 20);
+    EXPECT_LE(switches, frame.stats.other_surface_fragments);
+  }
+  const auto sphere = make_model("T13", pool);
+  const SceneInstance one{&sphere->render, {}};
+  renderer.render({&one, 1}, look({0, 0, 3}, {0, 0, 0}), unlit(), fs, pool, frame);
+  EXPECT_EQ(frame.stats.surface_switch_pixels, 0u);
+  fs.features = false;
+  renderer.render({&instance, 1}, look({0.3f, 0.6f, 2.05f}, {0, 0, 0.8f}), unlit(), fs, pool,
+                  frame);
+  EXPECT_EQ(frame.stats.surface_switch_pixels, 0u);
+}
+
 TEST(FeaturesRender, CurvedCreasesAndThinPartsReport) {
   // A3 (curved rims: cylinder cap, plate with a hole), A5 (crossed cylinders: rims clipped,
   // crossing not), A6 (thin slab: front and back never blend): holes and blends against the

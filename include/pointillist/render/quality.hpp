@@ -117,8 +117,9 @@ struct QualityScratch {
   std::vector<std::vector<float>> chunk_planes;        // per chunk: clip planes, eye space
   std::vector<std::vector<float>> band_buffers;        // per-pixel accumulators, one per worker
   std::vector<std::vector<std::uint32_t>> band_tiles;  // sharp features: surfaces per column
-  // The last frame's counts (RenderStats::clipped_fragments, other_surface_fragments).
-  std::uint64_t clipped_fragments = 0, other_surface_fragments = 0;
+  // The last frame's counts (RenderStats::clipped_fragments, other_surface_fragments,
+  // surface_switch_pixels).
+  std::uint64_t clipped_fragments = 0, other_surface_fragments = 0, surface_switch_pixels = 0;
 };
 
 // Draws `stream` (selected for `camera`) into color and depth (width × height of the camera, rows

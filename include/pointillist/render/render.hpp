@@ -24,10 +24,13 @@ struct RenderStats {
   std::uint64_t culled_backface = 0;  // subtrees (or terminal nodes) skipped facing away
   // Sharp features (0 without them): splats drawn with clip planes; covered pixels their planes
   // discarded; and (quality mode) fragments left out of a pixel because another surface is in
-  // front there (the per-surface rule).
+  // front there (the per-surface rule), and the pixels where such a fragment lay within the
+  // front surface's depth window, so that it would have blended in without the rule (where
+  // the front surface switches between surfaces that touch or cross).
   std::uint64_t clipped_splats = 0;
   std::uint64_t clipped_fragments = 0;
   std::uint64_t other_surface_fragments = 0;
+  std::uint64_t surface_switch_pixels = 0;
   int width = 0, height = 0;
   unsigned threads = 1;
   double ms_select = 0, ms_raster = 0, ms_total = 0;  // wall clock (steady_clock)

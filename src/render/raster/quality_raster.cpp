@@ -194,16 +194,20 @@ void draw_splat(const float* s, const float* planes, const View& v, const Band& 
         std::memcpy(ids + kFrontId * kLanes, &id, sizeof id);
         continue;
       }
+      Int4 other{};  // accumulation with features: lanes whose front is another surface
       if constexpr (kFeat == kSameSurface) {
         Int4 id;
         std::memcpy(&id, band.ids_at(j, k) + kFrontId * kLanes, sizeof id);
         const std::int32_t mine = static_cast<std::int32_t>(float_to_bits(s[kSurface]));
         if (mine != kMixedId) {
           const Int4 same = (id == mine) | (id == kMixedId);
-          if constexpr (kAccumulate) *band.other_surface += render_detail::lane_count(cover & ~same);
+          if constexpr (kAccumulate) {
+            other = cover & ~same;
+            *band.other_surface += render_detail::lane_count(other);
+          }
           cover &= same;
         }
-        if (!any4(cover)) continue;
+        if (!any4(cover) && !any4(other)) continue;
       }
       float* acc = band.acc_at(j, k);
       float* layer = kPeel || kNext ? band.layer_at(j, k) : nullptr;
@@ -222,6 +226,17 @@ void draw_splat(const float* s, const float* planes, const View& v, const Band& 
       if constexpr (!kAccumulate) {
         store4(acc + kSumBound * kLanes, select4(cover & (bound < old_b), bound, old_b));
         continue;
+      }
+      if constexpr (kFeat == kSameSurface) {
+        // A fragment of another surface within the front surface's depth window: without the
+        // per-surface rule it would have blended in. Such pixels are marked (front depth −∞,
+        // no longer needed after the front pass) and counted after the band's accumulation.
+        const Int4 stopped = other & (key <= old_b);
+        if (any4(stopped)) {
+          float* front = band.ids_at(j, k) + kFrontDepth * kLanes;
+          store4(front, select4(stopped, splat4(-kInf), load4(front)));
+        }
+        if (!any4(cover)) continue;
       }
       if constexpr (kNext) {
         const Int4 behind = cover & (key > old_b);
@@ -440,6 +455,18 @@ void clear_planes(const Band& band, bool layered, bool ids) {
   }
 }
 
+// Pixels of the band where the per-surface rule kept another surface out of the blend (marked
+// by the accumulation pass: front depth −∞).
+std::uint64_t count_switches(const Band& band) {
+  const std::size_t groups = static_cast<std::size_t>(band.row1 - band.row0) * band.groups;
+  std::uint64_t count = 0;
+  for (std::size_t g = 0; g < groups; ++g) {
+    const float* front = band.ids + g * kIdFloats + kFrontDepth * kLanes;
+    for (int l = 0; l < kLanes; ++l) count += front[l] == -kInf;
+  }
+  return count;
+}
+
 // Moves on to the next surface: lower = B, B = next, next = +inf, sums = 0.
 void next_surface(const Band& band) {
   const std::size_t groups = static_cast<std::size_t>(band.row1 - band.row0) * band.groups;
@@ -507,10 +534,10 @@ void rasterize(const SplatStream& stream, const std::span<const StreamPiece>* pi
   }
   const std::size_t band_count = static_cast<std::size_t>(setup.band_count);
   std::atomic<std::size_t> next_band{0};
-  std::atomic<std::uint64_t> clipped{0}, other_surface{0};
+  std::atomic<std::uint64_t> clipped{0}, other_surface{0}, switches{0};
   pool.run(workers, [&](std::size_t worker) {
     float* buffer = scratch.band_buffers[worker].data();
-    std::uint64_t clipped_here = 0, other_here = 0;
+    std::uint64_t clipped_here = 0, other_here = 0, switch_here = 0;
     for (std::size_t b = next_band++; b < band_count; b = next_band++) {
       const int row0 = static_cast<int>(b) * setup.band_rows;
       const Band band{row0,
@@ -532,6 +559,7 @@ void rasterize(const SplatStream& stream, const std::span<const StreamPiece>* pi
                   pick<false, false, false, kSameSurface>(z_range));
         band_pass(stream_order, scratch, b, band_count, v, band,
                   pick<true, false, false, kSameSurface>(z_range));
+        switch_here += count_switches(band);
         band_shader.shade<false>(band, out, true);
         continue;
       }
@@ -564,9 +592,11 @@ void rasterize(const SplatStream& stream, const std::span<const StreamPiece>* pi
     }
     clipped += clipped_here;
     other_surface += other_here;
+    switches += switch_here;
   });
   scratch.clipped_fragments = clipped;
   scratch.other_surface_fragments = other_surface;
+  scratch.surface_switch_pixels = switches;
 }
 
 }  // namespace
