@@ -133,8 +133,7 @@ void check_options(const GenerateOptions& o) {
       throw OptionError("--reference-depth writes the depth of the --reference image; give "
                         "--reference R.png too");
     }
-    std::string ext = std::filesystem::path(o.reference_depth_output).extension().string();
-    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    const std::string ext = lowercase_extension(o.reference_depth_output);
     if (ext != ".pfm") {
       throw OptionError("--reference-depth " + o.reference_depth_output +
                         ": the depth image is a PFM (float depth in scene units); give a path "
@@ -150,8 +149,7 @@ void check_options(const GenerateOptions& o) {
     throw OptionError("--reference writes the exact label image of a sharp-features test scene; "
                       "give --scene T1 (or another T*), not '" + o.scene + "'");
   }
-  std::string ext = std::filesystem::path(o.reference_output).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const std::string ext = lowercase_extension(o.reference_output);
   if (ext != ".png") {
     throw OptionError("--reference " + o.reference_output +
                       ": the reference is a PNG image; give a path ending in .png");

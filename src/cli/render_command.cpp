@@ -98,8 +98,7 @@ void check_options(const RenderOptions& o) {
                          {"--stats", o.stats_output}});
   for (const auto& [option, path] : {std::pair<const char*, const std::string&>{"-o", o.output},
                                      {"--depth", o.depth_output}}) {
-    std::string ext = std::filesystem::path(path).extension().string();
-    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    const std::string ext = lowercase_extension(path);
     const bool depth_pfm = std::string(option) == "--depth" && ext == ".pfm";
     if (!path.empty() && ext != ".png" && !depth_pfm) {
       throw OptionError(std::string(option) + " " + path +
@@ -209,8 +208,7 @@ int run_render(const RenderOptions& o) {
   }
   write_png_rgb8(o.output, frame.width, frame.height, frame.color);
   if (!o.depth_output.empty()) {
-    std::string ext = std::filesystem::path(o.depth_output).extension().string();
-    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    const std::string ext = lowercase_extension(o.depth_output);
     if (ext == ".pfm") {
       write_pfm(o.depth_output, frame.width, frame.height, frame.depth);
     } else {

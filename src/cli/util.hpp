@@ -11,6 +11,9 @@ namespace pointillist::cli {
 // "1.23 MB"-style size.
 std::string human_bytes(double bytes);
 
+// The extension of `path` (".png", with the dot) in lower case; empty without one.
+std::string lowercase_extension(const std::string& path);
+
 // The inputs for a summary line or a window title: the first three (file names only with
 // `file_names`), then "and N more".
 std::string input_names(std::span<const std::string> inputs, bool file_names = false);
