@@ -127,20 +127,36 @@ ClipMode combine_pairs(const Disc& s, const std::vector<ClipPlane>& planes,
                        const std::vector<Vec3f>& centres, std::span<const Vec3f> continuous) {
   if (planes.size() == 1) return ClipMode::Union;
   const float tol = kClassifyTolerance * s.r;
-  bool convex = false, reflex = false;
+  bool convex = false, reflex = false, near_convex = false, near_reflex = false;
   std::vector<Vec3f> line(planes.size());
   for (std::size_t a = 0; a < planes.size(); ++a) line[a] = normalized(cross(planes[a].n, s.n));
   for (std::size_t b = 0; b < planes.size(); ++b) {
     const Vec3f x = centres[b] - s.n * dot(centres[b] - s.c, s.n);
+    // The point of b's line (in the splat's plane) nearest to b's centre: on the crease.
+    const Vec3f nb = planes[b].n - s.n * dot(planes[b].n, s.n);
+    const Vec3f foot = x - nb * (side_near(planes[b], x, s.c) / std::max(dot(nb, nb), 1e-12f));
     for (std::size_t a = 0; a < planes.size(); ++a) {
+      if (a == b) continue;
       // Lines within 5° in the splat's plane are one crease (a quantized model's normals differ
       // by a degree or two): union and intersection of the two keep the same region but for a
-      // sliver, and their pair says nothing about the corner.
-      if (a == b || length(cross(line[a], line[b])) < kSameCreaseSin) continue;
+      // sliver, and their pair says little about a corner. They only decide when no pair of
+      // lines further apart does, by where b's line touches the crease: along a curved rim
+      // every partner's line is within a few degrees of the next, and at a hole's rim (the
+      // face's region bends away from each tangent line) the union of the cuts took a sliver of
+      // the face between the lines' crossings, a dashed 1-px gap along the rim.
+      if (length(cross(line[a], line[b])) < kSameCreaseSin) {
+        const float side = side_near(planes[a], foot, s.c);
+        near_convex |= side > tol;
+        near_reflex |= side < -tol;
+        continue;
+      }
       const float side = side_near(planes[a], x, s.c);
       convex |= side > tol;
       reflex |= side < -tol;
     }
+  }
+  if (!convex && !reflex) {
+    return near_reflex && !near_convex ? ClipMode::Intersection : ClipMode::Union;
   }
   if (convex && reflex) {
     // A mixed corner by the partners' centres (the step's riser at the corner where it meets

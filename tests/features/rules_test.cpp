@@ -352,3 +352,49 @@ TEST(ClassifyPartners, CurvatureDoesNotMoveConvexPartners) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(ClassifyPartners, NearlyParallelTangentsOfAHoleRimKeepTheFace) {
+  // The wall's tangent planes 4° apart (lines within 5°: one crease by the pair rule), as
+  // neighbouring partners along a hole's rim are: the face outside the circle must be kept
+  // wherever it is (intersection of the cuts); their union took a sliver between the lines.
+  Config c = hole_rim();
+  c.partners.clear();
+  for (float deg : {0.0f, 4.0f}) {
+    const float a = deg_to_rad(deg);
+    c.partners.push_back({{0.5f * std::cos(a), 0.17f, 0.5f * std::sin(a)},
+                          {-std::cos(a), 0, -std::sin(a)}, kR});
+  }
+  const ClipResult clip = classify(c, ClipRule::Classified);
+  ASSERT_EQ(clip.planes.size(), 2u);
+  EXPECT_EQ(clip.mode, ClipMode::Intersection);
+  // Between the two tangent points (azimuth 0° to 4°) the face outside the circle is kept but
+  // for the corner of the two lines (at most R(1/cos 2° − 1) = 0.0003 past the circle); the
+  // union of the cuts lost a sliver up to where the other line runs.
+  const TangentFrame f = tangent_frame(c.s.n);
+  int lost = 0, lost_by_union = 0;
+  for (int i = -200; i <= 200; ++i) {
+    for (int j = -200; j <= 200; ++j) {
+      const Vec3f p = c.s.c + f.u * (i * kR / 200) + f.v * (j * kR / 200);
+      const float azimuth = std::atan2(p.z, p.x);
+      if (length(p - c.s.c) > kR || c.boundary(p) < 4e-4f || azimuth < 0 ||
+          azimuth > deg_to_rad(4.0f)) {
+        continue;
+      }
+      lost += clip_discards(clip.planes, clip.mode, p);
+      lost_by_union += clip_discards(clip.planes, ClipMode::Union, p);
+    }
+  }
+  EXPECT_EQ(lost, 0);
+  EXPECT_GT(lost_by_union, 10);
+  // A cylinder cap's rim (convex: the face inside the circle) with the same two lines keeps
+  // the union of the cuts.
+  Config cap = c;
+  for (Disc& p : cap.partners) p.n = p.n * -1.0f;
+  cap.s.c = {0.45f, 0.2f, 0};
+  cap.kept = [](Vec3f p) { return p.x * p.x + p.z * p.z <= 0.25f; };
+  EXPECT_EQ(classify(cap, ClipRule::Classified).mode, ClipMode::Union);
+}
+
+}  // namespace
