@@ -1,13 +1,14 @@
 // The bounding-sphere graph over a uniform grid.
 //
-// Each splat i looks for the neighbours j it "owns": r_j < r_i, or r_j = r_i and j < i. Such a
-// neighbour lies within r_i + r_j <= 2·r_i, so the search box is ±2·r_i whatever the largest
-// radius of the set, and every edge is found exactly once, by its larger splat. The rows are
-// then filled from both ends of every edge (in parallel, in any order) and sorted, which makes
-// the result independent of the thread count.
+// Every splat of ordinary size finds all its neighbours of ordinary size itself (a search box of
+// ±(r_i + r_cut), r_cut = 2 median radii or the largest radius if smaller) and writes its own
+// row, sorted: no edge crosses between threads, so the rows need no merging and do not depend
+// on the thread count. The few oversized splats (r > r_cut: isolated points of a scan) search
+// ±(r_i + r_max) for all their neighbours, and their edges to ordinary splats are then merged
+// into those splats' rows, so that one huge splat does not widen everybody's search.
 #include <algorithm>
-#include <atomic>
 #include <cmath>
+#include <utility>
 
 #include "pointillist/features/neighbour_graph.hpp"
 
@@ -19,10 +20,6 @@ namespace {
 inline bool spheres_overlap(Vec3f ci, float ri, Vec3f cj, float rj) {
   const float reach = ri + rj;
   return length_squared(ci - cj) < reach * reach;
-}
-
-inline bool owns(float ri, std::uint32_t i, float rj, std::uint32_t j) {
-  return rj < ri || (rj == ri && j < i);
 }
 
 struct Grid {
@@ -80,41 +77,34 @@ Grid make_grid(std::span<const Vec3f> centers, std::span<const float> radii) {
   return g;
 }
 
-// CSR from the owned edges of every block: degrees, offsets, rows filled from both ends, rows
-// sorted.
-NeighbourGraph assemble(std::size_t n, const std::vector<std::vector<std::uint32_t>>& blocks,
-                        ThreadPool& pool) {
-  std::vector<std::atomic<std::uint32_t>> degree(n);
-  pool.run(blocks.size(), [&](std::size_t b) {
-    const std::vector<std::uint32_t>& e = blocks[b];
-    for (std::size_t k = 0; k < e.size(); k += 2) {
-      degree[e[k]].fetch_add(1, std::memory_order_relaxed);
-      degree[e[k + 1]].fetch_add(1, std::memory_order_relaxed);
+// Adds each oversized splat (radius > r_cut) to the rows of its ordinary neighbours: its own
+// row is complete, theirs did not look that far. Rows stay sorted.
+void merge_oversized(NeighbourGraph& graph, std::span<const float> radii, float r_cut) {
+  const std::size_t n = graph.vertex_count();
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> extra;  // (ordinary row, oversized)
+  for (std::size_t b = 0; b < n; ++b) {
+    if (radii[b] <= r_cut) continue;
+    for (std::uint32_t s : graph.row(b)) {
+      if (radii[s] <= r_cut) extra.emplace_back(s, static_cast<std::uint32_t>(b));
     }
-  });
-  NeighbourGraph graph;
-  graph.offsets.resize(n + 1);
-  graph.offsets[0] = 0;
-  for (std::size_t i = 0; i < n; ++i) graph.offsets[i + 1] = graph.offsets[i] + degree[i].load();
-  graph.neighbours.resize(graph.offsets[n]);
-  for (std::size_t i = 0; i < n; ++i) degree[i].store(0, std::memory_order_relaxed);
-  pool.run(blocks.size(), [&](std::size_t b) {
-    const std::vector<std::uint32_t>& e = blocks[b];
-    for (std::size_t k = 0; k < e.size(); k += 2) {
-      const std::uint32_t i = e[k], j = e[k + 1];
-      graph.neighbours[graph.offsets[i] + degree[i].fetch_add(1, std::memory_order_relaxed)] = j;
-      graph.neighbours[graph.offsets[j] + degree[j].fetch_add(1, std::memory_order_relaxed)] = i;
-    }
-  });
-  constexpr std::size_t kRowsPerTask = 4096;
-  pool.run((n + kRowsPerTask - 1) / kRowsPerTask, [&](std::size_t t) {
-    const std::size_t end = std::min(n, (t + 1) * kRowsPerTask);
-    for (std::size_t i = t * kRowsPerTask; i < end; ++i) {
-      std::sort(graph.neighbours.begin() + static_cast<std::ptrdiff_t>(graph.offsets[i]),
-                graph.neighbours.begin() + static_cast<std::ptrdiff_t>(graph.offsets[i + 1]));
-    }
-  });
-  return graph;
+  }
+  if (extra.empty()) return;
+  std::sort(extra.begin(), extra.end());
+  NeighbourGraph merged;
+  merged.offsets.assign(n + 1, 0);
+  merged.neighbours.reserve(graph.neighbours.size() + extra.size());
+  std::size_t e = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto row = graph.row(i);
+    const std::size_t begin = merged.neighbours.size();
+    merged.neighbours.insert(merged.neighbours.end(), row.begin(), row.end());
+    for (; e < extra.size() && extra[e].first == i; ++e) merged.neighbours.push_back(extra[e].second);
+    std::inplace_merge(merged.neighbours.begin() + static_cast<std::ptrdiff_t>(begin),
+                       merged.neighbours.begin() + static_cast<std::ptrdiff_t>(begin + row.size()),
+                       merged.neighbours.end());
+    merged.offsets[i + 1] = merged.neighbours.size();
+  }
+  graph = std::move(merged);
 }
 
 }  // namespace
@@ -132,45 +122,59 @@ NeighbourGraph build_neighbour_graph(std::span<const Vec3f> centers, std::span<c
     cell_centers[k] = centers[grid.order[k]];
     cell_radii[k] = radii[grid.order[k]];
   }
-  // Splats in cell order, so that neighbouring queries read neighbouring memory.
+  const float r_max = *std::max_element(radii.begin(), radii.end());
+  std::vector<float> sorted(radii.begin(), radii.end());
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const float r_cut = std::min(r_max, 2.0f * sorted[sorted.size() / 2]);
+  // Blocks of splats in index order, each block's rows in one array, then concatenated.
   constexpr std::size_t kBlock = 2048;
-  std::vector<std::vector<std::uint32_t>> blocks((n + kBlock - 1) / kBlock);
-  pool.run(blocks.size(), [&](std::size_t b) {
-    std::vector<std::uint32_t>& edges = blocks[b];
+  const std::size_t block_count = (n + kBlock - 1) / kBlock;
+  std::vector<std::vector<std::uint32_t>> rows(block_count);
+  NeighbourGraph graph;
+  graph.offsets.assign(n + 1, 0);
+  pool.run(block_count, [&](std::size_t b) {
+    std::vector<std::uint32_t>& out = rows[b];
     const std::size_t end = std::min(n, (b + 1) * kBlock);
-    for (std::size_t s = b * kBlock; s < end; ++s) {
-      const std::uint32_t i = grid.order[s];
+    for (std::size_t i = b * kBlock; i < end; ++i) {
       const Vec3f ci = centers[i];
       const float ri = radii[i];
-      // 2·r_i, widened so that rounding in the box and cell arithmetic never drops a neighbour
-      // the exact test accepts.
-      const float reach = 2.0f * ri * 1.0001f;
+      const bool oversized = ri > r_cut;
+      // Widened so that rounding in the box and cell arithmetic never drops a neighbour the
+      // exact test accepts.
+      const float reach = (ri + (oversized ? r_max : r_cut)) * 1.0001f;
       int lo[3], hi[3];
       for (int a = 0; a < 3; ++a) {
         lo[a] = grid.clamp_axis(ci[a] - reach, a);
         hi[a] = grid.clamp_axis(ci[a] + reach, a);
       }
+      const std::size_t first_entry = out.size();
       for (int z = lo[2]; z <= hi[2]; ++z) {
         for (int y = lo[1]; y <= hi[1]; ++y) {
           const std::size_t row = (static_cast<std::size_t>(z) * grid.dims[1] + y) * grid.dims[0];
           const std::uint32_t first = grid.cell_start[row + lo[0]];
           const std::uint32_t last = grid.cell_start[row + hi[0] + 1];
           for (std::uint32_t k = first; k < last; ++k) {
-            const float rj = cell_radii[k];
-            if (rj <= ri && spheres_overlap(ci, ri, cell_centers[k], rj)) {
-              const std::uint32_t j = grid.order[k];
-              if (owns(ri, i, rj, j)) {
-                edges.push_back(i);
-                edges.push_back(j);
-              }
+            const float rk = cell_radii[k];
+            if ((oversized || rk <= r_cut) && spheres_overlap(ci, ri, cell_centers[k], rk) &&
+                grid.order[k] != i) {
+              out.push_back(grid.order[k]);
             }
           }
         }
       }
+      std::sort(out.begin() + static_cast<std::ptrdiff_t>(first_entry), out.end());
+      graph.offsets[i + 1] = out.size() - first_entry;
     }
     progress.advance(end - b * kBlock);
   });
-  return assemble(n, blocks, pool);
+  for (std::size_t i = 0; i < n; ++i) graph.offsets[i + 1] += graph.offsets[i];
+  graph.neighbours.resize(graph.offsets[n]);
+  pool.run(block_count, [&](std::size_t b) {
+    std::copy(rows[b].begin(), rows[b].end(),
+              graph.neighbours.begin() + static_cast<std::ptrdiff_t>(graph.offsets[b * kBlock]));
+  });
+  if (r_cut < r_max) merge_oversized(graph, radii, r_cut);
+  return graph;
 }
 
 NeighbourGraph build_neighbour_graph_brute_force(std::span<const Vec3f> centers,
