@@ -30,9 +30,10 @@ struct NeighbourGraph {
 
 // The graph of eq. 3.1 with `radii` the radii the renderer draws: edge (i, j) iff
 // |c_i − c_j| < r_i + r_j (strict). Built over a uniform grid of cells about two typical radii
-// wide; each splat searches only for neighbours not larger than itself (ties by index), so a few
-// oversized splats do not slow every query. Parallel over blocks of splats; the result does not
-// depend on the thread count. Positions and radii must be finite, radii >= 0. Memory: the graph
+// wide; each splat of ordinary size (at most 2 median radii) searches for its ordinary
+// neighbours and writes its own row, and the few oversized splats search farther and are merged
+// into their neighbours' rows after, so they do not slow every query. Parallel over blocks of
+// splats; the result does not depend on the thread count. Positions and radii must be finite, radii >= 0. Memory: the graph
 // (12 bytes an edge) plus about 16 bytes a splat.
 NeighbourGraph build_neighbour_graph(std::span<const Vec3f> centers, std::span<const float> radii,
                                      ThreadPool& pool, Progress& progress = Progress::none());
