@@ -21,7 +21,8 @@
 # another face more than 2 mean splat radii behind the reference, from both depth images),
 # OVERSHOOT, LER in B_4 and over the covered pixels (%), MIX (interior mixed pixels, and mixed pixels in B_8 per reference boundary pixel),
 # edge displacement mean/max (px), transition width mean/max (px) ("-" when no profile has both
-# faces in the test; the note counts the profiles that lack one), whole-image PSNR (dB), the
+# faces in the test; the note counts the profiles that lack one), whole-image PSNR and PSNR in
+# B_8 (dB; "inf" also when the band is empty), the
 # render's wall time and its raster time from --stats (ms). A combination that fails prints its
 # error in the row's note and the run goes on. Needs jq, awk and coreutils only.
 set -euo pipefail
@@ -93,9 +94,9 @@ now_ms() { echo $(( $(date +%s%N) / 1000000 )); }
 oneline() { tr '\n\t' '  ' <"$1" | sed 's/  */ /g; s/^ //; s/ $//' | cut -c1-160; }
 
 rows=$work/rows.tsv
-header="scene\tsamp\tview\tvariant\tHOLE\tSEE\tOVERSHOOT\tLER_B4%\tLER_cov%\tMIX\tMIX/bpx\tdisp_mean\tdisp_max\ttw_mean\ttw_max\tPSNR\twall_ms\traster_ms\tnote"
+header="scene\tsamp\tview\tvariant\tHOLE\tSEE\tOVERSHOOT\tLER_B4%\tLER_cov%\tMIX\tMIX/bpx\tdisp_mean\tdisp_max\ttw_mean\ttw_max\tPSNR\tPSNR_B8\twall_ms\traster_ms\tnote"
 printf '%b\n' "$header" >"$rows"
-blank="\t\t\t\t\t\t\t\t\t\t\t\t"  # the 12 metric columns, empty
+blank="\t\t\t\t\t\t\t\t\t\t\t\t\t"  # the 13 metric columns, empty
 total=0
 for scene in $scenes; do
   for mode in $modes; do
@@ -151,6 +152,7 @@ for scene in $scenes; do
              ($l.edge_displacement_mean_px | n), ($l.edge_displacement_max_px | n),
              ($l.transition_width_mean_px | n), ($l.transition_width_max_px | n) end),
            (if .psnr_db == null then "inf" else (.psnr_db | n) end),
+           (if $l.psnr_band_db == null then "inf" else ($l.psnr_band_db | n) end),
            $wall, $raster,
            ([(if ($l.unmatched_profiles // 0) > 0 then "\($l.unmatched_profiles) of \($l.profiles + $l.unmatched_profiles) profiles lack a face in the test" else empty end),
              (if $note != "" then $note else empty end)] | join("; "))
@@ -166,8 +168,8 @@ awk -F'\t' -v OFS='\t' '
     for (i = 5; i < NF; i++) {
       if ($i !~ /^-?[0-9.]+(e[-+]?[0-9]+)?$/) continue
       if (i == 8 || i == 9 || i == 11) $i = sprintf("%.3f", $i)
-      else if (i == 12 || i == 14 || i == 16) $i = sprintf("%.2f", $i)
-      else if (i == 13 || i == 18) $i = sprintf("%.1f", $i)
+      else if (i == 12 || i == 14 || i == 16 || i == 17) $i = sprintf("%.2f", $i)
+      else if (i == 13 || i == 19) $i = sprintf("%.1f", $i)
     }
   }
   { print }' "$rows" >"$rows.fmt" && mv "$rows.fmt" "$rows"

@@ -51,7 +51,8 @@ std::string labels_to_json(const LabelComparison& l, int tolerance) {
                 "    \"edge_displacement_max_px\": %.6f,\n"
                 "    \"transition_width_mean_px\": %.6f,\n"
                 "    \"transition_width_max_px\": %.6f,\n"
-                "    \"see_through_pixels\": %s\n"
+                "    \"see_through_pixels\": %s,\n"
+                "    \"psnr_band_db\": %s\n"
                 "  }",
                 tolerance, ull(l.covered_count), ull(l.interior_count), ull(l.boundary_count),
                 ull(l.hole_count), ull(l.far_background_count), ull(l.overshoot_count),
@@ -61,7 +62,8 @@ std::string labels_to_json(const LabelComparison& l, int tolerance) {
                 l.mixed_per_boundary_px, ull(l.mixed_outside_count), ull(l.profile_count),
                 ull(l.unmatched_profile_count), l.displacement_mean_px, l.displacement_max_px,
                 l.transition_mean_px, l.transition_max_px,
-                l.depth_compared ? std::to_string(l.see_through_count).c_str() : "null");
+                l.depth_compared ? std::to_string(l.see_through_count).c_str() : "null",
+                std::isfinite(l.psnr_band_db) ? std::to_string(l.psnr_band_db).c_str() : "null");
   return buf;
 }
 
@@ -126,6 +128,13 @@ void print_labels(const LabelComparison& l, int tolerance) {
               ull(l.unmatched_profile_count));
   std::printf("  transition width:  mean %.2f px, max %.0f px\n", l.transition_mean_px,
               l.transition_max_px);
+  if (std::isnan(l.psnr_band_db)) {
+    std::printf("  PSNR in B_8:  - (no label boundary)\n");
+  } else if (std::isinf(l.psnr_band_db)) {
+    std::printf("  PSNR in B_8:  inf dB (identical there)\n");
+  } else {
+    std::printf("  PSNR in B_8:  %.2f dB\n", l.psnr_band_db);
+  }
 }
 
 void print_text(const CompareOptions& o, const ImageComparison& c, int width, int height) {

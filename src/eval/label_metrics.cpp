@@ -6,6 +6,7 @@
 #include <cassert>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <string>
 #include <utility>
 
@@ -309,6 +310,8 @@ LabelComparison compare_labels(ImageRgb8View reference, ImageRgb8View test,
   const Mask near_covered = dilate(g.covered, w, h, 1);
   const Mask band = dilate(g.boundary, w, h, o.band_px);
   const Mask mix_band = dilate(g.boundary, w, h, o.mix_band_px);
+  double band_squared = 0;
+  std::uint64_t band_pixels = 0;
   for (std::size_t i = 0; i < ref.size(); ++i) {
     const bool mixed = got[i] == kLabelMixed;
     if (!g.covered[i]) {
@@ -323,6 +326,12 @@ LabelComparison compare_labels(ImageRgb8View reference, ImageRgb8View test,
     }
     const bool error = got[i] != ref[i];
     ++out.covered_count;
+    if (mix_band[i]) {
+      const Rgb8 a = reference.pixels[i], b = test.pixels[i];
+      const auto sq = [](int x) { return static_cast<double>(x * x); };
+      band_squared += sq(a.r - b.r) + sq(a.g - b.g) + sq(a.b - b.b);
+      ++band_pixels;
+    }
     out.covered_error_count += error;
     out.wrong_count += error && got[i] < kLabelBackground;
     out.boundary_count += g.boundary[i];
@@ -342,6 +351,11 @@ LabelComparison compare_labels(ImageRgb8View reference, ImageRgb8View test,
   }
   assert(out.interior_count == holes.interior_count);
   out.ler_band = ratio(out.band_error_count, out.band_count);
+  if (band_pixels > 0) {
+    const double mse = band_squared / (3.0 * static_cast<double>(band_pixels));
+    out.psnr_band_db = mse == 0 ? std::numeric_limits<double>::infinity()
+                                : 10.0 * std::log10(255.0 * 255.0 / mse);
+  }
   out.ler_covered = ratio(out.covered_error_count, out.covered_count);
   out.mixed_per_boundary_px = ratio(out.mixed_band_count, out.boundary_count);
   measure_profiles(ref, got, g, test, o, out);

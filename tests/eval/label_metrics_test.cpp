@@ -2,6 +2,7 @@
 // two labels split by a straight boundary, and test images that move, blend, hole or overshoot it.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <limits>
 #include <string>
 #include <vector>
@@ -287,4 +288,17 @@ TEST(LabelMetrics, DepthImagesMustComeInPairsOfTheImageSizeWithAGap) {
   EXPECT_THROW(compare_labels(ref.view(), ref.view(),
                               {.palette = kPalette, .reference_depth = d, .test_depth = d}),
                Error);
+}
+
+TEST(LabelMetrics, PsnrInsideTheEightPixelBand) {
+  const Image ref = two_labels(32);
+  Image test = ref;
+  test.at(30, 20) = {200, 25, 75};  // label 0 is (230, 25, 75): one channel 30 levels off
+  test.at(10, 20) = {0, 0, 0};      // outside B_8 (columns 23..40): does not count
+  // B_8: boundary columns 31 and 32 widened by 8, columns 23..40, 48 rows.
+  const double mse = 30.0 * 30.0 / (3.0 * 18 * 48);
+  EXPECT_NEAR(compare(ref, test).psnr_band_db, 10 * std::log10(255.0 * 255.0 / mse), 1e-9);
+  EXPECT_TRUE(std::isinf(compare(ref, ref).psnr_band_db));
+  const Image one = two_labels(kHi);  // a single label: no boundary
+  EXPECT_TRUE(std::isnan(compare(one, one).psnr_band_db));
 }

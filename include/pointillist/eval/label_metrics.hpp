@@ -54,6 +54,7 @@
 //       (0.1, 0.9), w the least-squares fit of the sample's colour c ≈ w·c_a + (1 − w)·c_b
 //       clamped to [0, 1] (mean and max over the measured profiles).
 //
+//   PSNR(B_8)   the PSNR of the colours (R, G, B) over the covered pixels of B_8.
 //   SEE-THROUGH (with depth images of both, LabelCompareOptions::reference_depth/test_depth):
 //               interior pixels whose test label is neither L* nor background (another label,
 //               or MIXED) and whose test depth lies behind the reference depth by more than
@@ -68,6 +69,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <span>
 #include <string>
@@ -127,6 +129,9 @@ struct LabelComparison {
   std::uint64_t unmatched_profile_count = 0;  // valid profiles whose test lacks a or b
   double displacement_mean_px = 0, displacement_max_px = 0;  // EDGE DISPLACEMENT |Δ|
   double transition_mean_px = 0, transition_max_px = 0;      // TRANSITION WIDTH
+  // PSNR inside B_8 (the MSE of R, G, B over covered pixels within mix_band_px of a boundary;
+  // +inf when equal there, NaN when there is no boundary).
+  double psnr_band_db = std::numeric_limits<double>::quiet_NaN();
   bool depth_compared = false;            // depth images were given
   std::uint64_t see_through_count = 0;    // SEE-THROUGH (0 without depth)
 };
