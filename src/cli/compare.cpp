@@ -180,16 +180,9 @@ int run_compare(const CompareOptions& o) {
   if (o.labels) {
     ImageFloat ref_depth, test_depth;
     if (!o.depth_images.empty()) {
-      ref_depth = read_pfm(o.depth_images[0]);
-      test_depth = read_pfm(o.depth_images[1]);
-      for (const auto* d : {&ref_depth, &test_depth}) {
-        if (d->width != reference.width || d->height != reference.height) {
-          throw Error(o.depth_images[d == &ref_depth ? 0 : 1] + " is " + std::to_string(d->width) +
-                      "x" + std::to_string(d->height) + " but the images are " +
-                      std::to_string(reference.width) + "x" + std::to_string(reference.height) +
-                      "; give the depth images written with them");
-        }
-      }
+      // The colour images' size, checked before the depth images' bodies are read.
+      ref_depth = read_pfm(o.depth_images[0], reference.width, reference.height);
+      test_depth = read_pfm(o.depth_images[1], reference.width, reference.height);
     }
     labels = compare_labels(ref_view, test_view,
                             {.palette = kLabelPalette,

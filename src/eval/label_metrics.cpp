@@ -343,7 +343,7 @@ LabelComparison compare_labels(ImageRgb8View reference, ImageRgb8View test,
     ++out.interior_count;
     out.mixed_count += mixed;
     if (out.depth_compared && error && got[i] != kLabelBackground) {
-      // NaN or +inf (nothing drawn) compares false: not a farther surface.
+      // Nothing drawn (+inf) or NaN is no farther surface: only finite test depths count.
       out.see_through_count += o.test_depth[i] > o.reference_depth[i] + o.see_through_gap &&
                                std::isfinite(o.test_depth[i]);
     }

@@ -59,7 +59,6 @@ bool keep_positive_side(const Disc& s, const Disc& partner, std::span<const Vec3
 // sag ½ wᵀ S w of that surface toward the clipped side at the two ends of s's chord on the
 // line where the planes meet (w: the end's offset from the partner's centre in its tangent
 // plane). 0 where the surface curves toward the kept side, or is flat.
-int concavity(const Disc& s, const Disc& partner);
 float sag_shift(const Disc& s, const Disc& partner, bool keep_positive) {
   const Shape& k = partner.shape;
   if (k.xx == 0 && k.xy == 0 && k.yy == 0) return 0;
@@ -80,7 +79,8 @@ float sag_shift(const Disc& s, const Disc& partner, bool keep_positive) {
     const float sag = 0.5f * (k.xx * a * a + 2.0f * k.xy * a * b + k.yy * b * b);
     shift = std::max(shift, sign * sag);
   }
-  return std::min(shift, kMaxSagShift * s.r);
+  // At most kMaxSagShift radii within s's plane, where the line moves by shift / sin(angle).
+  return std::min(shift, kMaxSagShift * s.r * e_len);
 }
 
 // Sign of eq. 4.14's term for one partner: +1 concave, −1 convex, 0 within the tolerance.

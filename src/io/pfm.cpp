@@ -2,6 +2,7 @@
 // character, then W × H 32-bit floats, rows from the bottom up, little-endian when scale < 0.
 #include "pointillist/io/pfm.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <cassert>
 #include <cctype>
@@ -67,8 +68,14 @@ void write_pfm(const std::string& path, int width, int height, std::span<const f
   file.commit();
 }
 
-ImageFloat read_pfm(const std::string& path) {
+ImageFloat read_pfm(const std::string& path, int expect_width, int expect_height) {
   std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (ec) throw IoError("cannot read " + path + ": " + ec.message());
+  if (!std::filesystem::is_regular_file(status)) {
+    throw IoError("cannot read " + path + ": not a regular file; give a .pfm file (written by "
+                  "render --depth D.pfm or generate --reference-depth), not a pipe or a device");
+  }
   const std::uintmax_t size = std::filesystem::file_size(path, ec);
   if (ec) throw IoError("cannot read " + path + ": " + ec.message());
   // The largest body a valid header can announce, so that nothing larger is read.
@@ -79,9 +86,16 @@ ImageFloat read_pfm(const std::string& path) {
   }
   std::ifstream in(path, std::ios::binary);
   if (!in) throw IoError("cannot open " + path + ": " + std::strerror(errno));
+  const auto read_exactly = [&](char* to, std::size_t bytes) {
+    in.read(to, static_cast<std::streamsize>(bytes));
+    if (static_cast<std::size_t>(in.gcount()) != bytes) {
+      throw IoError("cannot read " + path + ": it ended after " +
+                    std::to_string(in.gcount()) + " of " + std::to_string(bytes) +
+                    " bytes (did it change while being read?)");
+    }
+  };
   std::string head(static_cast<std::size_t>(std::min<std::uintmax_t>(size, kMaxHeader)), '\0');
-  in.read(head.data(), static_cast<std::streamsize>(head.size()));
-  if (!in) throw IoError("cannot read " + path + ": " + std::strerror(errno));
+  read_exactly(head.data(), head.size());
   std::size_t pos = 0;
   const std::string magic = token(head, pos);
   if (magic == "PF") {
@@ -102,6 +116,13 @@ ImageFloat read_pfm(const std::string& path) {
     throw FormatError(path + ": the PFM header's scale is '" + scale_text +
                       "'; it must be a nonzero number (negative: little-endian)");
   }
+  if ((expect_width > 0 && image.width != expect_width) ||
+      (expect_height > 0 && image.height != expect_height)) {
+    throw FormatError(path + " is " + std::to_string(image.width) + "x" +
+                      std::to_string(image.height) + " but " + std::to_string(expect_width) +
+                      "x" + std::to_string(expect_height) +
+                      " was expected; give the depth image written with the colour image");
+  }
   const std::uint64_t count = static_cast<std::uint64_t>(image.width) * image.height;
   if (size - pos != 4 * count) {
     throw FormatError(path + ": a " + std::to_string(image.width) + "x" +
@@ -109,19 +130,20 @@ ImageFloat read_pfm(const std::string& path) {
                       " bytes after its header, the file has " + std::to_string(size - pos) +
                       " (truncated or not a PFM)");
   }
-  std::vector<std::uint32_t> body(count);
-  in.seekg(static_cast<std::streamoff>(pos));
-  in.read(reinterpret_cast<char*>(body.data()), static_cast<std::streamsize>(4 * count));
-  if (!in) throw IoError("cannot read " + path + ": " + std::strerror(errno));
-  const bool little = scale < 0;
-  const bool swap = little != (std::endian::native == std::endian::little);
+  // Read into the image, then put the rows top to bottom and the bytes in the host's order.
   image.pixels.resize(count);
-  for (int y = 0; y < image.height; ++y) {
-    const std::uint32_t* src = body.data() + static_cast<std::size_t>(image.height - 1 - y) * image.width;
-    float* dst = image.pixels.data() + static_cast<std::size_t>(y) * image.width;
-    for (int x = 0; x < image.width; ++x) {
-      const std::uint32_t bits = swap ? __builtin_bswap32(src[x]) : src[x];
-      dst[x] = std::bit_cast<float>(bits);
+  in.seekg(static_cast<std::streamoff>(pos));
+  read_exactly(reinterpret_cast<char*>(image.pixels.data()), 4 * count);
+  const std::size_t w = static_cast<std::size_t>(image.width);
+  for (int y = 0; y < image.height / 2; ++y) {
+    std::swap_ranges(image.pixels.begin() + static_cast<std::ptrdiff_t>(y * w),
+                     image.pixels.begin() + static_cast<std::ptrdiff_t>((y + 1) * w),
+                     image.pixels.begin() + static_cast<std::ptrdiff_t>((image.height - 1 - y) * w));
+  }
+  const bool little = scale < 0;
+  if (little != (std::endian::native == std::endian::little)) {
+    for (float& v : image.pixels) {
+      v = std::bit_cast<float>(__builtin_bswap32(std::bit_cast<std::uint32_t>(v)));
     }
   }
   return image;

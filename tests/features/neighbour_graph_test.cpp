@@ -26,8 +26,8 @@ struct Splats {
   std::vector<float> radii;
 };
 
-// Samples of the cube's surface with radii around `r`, a few of them 20 times larger, some
-// exactly equal (ties of the ownership rule) and a few zero.
+// Samples of the cube's surface with radii around `r`, a few of them 20 times larger (the
+// oversized splats merged after), some exactly equal and a few zero.
 Splats cube_splats(std::size_t n, float r, std::uint64_t seed) {
   const SurfaceSamples s = sample_scene(cube_scene(1.0f), n, seed);
   Splats out;

@@ -7,6 +7,8 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 
 #include "io_test_support.hpp"
@@ -76,6 +78,34 @@ TEST(Pfm, RefusesWhatIsNotAGrayscalePfmNamingTheFile) {
   refused("Pf\n1 1\n-1\n" + le(1) + "extra", "needs 4 bytes");
   refused("", "not a PFM");
   EXPECT_THROW(read_pfm(dir.file("missing.pfm")), IoError);
+}
+
+}  // namespace
+}  // namespace pointillist
+
+namespace pointillist {
+namespace {
+
+TEST(Pfm, ExpectedSizeIsCheckedBeforeTheBodyAndPipesAreRefused) {
+  TempDir dir;
+  write_pfm(dir.file("d.pfm"), 3, 2, std::vector<float>(6, 1.0f));
+  EXPECT_EQ(read_pfm(dir.file("d.pfm"), 3, 2).pixels.size(), 6u);
+  try {
+    read_pfm(dir.file("d.pfm"), 4, 2);
+    ADD_FAILURE() << "accepted a 3x2 image as 4x2";
+  } catch (const FormatError& e) {
+    EXPECT_NE(std::string(e.what()).find("is 3x2 but 4x2 was expected"), std::string::npos)
+        << e.what();
+  }
+  // A header announcing the largest size with a body to match is refused by the expected size
+  // alone (the file is sparse: nothing is read or allocated).
+  {
+    std::ofstream out(dir.file("big.pfm"), std::ios::binary);
+    out << "Pf\n65536 65536\n-1\n";
+  }
+  std::filesystem::resize_file(dir.file("big.pfm"), 18 + 4ull * 65536 * 65536);
+  EXPECT_THROW(read_pfm(dir.file("big.pfm"), 64, 64), FormatError);
+  EXPECT_THROW(read_pfm(dir.file(""), 1, 1), IoError);  // a folder
 }
 
 }  // namespace

@@ -33,8 +33,9 @@ struct NeighbourGraph {
 // wide; each splat of ordinary size (at most 2 median radii) searches for its ordinary
 // neighbours and writes its own row, and the few oversized splats search farther and are merged
 // into their neighbours' rows after, so they do not slow every query. Parallel over blocks of
-// splats; the result does not depend on the thread count. Positions and radii must be finite, radii >= 0. Memory: the graph
-// (12 bytes an edge) plus about 16 bytes a splat.
+// splats; the result does not depend on the thread count. Positions and radii must be finite,
+// radii >= 0. Memory: the graph (8 bytes an edge: both rows) plus about 24 bytes a splat; while
+// the rows are joined they exist twice (and once more when oversized splats are merged in).
 NeighbourGraph build_neighbour_graph(std::span<const Vec3f> centers, std::span<const float> radii,
                                      ThreadPool& pool, Progress& progress = Progress::none());
 

@@ -64,8 +64,10 @@ inline bool on_planes_of_each_other(Vec3f ci, Vec3f ni, float ri, Vec3f cj, Vec3
                                     float w_s) {
   const Vec3f d = cj - ci;
   const float r = kStackedOffset * std::min(ri, rj);
-  // Squared: allowed² = max(sin² θ_s · |d|², r²).
-  const float allowed2 = std::max((1.0f - w_s * w_s) * dot(d, d), r * r);
+  // Squared: allowed² = max(sin² θ_s · |d|², r²), θ_s taken at most 90° (a chord can make at most
+  // that with a plane).
+  const float sin2 = w_s > 0 ? 1.0f - w_s * w_s : 1.0f;
+  const float allowed2 = std::max(sin2 * dot(d, d), r * r);
   const float oi = dot(ni, d), oj = dot(nj, d), sum = oi + oj;
   return oi * oi <= allowed2 && oj * oj <= allowed2 && sum * sum <= allowed2;
 }
@@ -114,8 +116,8 @@ struct ClipResult {
 // surface's tangent at its centre, and where that surface curves away from it onto the clipped
 // side (the crease of a union of two spheres), the disc stops short of the surface it meets
 // and opens a thin gap. The plane moves onto its clipped side by the largest sag of the
-// partner's surface at the ends of the chord where it cuts s (at most kMaxSagShift radii of
-// s); what the disc then reaches past the true crease lies behind the partner's surface. It
+// partner's surface at the ends of the chord where it cuts s (its line in s's plane moves at
+// most kMaxSagShift radii of s); what the disc then reaches past the true crease lies behind the partner's surface. It
 // never moves the other way, and convex creases are left alone: there the extra part would be
 // in view (the rim of a hole, whose wall curves away from its tangent planes too).
 inline constexpr float kMaxSagShift = 0.5f;

@@ -20,9 +20,11 @@ struct ImageFloat {
 // a size of zero); asserts pixels.size() == width * height.
 void write_pfm(const std::string& path, int width, int height, std::span<const float> pixels);
 
-// Reads a grayscale PFM ("Pf") in either byte order. Throws FormatError naming the file for a
-// colour PFM ("PF"), a header that is not a PFM's, sizes above 65536 a side, or a body whose
-// length is not width × height floats; IoError when the file cannot be read.
-ImageFloat read_pfm(const std::string& path);
+// Reads a grayscale PFM ("Pf") in either byte order. With expect_width / expect_height > 0 the
+// header's size must be that (checked before anything is allocated by it). Throws FormatError
+// naming the file for a colour PFM ("PF"), a header that is not a PFM's, sizes above 65536 a
+// side or other than expected, or a body whose length is not width × height floats; IoError
+// when the file cannot be read or is not a regular file.
+ImageFloat read_pfm(const std::string& path, int expect_width = 0, int expect_height = 0);
 
 }  // namespace pointillist
