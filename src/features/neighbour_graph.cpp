@@ -23,6 +23,7 @@ inline bool spheres_overlap(Vec3f ci, float ri, Vec3f cj, float rj) {
 }
 
 struct Grid {
+  float median_radius = 0;
   Vec3f origin;
   float inv_cell = 1;
   int dims[3] = {1, 1, 1};
@@ -49,7 +50,8 @@ Grid make_grid(std::span<const Vec3f> centers, std::span<const float> radii) {
   const Vec3f ext = box.extent();
   std::vector<float> sorted(radii.begin(), radii.end());
   std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-  float cell = 2.0f * sorted[sorted.size() / 2];
+  g.median_radius = sorted[sorted.size() / 2];
+  float cell = 2.0f * g.median_radius;
   const double max_cells = 2.0 * static_cast<double>(centers.size()) + 64.0;
   const float longest = std::max({ext.x, ext.y, ext.z, 1e-30f});
   if (!(cell > longest * 1e-6f)) cell = longest / std::cbrt(static_cast<float>(max_cells));
@@ -123,9 +125,7 @@ NeighbourGraph build_neighbour_graph(std::span<const Vec3f> centers, std::span<c
     cell_radii[k] = radii[grid.order[k]];
   }
   const float r_max = *std::max_element(radii.begin(), radii.end());
-  std::vector<float> sorted(radii.begin(), radii.end());
-  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-  const float r_cut = std::min(r_max, 2.0f * sorted[sorted.size() / 2]);
+  const float r_cut = std::min(r_max, 2.0f * grid.median_radius);
   // Blocks of splats in index order, each block's rows in one array, then concatenated.
   constexpr std::size_t kBlock = 2048;
   const std::size_t block_count = (n + kBlock - 1) / kBlock;
