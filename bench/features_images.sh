@@ -72,6 +72,8 @@ v2_camera() {
     T8) closeup 0 0 1 1 1 1 ;;            # the mixed corner: floor, riser and front
     T10) closeup 0.35 0 0.5 1 0 1 ;;      # the crossing curve where the normals are orthogonal
     T11) closeup 1 1 0.01 1 1 1 ;;        # a corner of the slab (front face, two rim faces)
+    T2|T14*) closeup 1 1 1 1 1 1 ;;       # the cube's corner, as T1
+    T15) closeup 0 0 0.3 0 1 -0.5 ;;      # the open crease where it is still sharp
     *) echo "--view 0,0" ;;
   esac
 }

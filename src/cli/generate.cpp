@@ -75,9 +75,14 @@ int generate_csg(const GenerateOptions& o) {
     write_pfm(o.reference_depth_output, o.view.width, o.view.height, reference.depth);
   }
   if (!o.quiet) {
-    std::printf("generated %zu samples of test scene %s (%s sampling, exact normals, a colour "
-                "per face) -> %s\n",
-                s.points.size(), o.scene.c_str(), jittered ? "jittered grid" : "random",
+    char normals[96] = "exact normals";
+    if (scene.normal_noise_degrees > 0 || scene.position_noise > 0) {
+      std::snprintf(normals, sizeof normals, "normals tilted by %g degrees and positions by %g h (sigma)",
+                    scene.normal_noise_degrees, scene.position_noise);
+    }
+    std::printf("generated %zu samples of test scene %s (%s sampling, %s, a colour per face) -> "
+                "%s\n",
+                s.points.size(), o.scene.c_str(), jittered ? "jittered grid" : "random", normals,
                 o.output.c_str());
     if (!o.reference_output.empty()) {
       std::printf("exact label reference (ray cast, unlit, a colour per face) %dx%d -> %s\n",
@@ -241,13 +246,17 @@ Command add_generate_command(CLI::App& app) {
       ->required();
   std::vector<std::string> scenes = {"demo", "sphere", "torus", "cube"};
   for (const std::string& id : csg_scene_ids()) scenes.push_back(id);
+  for (const char* id : {"T12", "T14"}) scenes.push_back(id);  // T12-90, T14-2
   for (const char* id : {"wall", "city", "field", "row"}) scenes.push_back(id);
   cmd->add_option("--scene", o->scene,
-                  "demo, sphere, torus or cube; or a sharp-features test scene T1 (cube), T3 "
-                  "(cylinder), T4 (plate with a hole), T5/T6 (union/intersection of two "
-                  "spheres), T7 (bitten cube), T8 (step), T9 (two interpenetrating spheres), "
-                  "T10 (crossed cylinders), T11 (thin slab), T13 (sphere); or a scene of many "
-                  "instances for occlusion culling: wall, city, field, row")
+                  "demo, sphere, torus or cube; or a sharp-features test scene T1 (cube), T2 "
+                  "(cube of mixed density), T3 (cylinder), T4 (plate with a hole), T5/T6 "
+                  "(union/intersection of two spheres), T7 (bitten cube), T8 (step), T9 (two "
+                  "interpenetrating spheres), T10 (crossed cylinders), T11 (thin slab), "
+                  "T12-20|30|45|60|90|120|150|165 (wedge of two strips at that dihedral angle), "
+                  "T13 (sphere), T14-2|5 (cube with 2 or 5 degrees of normal noise), T15 (open "
+                  "crease); or a scene of many instances for occlusion culling: wall, city, "
+                  "field, row")
       ->default_val("demo")
       ->check(CLI::IsMember(scenes));
   cmd->add_option("--models", o->models,

@@ -1,5 +1,7 @@
 #include "pointillist/scene/csg.hpp"
 
+#include "csg_internal.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -12,6 +14,9 @@
 
 namespace pointillist {
 namespace {
+
+using csg_detail::FaceSample;
+using csg_detail::sample_rectangle;
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr double kTwoPi = 6.28318530717958647692;
@@ -27,6 +32,8 @@ std::uint32_t face_count(const Primitive& p) {
     case PrimitiveKind::Box: return 6;
     case PrimitiveKind::Sphere: return 1;
     case PrimitiveKind::Cylinder: return 3;
+    case PrimitiveKind::Quad:
+    case PrimitiveKind::Crease: return csg_detail::open_face_count(p);
   }
   return 0;
 }
@@ -46,6 +53,8 @@ bool inside(const Primitive& p, Vec3f x) {
       const Vec3f radial = d - axis_vector(p.axis, axial);
       return std::fabs(axial) <= p.half_length + eps && length(radial) <= p.radius + eps;
     }
+    case PrimitiveKind::Quad:
+    case PrimitiveKind::Crease: return false;  // open: no inside
   }
   return false;
 }
@@ -61,34 +70,10 @@ Vec3f face_normal(const Primitive& p, std::uint32_t face, Vec3f x) {
       const Vec3f d = x - p.center;
       return normalized(d - axis_vector(p.axis, d[p.axis]));
     }
+    case PrimitiveKind::Quad:
+    case PrimitiveKind::Crease: return csg_detail::open_face_normal(p, face, x);
   }
   return {0, 0, 1};
-}
-
-// A face sample before trimming: position, outward normal, local face.
-struct FaceSample {
-  Vec3f x;
-  std::uint32_t face;
-};
-
-// Samples of a w × h rectangle in the plane spanned by axes (u, v): J mode a jittered grid of
-// about area/spacing² cells, R mode as many uniform draws.
-template <class Emit>
-void sample_rectangle(float w, float h, float spacing, SamplingMode mode, std::mt19937_64& rng,
-                      Emit&& emit) {
-  const int nu = std::max(1, static_cast<int>(std::lround(w / spacing)));
-  const int nv = std::max(1, static_cast<int>(std::lround(h / spacing)));
-  std::uniform_real_distribution<float> unit(0.0f, 1.0f), jitter(-0.25f, 0.25f);
-  const float su = w / nu, sv = h / nv;
-  for (int i = 0; i < nu; ++i) {
-    for (int j = 0; j < nv; ++j) {
-      if (mode == SamplingMode::Jittered) {
-        emit((i + 0.5f + jitter(rng)) * su, (j + 0.5f + jitter(rng)) * sv);
-      } else {
-        emit(unit(rng) * w, unit(rng) * h);
-      }
-    }
-  }
 }
 
 void sample_primitive(const Primitive& p, float spacing, SamplingMode mode, std::mt19937_64& rng,
@@ -101,7 +86,8 @@ void sample_primitive(const Primitive& p, float spacing, SamplingMode mode, std:
         base[a] += face % 2 ? p.half[a] : -p.half[a];
         base[u] -= p.half[u];
         base[v] -= p.half[v];
-        sample_rectangle(2 * p.half[u], 2 * p.half[v], spacing, mode, rng, [&](float s, float t) {
+        const float h = p.face_spacing[a] > 0 ? p.face_spacing[a] : spacing;
+        sample_rectangle(2 * p.half[u], 2 * p.half[v], h, mode, rng, [&](float s, float t) {
           Vec3f x = base;
           x[u] += s;
           x[v] += t;
@@ -158,6 +144,8 @@ void sample_primitive(const Primitive& p, float spacing, SamplingMode mode, std:
       }
       break;
     }
+    case PrimitiveKind::Quad:
+    case PrimitiveKind::Crease: csg_detail::sample_open(p, spacing, mode, rng, out); break;
   }
 }
 
@@ -238,6 +226,8 @@ bool ray_interval(const Primitive& p, Vec3f origin, Vec3f dir, Interval& iv) {
       if (!slab(a, p.half_length, 1, 2)) return false;
       break;
     }
+    case PrimitiveKind::Quad:
+    case PrimitiveKind::Crease: return false;  // open: no interval (ray_open)
   }
   return iv.t0 < iv.t1;
 }
@@ -262,33 +252,7 @@ bool member(const CsgScene& scene, const std::vector<Interval>& iv,
   return false;
 }
 
-Primitive box(Vec3f center, Vec3f half) {
-  Primitive p;
-  p.kind = PrimitiveKind::Box;
-  p.center = center;
-  p.half = half;
-  return p;
-}
-Primitive sphere(Vec3f center, float radius) {
-  Primitive p;
-  p.kind = PrimitiveKind::Sphere;
-  p.center = center;
-  p.radius = radius;
-  return p;
-}
-Primitive cylinder(Vec3f center, float radius, float half_length, int axis) {
-  Primitive p;
-  p.kind = PrimitiveKind::Cylinder;
-  p.center = center;
-  p.radius = radius;
-  p.half_length = half_length;
-  p.axis = axis;
-  return p;
-}
-
 }  // namespace
-
-std::uint32_t CsgScene::label_count() const { return first_label(primitives.size()); }
 
 std::uint32_t CsgScene::first_label(std::size_t primitive) const {
   std::uint32_t n = 0;
@@ -296,51 +260,26 @@ std::uint32_t CsgScene::first_label(std::size_t primitive) const {
   return n;
 }
 
-std::vector<std::string> csg_scene_ids() {
-  return {"T1", "T3", "T4", "T5", "T6", "T7", "T8", "T9", "T10", "T11", "T13"};
-}
-
-CsgScene csg_scene(const std::string& id) {
-  CsgScene s;
-  s.name = id;
-  if (id == "T1") {
-    s.primitives = {box({0, 0, 0}, {1, 1, 1})};
-    s.spacing = 0.04f;
-  } else if (id == "T3") {
-    s.primitives = {cylinder({0, 0, 0}, 0.8f, 0.8f, 1)};
-    s.spacing = 0.03f;
-  } else if (id == "T4") {
-    s.primitives = {box({0, 0, 0}, {1, 0.2f, 1}), cylinder({0, 0, 0}, 0.5f, 0.3f, 1)};
-    s.op = CsgOp::Difference;
-    s.spacing = 0.03f;
-  } else if (id == "T5" || id == "T6" || id == "T9") {
-    s.primitives = {sphere({-0.6f, 0, 0}, 1), sphere({0.6f, 0, 0}, 1)};
-    s.op = id == "T5" ? CsgOp::Union : (id == "T6" ? CsgOp::Intersection : CsgOp::Separate);
-    s.spacing = id == "T5" ? 0.032f : (id == "T6" ? 0.02f : 0.035f);
-  } else if (id == "T7") {
-    s.primitives = {box({0, 0, 0}, {1, 1, 1}), sphere({1, 1, 1}, 0.9f)};
-    s.op = CsgOp::Difference;
-    s.spacing = 0.04f;
-  } else if (id == "T8") {
-    s.primitives = {box({0, -0.5f, 0}, {1, 0.5f, 1}), box({-0.5f, 0.5f, 0}, {0.5f, 0.5f, 1})};
-    s.spacing = 0.04f;
-  } else if (id == "T10") {
-    s.primitives = {cylinder({0, 0, 0}, 0.5f, 1.2f, 0), cylinder({0, 0, 0}, 0.35f, 1.2f, 2)};
-    s.op = CsgOp::Separate;
-    s.spacing = 0.03f;
-  } else if (id == "T11") {
-    s.primitives = {box({0, 0, 0}, {1, 1, 0.01f})};
-    s.spacing = 0.04f;
-  } else if (id == "T13") {
-    s.primitives = {sphere({0, 0, 0}, 1)};
-    s.spacing = 0.025f;
-  } else {
-    std::string known;
-    for (const std::string& k : csg_scene_ids()) known += (known.empty() ? "" : ", ") + k;
-    throw OptionError("unknown test scene '" + id + "' (known: " + known + ")");
+namespace {
+// Spec T14's scanner noise (CsgScene::normal_noise_degrees, position_noise), from a stream of its
+// own so the noise-free samples stay those of the scene without it.
+void add_noise(const CsgScene& scene, std::uint64_t seed, PointSet& points) {
+  if (scene.normal_noise_degrees <= 0 && scene.position_noise <= 0) return;
+  std::mt19937_64 rng(seed ^ 0x6a09e667f3bcc909ull);
+  std::normal_distribution<float> tilt(0.0f, std::max(scene.normal_noise_degrees, 0.0f) * kPi / 180);
+  std::normal_distribution<float> offset(0.0f, std::max(scene.position_noise, 0.0f) * scene.spacing);
+  std::uniform_real_distribution<float> turn(0.0f, static_cast<float>(kTwoPi));
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Vec3f n = points.normals[i];
+    const Vec3f t1 = normalized(cross(n, std::fabs(n.x) < 0.9f ? Vec3f{1, 0, 0} : Vec3f{0, 1, 0}));
+    const Vec3f t2 = cross(n, t1);
+    const float phi = turn(rng), angle = scene.normal_noise_degrees > 0 ? tilt(rng) : 0.0f;
+    const Vec3f toward = t1 * std::cos(phi) + t2 * std::sin(phi);
+    points.normals[i] = normalized(n * std::cos(angle) + toward * std::sin(angle));
+    if (scene.position_noise > 0) points.positions[i] = points.positions[i] + n * offset(rng);
   }
-  return s;
 }
+}  // namespace
 
 CsgSamples sample_csg(const CsgScene& scene, SamplingMode mode, std::uint64_t seed) {
   CsgSamples out;
@@ -360,6 +299,7 @@ CsgSamples sample_csg(const CsgScene& scene, SamplingMode mode, std::uint64_t se
       out.labels.push_back(first + f.face);
     }
   }
+  add_noise(scene, seed, out.points);
   return out;
 }
 
@@ -377,12 +317,14 @@ std::pair<std::size_t, std::uint32_t> face_of(const CsgScene& scene, std::uint32
 bool csg_face_is_planar(const CsgScene& scene, std::uint32_t label) {
   const auto [k, face] = face_of(scene, label);
   const Primitive& p = scene.primitives[k];
+  if (csg_detail::is_open(p)) return csg_detail::open_face_is_planar(p, face);
   return p.kind == PrimitiveKind::Box || (p.kind == PrimitiveKind::Cylinder && face > 0);
 }
 
 bool csg_face_contains(const CsgScene& scene, std::uint32_t label, Vec3f x) {
   const auto [k, face] = face_of(scene, label);
   const Primitive& p = scene.primitives[k];
+  if (csg_detail::is_open(p)) return csg_detail::open_face_contains(p, face, x);
   constexpr float eps = 1e-6f;
   const Vec3f d = x - p.center;
   if (p.kind == PrimitiveKind::Box) {
@@ -409,6 +351,18 @@ std::optional<CsgHit> ray_cast_csg(const CsgScene& scene, Vec3f origin, Vec3f di
   };
   std::vector<Event> events;
   for (std::size_t k = 0; k < n; ++k) {
+    // An open surface: its first crossing, in Separate scenes only. It is one-sided, seen only
+    // from the side its normal faces, as the renderer culls back-facing splats.
+    if (csg_detail::is_open(scene.primitives[k])) {
+      const Primitive& p = scene.primitives[k];
+      if (const auto h = csg_detail::ray_open(p, origin, dir)) {
+        const Vec3f x = origin + dir * static_cast<float>(h->t);
+        if (dot(csg_detail::open_face_normal(p, h->face, x), dir) < 0) {
+          events.push_back({h->t, k, h->face});
+        }
+      }
+      continue;
+    }
     hit[k] = ray_interval(scene.primitives[k], origin, dir, iv[k]);
     if (!hit[k]) continue;
     events.push_back({iv[k].t0, k, iv[k].face0});
@@ -463,6 +417,10 @@ CsgImage ray_cast_csg_image(const CsgScene& scene, const Camera& camera) {
 Aabb csg_bounds(const CsgScene& scene) {
   Aabb box;
   for (const Primitive& p : scene.primitives) {
+    if (csg_detail::is_open(p)) {
+      csg_detail::extend_open_bounds(p, box);
+      continue;
+    }
     Vec3f half = p.half;
     if (p.kind == PrimitiveKind::Sphere) half = {p.radius, p.radius, p.radius};
     if (p.kind == PrimitiveKind::Cylinder) {

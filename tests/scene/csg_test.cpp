@@ -15,7 +15,8 @@ namespace {
 
 TEST(CsgScenes, EverySampleIsWhereTheRayCasterFindsItsFace) {
   for (const std::string& id : csg_scene_ids()) {
-    const CsgScene scene = csg_scene(id);
+    CsgScene scene = csg_scene(id);
+    scene.normal_noise_degrees = scene.position_noise = 0;  // T14: the samples before the noise
     for (SamplingMode mode : {SamplingMode::Jittered, SamplingMode::Random}) {
       const CsgSamples s = sample_csg(scene, mode, 5);
       ASSERT_FALSE(s.labels.empty()) << id;
@@ -38,7 +39,8 @@ TEST(CsgScenes, EverySampleIsWhereTheRayCasterFindsItsFace) {
 TEST(CsgScenes, JitteredSampleCountsMatchTheSpecification) {
   // N≈ of spec §4.2 (after trimming).
   const std::pair<const char*, double> expected[] = {
-      {"T1", 15000}, {"T3", 13400}, {"T5", 19600}, {"T9", 20500}, {"T13", 20100}};
+      {"T1", 15000}, {"T2", 26250}, {"T3", 13400}, {"T5", 19600}, {"T9", 20500},
+      {"T12-45", 4400}, {"T13", 20100}, {"T14-2", 15000}};
   for (const auto& [id, n] : expected) {
     const double got = static_cast<double>(sample_csg(csg_scene(id), SamplingMode::Jittered, 1).labels.size());
     EXPECT_NEAR(got / n, 1.0, 0.05) << id << ": " << got;
@@ -74,6 +76,82 @@ TEST(CsgScenes, DifferenceFlipsTheSubtractedNormals) {
     EXPECT_LE(std::fabs(p.y), 0.2f + 1e-5f);
   }
   EXPECT_GT(wall, 600u);
+}
+
+TEST(CsgScenes, MixedDensityCubeHasEachFacesSpacing) {
+  // T2: ±x at h = 0.02, ±y at 0.04, ±z at 0.08 on a cube of side 2: (2/h)² samples a face.
+  const CsgSamples s = sample_csg(csg_scene("T2"), SamplingMode::Jittered, 4);
+  std::vector<std::size_t> per_label(6);
+  for (std::uint32_t l : s.labels) ++per_label[l];
+  const std::size_t expected[6] = {10000, 10000, 2500, 2500, 625, 625};
+  for (int l = 0; l < 6; ++l) EXPECT_EQ(per_label[l], expected[l]) << "face " << l;
+}
+
+TEST(CsgScenes, WedgeStripsMeetAtTheirDihedralAngle) {
+  // T12-θ: two 2 × 1 strips on the hinge x = y = 0; the outward normals' dot product is −cos θ
+  // and each strip's samples lie within 1 of the hinge, on its plane.
+  for (const int degrees : {20, 90, 165}) {
+    const CsgScene scene = csg_scene("T12-" + std::to_string(degrees));
+    const CsgSamples s = sample_csg(scene, SamplingMode::Random, 6);
+    Vec3f n[2] = {};
+    for (std::size_t i = 0; i < s.labels.size(); ++i) {
+      ASSERT_LT(s.labels[i], 2u);
+      n[s.labels[i]] = s.points.normals[i];
+      const Vec3f p = s.points.positions[i];
+      EXPECT_LE(std::hypot(p.x, p.y), 1.0f + 1e-5f);
+      EXPECT_LE(std::fabs(p.z), 1.0f + 1e-5f);
+      EXPECT_NEAR(dot(s.points.normals[i], p), 0.0f, 1e-5f);  // the strip's plane holds the hinge
+    }
+    EXPECT_NEAR(dot(n[0], n[1]), -std::cos(degrees * kPi / 180), 1e-5f) << degrees;
+    EXPECT_GT(n[0].y, 0.0f);  // a ridge: seen from above
+  }
+  EXPECT_EQ(csg_scene("T12").primitives[1].edge_u, csg_scene("T12-90").primitives[1].edge_u);
+}
+
+TEST(CsgScenes, OpenCreaseIsTheHeightFieldAndOneSided) {
+  // T15: y = 0.5·|x|·max(0, 1 − z). Rays straight down hit it there, with the normal of that
+  // function's graph; rays straight up see its back and pass.
+  const CsgScene scene = csg_scene("T15");
+  for (float x = -0.95f; x < 1.0f; x += 0.1f) {
+    for (float z = 0.05f; z < 2.0f; z += 0.1f) {
+      const float y = 0.5f * std::fabs(x) * std::max(0.0f, 1 - z);
+      const auto hit = ray_cast_csg(scene, {x, 3, z}, {0, -1, 0});
+      ASSERT_TRUE(hit) << x << " " << z;
+      EXPECT_NEAR(3 - hit->t, y, 1e-5f);
+      const std::uint32_t label = z >= 1 ? 2u : (x < 0 ? 0u : 1u);
+      EXPECT_EQ(hit->label, label);
+      // The graph's normal: (−∂y/∂x, 1, −∂y/∂z), normalised.
+      const float dx = z < 1 ? 0.5f * (x < 0 ? -1 : 1) * (1 - z) : 0;
+      const float dz = z < 1 ? -0.5f * std::fabs(x) : 0;
+      const Vec3f expected = normalized(Vec3f{-dx, 1, -dz});
+      EXPECT_GT(dot(hit->normal, expected), 0.99999f) << x << " " << z;
+      EXPECT_FALSE(ray_cast_csg(scene, {x, -3, z}, {0, 1, 0}));
+    }
+  }
+}
+
+TEST(CsgScenes, NoisyCubeHasTheNoiseItNames) {
+  // T14-2 and T14-5: T1's samples, each normal tilted by an angle of standard deviation 2° or 5°
+  // and each position moved along its face's normal by 0.1 h (σ).
+  const CsgSamples clean = sample_csg(csg_scene("T1"), SamplingMode::Jittered, 8);
+  for (const float sigma : {2.0f, 5.0f}) {
+    const CsgSamples noisy =
+        sample_csg(csg_scene(sigma == 2.0f ? "T14-2" : "T14-5"), SamplingMode::Jittered, 8);
+    ASSERT_EQ(noisy.labels, clean.labels);
+    double angle2 = 0, offset2 = 0, tangential = 0;
+    for (std::size_t i = 0; i < clean.labels.size(); ++i) {
+      const Vec3f n = clean.points.normals[i];
+      const double a = std::acos(std::min(1.0f, dot(n, noisy.points.normals[i])));
+      angle2 += a * a;
+      const Vec3f d = noisy.points.positions[i] - clean.points.positions[i];
+      offset2 += double(dot(d, n)) * dot(d, n);
+      tangential = std::max(tangential, double(length(d - n * dot(d, n))));
+    }
+    const double count = static_cast<double>(clean.labels.size());
+    EXPECT_NEAR(std::sqrt(angle2 / count) * 180 / kPi, sigma, 0.05 * sigma);
+    EXPECT_NEAR(std::sqrt(offset2 / count), 0.1 * 0.04, 0.05 * 0.1 * 0.04);
+    EXPECT_LT(tangential, 1e-6);
+  }
 }
 
 TEST(CsgScenes, UnknownIdIsRefusedWithTheKnownOnes) {

@@ -20,6 +20,12 @@ enum class PrimitiveKind {
   Box,       // centre ± half; faces −x, +x, −y, +y, −z, +z (labels 0..5)
   Sphere,    // centre, radius; one face
   Cylinder,  // centre, radius, half_length along `axis`; faces side, −cap, +cap (labels 0..2)
+  // Open surfaces (no inside; only in CsgOp::Separate scenes):
+  Quad,      // the rectangle `center` + s·edge_u + t·edge_v, s, t in [0, 1]; one face, normal
+             // along cross(edge_u, edge_v)
+  Crease,    // spec T15's height field y = 0.5·|x|·max(0, 1 − z), x in [−1, 1], z in [0, 2],
+             // moved by `center`; normals up (+y); faces x < 0, x > 0 (where z < 1: the two
+             // sides of a crease that fades out at z = 1) and the flat part z ≥ 1
 };
 
 struct Primitive {
@@ -29,6 +35,10 @@ struct Primitive {
   float radius = 1;     // Sphere, Cylinder
   float half_length = 1;  // Cylinder
   int axis = 1;         // Cylinder: 0 = x, 1 = y, 2 = z
+  Vec3f edge_u, edge_v;  // Quad
+  // Box: the J-mode spacing h of the faces normal to x, y and z (0: the scene's), for a cube of
+  // mixed density (spec T2); R mode draws the same counts.
+  Vec3f face_spacing{0, 0, 0};
 };
 
 enum class CsgOp {
@@ -43,16 +53,25 @@ struct CsgScene {
   std::vector<Primitive> primitives;
   CsgOp op = CsgOp::Union;
   float spacing = 0.04f;  // h, the J-mode sample spacing of the scene
+  // Scanner-like noise on the samples (spec T14), drawn after sampling from a stream of its own
+  // (the noise-free samples stay those of the scene without it): each normal tilted by an angle
+  // of standard deviation `normal_noise_degrees` about a uniformly random tangent axis, each
+  // position moved along its exact normal by a normal deviate of standard deviation
+  // `position_noise`·spacing. Labels stay; the reference stays the exact surface.
+  float normal_noise_degrees = 0;
+  float position_noise = 0;
 
   // Number of face labels: primitive k's faces are labels first_label(k) ...
   std::uint32_t label_count() const;
   std::uint32_t first_label(std::size_t primitive) const;
 };
 
-// The scenes of spec §4.2 by id: "T1" cube, "T3" cylinder, "T4" plate with a hole, "T5" union
-// and "T6" intersection of two spheres, "T7" bitten cube, "T8" step, "T9" two interpenetrating
-// spheres, "T10" crossed capped cylinders, "T11" thin slab, "T13" smooth sphere. Throws
-// OptionError naming the known ids for another.
+// The scenes of spec §4.2 by id: "T1" cube, "T2" cube of mixed density, "T3" cylinder, "T4"
+// plate with a hole, "T5" union and "T6" intersection of two spheres, "T7" bitten cube, "T8"
+// step, "T9" two interpenetrating spheres, "T10" crossed capped cylinders, "T11" thin slab,
+// "T12-θ" wedge of two strips with interior dihedral θ degrees (20, 30, 45, 60, 90, 120, 150,
+// 165; "T12" is 90), "T13" smooth sphere, "T14-2" and "T14-5" the cube with 2° and 5° noise
+// ("T14" is 2°), "T15" open crease. Throws OptionError naming the known ids for another.
 CsgScene csg_scene(const std::string& id);
 std::vector<std::string> csg_scene_ids();
 
@@ -85,7 +104,7 @@ std::vector<std::uint32_t> csg_surface_groups(const CsgScene& scene, const CsgSa
 // the planar faces (box faces, caps); for a curved face (sphere, cylinder side) only the
 // boundary test applies. The ground truth of which part of a splat must be clipped.
 bool csg_face_contains(const CsgScene& scene, std::uint32_t label, Vec3f p);
-// Whether face `label` is planar.
+// Whether face `label` is planar (a box face, a cap, a quad, the crease's flat part).
 bool csg_face_is_planar(const CsgScene& scene, std::uint32_t label);
 
 struct CsgHit {
