@@ -89,6 +89,10 @@ void validate_feature_options(const FeatureOptions& o) {
     throw OptionError("the clip margin must be in [0, 0.5] splat radii, not " +
                       std::to_string(o.clip_margin));
   }
+  if (!(o.noise_floor >= 0.0f && o.noise_floor <= 1.0f)) {
+    throw OptionError("the noise floor must be in [0, 1] splat radii, not " +
+                      std::to_string(o.noise_floor));
+  }
   if (!(o.radius_scale >= 1.0f && o.radius_scale <= 2.0f)) {
     throw OptionError("the features' radius scale must be in [1, 2] (the renderer's "
                       "--radius-scale), not " + std::to_string(o.radius_scale));
@@ -117,8 +121,9 @@ FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec
   // curved creases.
   std::vector<std::uint8_t> kinds(graph.neighbours.size());
   std::vector<Shape> shapes;
+  std::vector<float> noise;
   const bool fit = options.clip_rule == ClipRule::Classified;
-  if (fit) shapes.resize(n);
+  if (fit) shapes.resize(n), noise.resize(n);
   const float w_s = options.sharp_threshold;
   pool.run(blocks.size(), [&](std::size_t b) {
     std::vector<Vec3f> around, around_normals;
@@ -140,11 +145,18 @@ FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec
           kinds[e] = kStacked;
         }
       }
-      if (fit && sharp) shapes[i] = fit_shape(centers[i], normals[i], around, around_normals);
+      if (fit && sharp) {
+        shapes[i] = fit_shape(centers[i], normals[i], around, around_normals);
+        // The residual less what the model's quantization alone leaves (noise_floor).
+        const float residual = fit_residual(centers[i], normals[i], shapes[i], around);
+        const float floor = options.noise_floor * drawn[i];
+        noise[i] = std::sqrt(std::max(0.0f, residual * residual - floor * floor));
+      }
     }
   });
   const auto disc = [&](std::size_t j) {
-    return Disc{centers[j], normals[j], drawn[j], shapes.empty() ? Shape{} : shapes[j]};
+    return fit ? Disc{centers[j], normals[j], drawn[j], shapes[j], noise[j]}
+               : Disc{centers[j], normals[j], drawn[j]};
   };
   {
     ProgressPhase phase(progress, "sharp features", n);

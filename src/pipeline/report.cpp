@@ -56,6 +56,7 @@ std::string render_report_json(const RenderReport& r) {
     j["clipped_fragments"] = s.clipped_fragments;
     j["other_surface_fragments"] = s.other_surface_fragments;
     j["surface_switch_pixels"] = s.surface_switch_pixels;
+    j["clip_pinholes_filled"] = s.clip_pinholes_filled;
   }
   j["width"] = s.width;
   j["height"] = s.height;

@@ -398,3 +398,49 @@ TEST(ClassifyPartners, NearlyParallelTangentsOfAHoleRimKeepTheFace) {
 }
 
 }  // namespace
+
+TEST(FitResidual, ZeroOnACurvedSurfaceAndTheNoiseOnANoisyPlane) {
+  // Exact samples of a sphere lie on the fitted second-order surface; samples of a plane moved
+  // along its normal by a known amount σ lie √2·σ from the surface of a splat moved as much
+  // (its own offset and each neighbour's, independent).
+  std::vector<Vec3f> pts, nrm;
+  const Vec3f centre{0, 0, 0}, at = normalized(Vec3f{0.3f, 0.8f, 0.2f});
+  sphere_ring(centre, 1.0f, at, 0.05f, pts, nrm);
+  const Shape shape = fit_shape(at, at, pts, nrm);
+  EXPECT_LT(fit_residual(at, at, shape, pts), 1e-3f * 0.05f);
+  // The noisy plane: ±σ offsets in a fixed pattern whose mean square is σ² (a square wave),
+  // the splat itself at +σ: the distances are 0 and 2σ alternately, so √2·σ.
+  constexpr float sigma = 0.004f;
+  std::vector<Vec3f> noisy;
+  for (int k = 0; k < 16; ++k) {
+    const float a = k * kPi / 8;
+    noisy.push_back({0.05f * std::cos(a), (k % 2 ? sigma : -sigma), 0.05f * std::sin(a)});
+  }
+  EXPECT_NEAR(fit_residual({0, sigma, 0}, kY, Shape{}, noisy), std::sqrt(2.0f) * sigma, 1e-5f);
+  EXPECT_EQ(fit_residual({0, 0, 0}, kY, Shape{}, {}), 0.0f);
+}
+
+TEST(ClassifyPartners, NoiseMovesTheLineOutByItsMeasure) {
+  // A cube edge (faces y = 1 and x = 1): the splat on the top face keeps x <= 1. With noise
+  // measured at both discs, the line moves √(a² + b²) further out (a right angle: along
+  // the partner's normal is along the splat's plane); without, it stays on the edge.
+  const Disc s{{0.95f, 1, 0}, kY, kR}, p{{1, 0.95f, 0}, kX, kR};
+  const std::vector<Vec3f> around = ring(s, [](Vec3f x) { return x.x < 1; });
+  const auto edge = [&](float own, float partner) {
+    Disc a = s, b = p;
+    a.noise = own;
+    b.noise = partner;
+    const ClipResult clip = classify_partners(a, {&b, 1}, around, ClipRule::Classified);
+    // Where along +x the clip starts: bisect on the line through the centre.
+    float lo = 0.95f, hi = 0.95f + kR;
+    for (int k = 0; k < 40; ++k) {
+      const float mid = 0.5f * (lo + hi);
+      (clip_discards(clip.planes, clip.mode, {mid, 1, 0}) ? hi : lo) = mid;
+    }
+    return lo;
+  };
+  EXPECT_NEAR(edge(0, 0), 1.0f, 1e-5f);
+  EXPECT_NEAR(edge(0.003f, 0.004f), 1.0f + 0.005f, 1e-5f);
+  // At most half a radius, however noisy.
+  EXPECT_NEAR(edge(0.1f, 0.1f), 1.0f + 0.5f * kR, 1e-5f);
+}

@@ -65,12 +65,21 @@ struct FeatureOptions {
   // degree or two off) needs some, or the discs of two faces stop short of each other and open
   // thin holes along the crease; for_quantized_model gives them kQuantizedClipMargin.
   float clip_margin = 0.0f;
+  // A scan's noise moves the lines out too: each splat's planes by the root-mean-square
+  // distance of its and its partners' smooth neighbours from their fitted surfaces (Disc::noise,
+  // 0 on exact data), when that is more than clip_margin. The part of that distance below
+  // noise_floor drawn radii is not counted (in [0, 1]): a quantized model's centres and normals
+  // leave about 0.11 radii on exact data, which clip_margin covers.
+  float noise_floor = 0.0f;
 };
 inline constexpr float kQuantizedClipMargin = 0.1f;
+inline constexpr float kQuantizedNoiseFloor = 0.12f;
 
-// `options` for the leaves of a quantized model (.ptl v2, .qs): at least kQuantizedClipMargin.
+// `options` for the leaves of a quantized model (.ptl v2, .qs): at least kQuantizedClipMargin
+// and kQuantizedNoiseFloor.
 inline FeatureOptions for_quantized_model(FeatureOptions options) {
   if (options.clip_margin < kQuantizedClipMargin) options.clip_margin = kQuantizedClipMargin;
+  if (options.noise_floor < kQuantizedNoiseFloor) options.noise_floor = kQuantizedNoiseFloor;
   return options;
 }
 

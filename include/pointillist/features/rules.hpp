@@ -30,6 +30,9 @@ struct Disc {
   Vec3f n;
   float r = 0;
   Shape shape{};
+  // How far its continuous neighbours' centres lie from the surface `shape` describes (root
+  // mean square, model units): a scan's noise, 0 on exact samples (fit_residual).
+  float noise = 0;
 };
 
 // The tangent frame (u, v) of a unit normal n that Shape refers to (deterministic in n).
@@ -44,6 +47,11 @@ TangentFrame tangent_frame(Vec3f n);
 // plane; zero without neighbours.
 Shape fit_shape(Vec3f c, Vec3f n, std::span<const Vec3f> neighbour_centres,
                 std::span<const Vec3f> neighbour_normals);
+
+// The root-mean-square distance of `neighbour_centres` from the surface through c with normal n
+// and shape `shape` (the second-order surface of fit_shape): noise of a scan's positions and
+// normals, since exact samples of a smooth surface lie on it to second order.
+float fit_residual(Vec3f c, Vec3f n, const Shape& shape, std::span<const Vec3f> neighbour_centres);
 
 enum class Crossing {
   Cross,     // the two discs meet (closed intervals: touching chords count)

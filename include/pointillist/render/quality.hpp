@@ -117,9 +117,11 @@ struct QualityScratch {
   std::vector<std::vector<float>> chunk_planes;        // per chunk: clip planes, eye space
   std::vector<std::vector<float>> band_buffers;        // per-pixel accumulators, one per worker
   std::vector<std::vector<std::uint32_t>> band_tiles;  // sharp features: surfaces per column
+  std::vector<std::uint8_t> clip_mask;  // sharp features: pixels where clipping discarded some
   // The last frame's counts (RenderStats::clipped_fragments, other_surface_fragments,
-  // surface_switch_pixels).
+  // surface_switch_pixels, clip_pinholes_filled).
   std::uint64_t clipped_fragments = 0, other_surface_fragments = 0, surface_switch_pixels = 0;
+  std::uint64_t pinholes_filled = 0;
 };
 
 // Draws `stream` (selected for `camera`) into color and depth (width × height of the camera, rows

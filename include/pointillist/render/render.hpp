@@ -31,6 +31,9 @@ struct RenderStats {
   std::uint64_t clipped_fragments = 0;
   std::uint64_t other_surface_fragments = 0;
   std::uint64_t surface_switch_pixels = 0;
+  // Quality mode: empty pixels that clip planes emptied, in gaps of at most 2 pixels between
+  // covered ones, filled from the nearest (clipping never opens a hole).
+  std::uint64_t clip_pinholes_filled = 0;
   int width = 0, height = 0;
   unsigned threads = 1;
   double ms_select = 0, ms_raster = 0, ms_total = 0;  // wall clock (steady_clock)

@@ -72,6 +72,10 @@ struct Band {
   std::uint64_t* clipped;
   std::uint64_t* other_surface;
   std::uint32_t* tiles = nullptr;  // the surface rule's tile columns (see kMultiTile)
+  // The surface rule: the image's pixels (row-major, `width` wide) where a clip plane discarded
+  // a covered fragment, marked in the visibility pass (the band's rows only).
+  std::uint8_t* clip_mask = nullptr;
+  int width = 0;
   float* ids_at(int j, int k) const {
     return ids + (static_cast<std::size_t>(j - row0) * groups + k) * kIdFloats;
   }

@@ -30,6 +30,7 @@
 #include "pointillist/core/error.hpp"
 #include "pointillist/render/quality.hpp"
 #include "raster/clip_lanes.hpp"
+#include "raster/clip_pinholes.hpp"
 #include "raster/quality_band.hpp"
 #include "raster/quality_kernel.hpp"
 
@@ -109,6 +110,12 @@ void draw_splat(const float* s, const float* planes, const View& v, const Band& 
           // columns), or the first pass of the layered rule.
           if (!kAccumulate && (kFeat == kSameSurface || kFeat == kClipOnly)) {
             *band.clipped += render_detail::lane_count(cut);
+            if (band.clip_mask != nullptr && any4(cut)) {
+              std::uint8_t* row = band.clip_mask + static_cast<std::size_t>(j) * band.width;
+              for (int l = 0; l < kLanes; ++l) {
+                if (cut[l] && k * kLanes + l < band.width) row[k * kLanes + l] = 1;
+              }
+            }
           }
           cover &= ~cut;
           if (!any4(cover)) continue;
@@ -343,6 +350,11 @@ void rasterize(const SplatStream& stream, const std::span<const StreamPiece>* pi
   for (std::size_t w = 0; w < workers; ++w) {
     if (scratch.band_buffers[w].size() < buffer_floats) scratch.band_buffers[w].resize(buffer_floats);
   }
+  // Pixels that clipping emptied are marked, and the narrow gaps among them filled after.
+  const bool fill_pinholes = surface_rule && !depth.empty();
+  if (fill_pinholes) {
+    scratch.clip_mask.assign(static_cast<std::size_t>(camera.width) * camera.height, 0);
+  }
   const std::size_t band_count = static_cast<std::size_t>(setup.band_count);
   std::atomic<std::size_t> next_band{0};
   std::atomic<std::uint64_t> clipped{0}, other_surface{0}, switches{0};
@@ -359,7 +371,9 @@ void rasterize(const SplatStream& stream, const std::span<const StreamPiece>* pi
                       buffer + band_groups * (kGroupFloats + (layered ? kLayerFloats : 0)),
                       &clipped_here,
                       &other_here,
-                      surface_rule ? scratch.band_tiles[worker].data() : nullptr};
+                      surface_rule ? scratch.band_tiles[worker].data() : nullptr,
+                      fill_pinholes ? scratch.clip_mask.data() : nullptr,
+                      camera.width};
       clear_planes(band, layered, surface_rule);
       if (surface_rule) {
         std::fill(band.tiles, band.tiles + tile_count, kEmptyTile);
@@ -406,6 +420,11 @@ void rasterize(const SplatStream& stream, const std::span<const StreamPiece>* pi
     switches += switch_here;
   });
   scratch.clipped_fragments = clipped;
+  scratch.pinholes_filled =
+      fill_pinholes && clipped > 0
+          ? render_detail::fill_clipped_pinholes(color, depth, scratch.clip_mask, camera.width,
+                                                 camera.height)
+          : 0;
   scratch.other_surface_fragments = other_surface;
   scratch.surface_switch_pixels = switches;
 }
