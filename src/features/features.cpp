@@ -167,11 +167,12 @@ FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec
       block.plane_counts.resize(end - first);
       std::vector<Vec3f> continuous;
       std::vector<std::uint32_t> crossing;
-      std::vector<Disc> partners, through;
+      std::vector<Disc> partners, through, sharp;
       for (std::size_t i = first; i < end; ++i) {
         const Disc s = disc(i);
         continuous.clear();
         crossing.clear();
+        sharp.clear();
         bool candidate = false;
         for (std::uint64_t e = graph.offsets[i]; e < graph.offsets[i + 1]; ++e) {
           const std::uint32_t j = graph.neighbours[e];
@@ -180,7 +181,8 @@ FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec
             continue;
           }
           candidate = true;
-          const Crossing x = disc_crossing(s, disc(j));
+          sharp.push_back(disc(j));
+          const Crossing x = disc_crossing(s, sharp.back());
           if (j > i) {
             ++block.stats.sharp_edges;
             block.stats.crossing_edges += x == Crossing::Cross;
@@ -219,9 +221,9 @@ FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec
         };
         std::stable_sort(partners.begin(), partners.end(), nearer);
         std::stable_sort(through.begin(), through.end(), nearer);
-        const ClipResult clip =
-            classify_partners(s, partners, continuous, options.clip_rule, through,
-                              options.clip_margin);
+        ClipResult clip = classify_partners(s, partners, continuous, options.clip_rule, through,
+                                            options.clip_margin);
+        if (options.clip_rule == ClipRule::Classified) keep_uncovered(s, clip, sharp, w_s);
         block.stats.undefined_4_15 += clip.undefined_4_15;
         block.stats.capped += clip.capped;
         block.modes[i - first] = clip.mode;

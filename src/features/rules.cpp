@@ -386,6 +386,65 @@ std::vector<std::uint8_t> reflex_partners(const Disc& s, std::span<const Vec3f> 
   return flags;
 }
 
+int keep_uncovered(const Disc& s, ClipResult& clip, std::span<const Disc> others, float w_s) {
+  if (clip.mode != ClipMode::Union || clip.planes.empty()) return 0;
+  constexpr int kSteps = 8, kAlong = 3;
+  const float step = kMaxSagShift * s.r / kSteps;
+  int moved = 0;
+  std::vector<const Disc*> surface;
+  for (ClipPlane& plane : clip.planes) {
+    // The plane is scaled: within s's plane, side(X) = side(c) + (X − c)·e with e the unit
+    // direction of n's in-plane part; the line where the planes meet passes through foot.
+    const Vec3f in_plane = plane.n - s.n * dot(plane.n, s.n);
+    const float len = length(in_plane);
+    const float side_c = plane_side(plane, s.c);
+    if (len < 1e-6f || std::fabs(side_c) >= s.r) continue;
+    const Vec3f e = in_plane / len, along = cross(s.n, e), unit = normalized(plane.n);
+    const Vec3f foot = s.c - e * side_c;
+    // The discs of the plane's surface, and the direction within its plane, away from the
+    // line, in which that surface lies (toward their centres).
+    surface.clear();
+    Vec3f mean{0, 0, 0};
+    for (const Disc& q : others) {
+      if (std::fabs(dot(q.n, unit)) < w_s) continue;
+      surface.push_back(&q);
+      mean += q.c - foot;
+    }
+    if (surface.empty()) continue;
+    Vec3f into = cross(unit, along);
+    if (dot(into, mean) < 0) into = -into;
+    const float half = std::sqrt(s.r * s.r - side_c * side_c);
+    float gap = 0;
+    for (int k = 0; k < kAlong; ++k) {
+      // The middle half of s's chord: s's neighbours are sure to include the discs that cover
+      // the surface there, when any do.
+      const Vec3f on_line = foot + along * (0.5f * half * (2.0f * static_cast<float>(k) / (kAlong - 1) - 1.0f));
+      // Beyond another plane, the line is past a corner, where this plane's surface has ended.
+      bool past_corner = false;
+      for (const ClipPlane& p : clip.planes) past_corner |= &p != &plane && plane_side(p, on_line) < 0;
+      if (past_corner) continue;
+      // How far from the line the surface's discs first cover it.
+      int first = kSteps + 1;
+      for (int u = 0; u <= kSteps && first > kSteps; ++u) {
+        const Vec3f z = on_line + into * (static_cast<float>(u) * step);
+        for (const Disc* q : surface) {
+          const float off = dot(q->n, z - q->c);
+          if (std::fabs(off) <= s.r && length_squared(z - q->n * off - q->c) <= q->r * q->r) {
+            first = u;
+            break;
+          }
+        }
+      }
+      gap = std::max(gap, static_cast<float>(std::min(first, kSteps)) * step);
+    }
+    if (gap > 0) {
+      plane.h -= gap;
+      ++moved;
+    }
+  }
+  return moved;
+}
+
 ClipResult classify_partners(const Disc& s, std::span<const Disc> partners,
                              std::span<const Vec3f> continuous, ClipRule rule,
                              std::span<const Disc> reflex, float margin) {

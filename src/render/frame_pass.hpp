@@ -78,7 +78,7 @@ void frame_pass(const Camera& camera, const RenderSettings& settings,
     s.clipped_fragments = quality ? scratch->clipped_fragments : frame.scratch.clipped_fragments;
     s.other_surface_fragments = quality ? scratch->other_surface_fragments : 0;
     s.surface_switch_pixels = quality ? scratch->surface_switch_pixels : 0;
-    s.clip_pinholes_filled = quality ? scratch->pinholes_filled : 0;
+    s.clip_pinholes_filled = quality ? scratch->pinholes_filled : frame.scratch.pinholes_filled;
   }
 }
 

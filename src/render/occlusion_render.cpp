@@ -54,7 +54,7 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
   if (scene.empty()) {  // nothing to draw: the background
     frame.splats.chunk_count = 0;
     begin_splats(cam, settings, pool, frame.scratch, frame.depth);
-    finish_splats(cam, pool, frame.scratch, frame.color);
+    finish_splats(cam, pool, frame.scratch, frame.color, frame.depth);
     fill_stats(frame, {}, cam, pool.thread_count(), start, start, Clock::now());
     return;
   }
@@ -522,7 +522,7 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
                                              quality_scratch_, frame.color, frame.depth);
     ms_raster += std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
   } else {
-    finish_splats(cam, pool, frame.scratch, frame.color);
+    finish_splats(cam, pool, frame.scratch, frame.color, frame.depth);
   }
 
   SelectionStats selection;
@@ -545,6 +545,7 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
       }
     }
     s.clipped_fragments = frame.scratch.clipped_fragments;
+    s.clip_pinholes_filled = frame.scratch.pinholes_filled;
   }
 }
 

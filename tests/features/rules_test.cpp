@@ -444,3 +444,70 @@ TEST(ClassifyPartners, NoiseMovesTheLineOutByItsMeasure) {
   // At most half a radius, however noisy.
   EXPECT_NEAR(edge(0.1f, 0.1f), 1.0f + 0.5f * kR, 1e-5f);
 }
+
+// A splat of the top face y = 1 near the edge x = 1, its partner the side face x = 1, and the
+// side's discs (radius 0.1) in a row along the edge whose rims stop `gap` below it.
+struct EdgeWithSideRow {
+  Disc s{{0.95f, 1, 0}, kY, kR};
+  Disc partner;
+  std::vector<Disc> side;
+  explicit EdgeWithSideRow(float gap) {
+    for (int k = -4; k <= 4; ++k) side.push_back({{1, 1 - gap - kR, 0.05f * k}, kX, kR});
+    partner = side[4];
+  }
+  ClipResult clip(float w_s = 0.9f) const {
+    std::vector<Disc> around_side = side;
+    ClipResult c = classify_partners(s, {&partner, 1}, ring(s, [](Vec3f x) { return x.x < 1; }),
+                                     ClipRule::Classified);
+    keep_uncovered(s, c, around_side, w_s);
+    return c;
+  }
+  // Where along +x through the centre the clip starts.
+  float line() const {
+    const ClipResult c = clip();
+    float lo = 0.95f, hi = 0.95f + kR;
+    for (int k = 0; k < 40; ++k) {
+      const float mid = 0.5f * (lo + hi);
+      (clip_discards(c.planes, c.mode, {mid, 1, 0}) ? hi : lo) = mid;
+    }
+    return lo;
+  }
+};
+
+TEST(KeepUncovered, TheLineMovesOutByTheOtherFacesGap) {
+  // The side's discs reach the edge: the line stays on it. They stop 0.013 below it: the line
+  // moves out by that gap rounded up to the steps of 0.5 r / 8 (0.00625): 0.0125... 0.01875.
+  const float step = 0.5f * kR / 8;
+  EXPECT_NEAR(EdgeWithSideRow(-0.01f).line(), 1.0f, 1e-5f);
+  const float moved = EdgeWithSideRow(0.013f).line() - 1.0f;
+  EXPECT_GE(moved, 0.013f - 1e-5f);
+  EXPECT_LE(moved, 0.013f + step + 1e-5f);
+  // The row's discs tilted 30° (normals outside the threshold) are not the side's surface,
+  // which is then the partner alone: a small disc whose rim reaches the edge only near its
+  // centre, 0.03 below the edge. The line moves out by a step there.
+  EdgeWithSideRow tilted(0.013f);
+  for (Disc& d : tilted.side) d.n = normalized(Vec3f{1, 0.577f, 0});
+  tilted.partner = {{1, 0.97f, 0}, kX, 0.05f};
+  tilted.side.push_back(tilted.partner);
+  EXPECT_NEAR(tilted.line(), 1.0f + step, 1e-5f);
+}
+
+TEST(KeepUncovered, PastACornerTheOtherFaceHasEnded) {
+  // The cube's corner (1, 1, 1): a top-face splat whose chord on the edge x = 1 runs past
+  // z = 1. The side faces' discs reach their edges with the top face but end at their own
+  // shared edge: the part of the x = 1 line past z = 1 is past the corner, not a gap, and the
+  // lines stay.
+  const Disc s{{0.97f, 1, 0.97f}, kY, kR};
+  std::vector<Disc> others;
+  for (int k = -4; k <= -1; ++k) {
+    others.push_back({{1, 0.97f, 1 + 0.04f * k}, kX, 0.05f});
+    others.push_back({{1 + 0.04f * k, 0.97f, 1}, kZ, 0.05f});
+  }
+  const Disc partners[2] = {others[6], others[7]};  // the discs nearest the corner
+  ClipResult c = classify_partners(s, partners,
+                                   ring(s, [](Vec3f x) { return x.x < 1 && x.z < 1; }),
+                                   ClipRule::Classified);
+  ASSERT_EQ(c.mode, ClipMode::Union);
+  ASSERT_EQ(c.planes.size(), 2u);
+  EXPECT_EQ(keep_uncovered(s, c, others, 0.9f), 0);
+}

@@ -133,4 +133,16 @@ ClipResult classify_partners(const Disc& s, std::span<const Disc> partners,
                              std::span<const Vec3f> continuous, ClipRule rule,
                              std::span<const Disc> reflex = {}, float margin = 0.0f);
 
+// Clipping never uncovers a gap of the other surface: where the discs of the surface a plane
+// stands for stop short of the crease (samples of a sparse face whose discs do not reach the
+// edge; the sample nearest an open crease fallen on the other side of it), the discs of `s`
+// that reached over it kept it covered. For each plane of a union (or single) clip, at three
+// points of the line where the planes meet (the middle half of s's chord), the surface's discs
+// among `others` (s's sharp-edge neighbours whose normal is within `w_s` of the plane's) are
+// asked how far from the line, within that plane, they first cover it, in steps of
+// kMaxSagShift·r/8; the line moves out by the widest such gap (none when a disc reaches the
+// line; a gap wider than kMaxSagShift·r is left alone: the surface is not there). Returns how
+// many planes moved. Intersection and nearest-plane clips are left as they are.
+int keep_uncovered(const Disc& s, ClipResult& clip, std::span<const Disc> others, float w_s);
+
 }  // namespace pointillist

@@ -31,8 +31,8 @@ struct RenderStats {
   std::uint64_t clipped_fragments = 0;
   std::uint64_t other_surface_fragments = 0;
   std::uint64_t surface_switch_pixels = 0;
-  // Quality mode: empty pixels that clip planes emptied, in gaps of at most 2 pixels between
-  // covered ones, filled from the nearest (clipping never opens a hole).
+  // Empty pixels that clip planes emptied, in gaps of at most 2 pixels between covered ones,
+  // filled from the nearest (clipping never opens a pinhole).
   std::uint64_t clip_pinholes_filled = 0;
   int width = 0, height = 0;
   unsigned threads = 1;

@@ -27,6 +27,11 @@ struct RasterScratch {
   Buffer<std::uint32_t> image;   // per pixel: packed colour, drawing in several batches
   Buffer<float> log_depth;       // eye-dome lighting: log2 of each pixel's depth
   std::uint64_t clipped_fragments = 0;  // the last frame's (RenderStats::clipped_fragments)
+  // Sharp features: the pixels where a clip plane discarded a covered pixel this frame, and
+  // how many empty ones among them were filled (fill_clipped_pinholes).
+  std::vector<std::uint8_t> clip_mask;
+  bool clip_mask_active = false;
+  std::uint64_t pinholes_filled = 0;
 };
 
 // Clears color to settings.background and depth to +infinity, then draws every splat of
@@ -53,7 +58,8 @@ void rasterize_splats(const SplatStream& stream, const CameraFrame& camera,
 
 // The same drawing in batches (occlusion culling draws, tests depths, and draws more):
 // begin_splats clears the image held in `scratch` and `depth`; draw_splats draws chunks
-// [first_chunk, end_chunk) of `stream` over what is there; finish_splats writes the colours.
+// [first_chunk, end_chunk) of `stream` over what is there; finish_splats writes the colours
+// (and, with sharp features, fills the pinholes clipping opened, as rasterize_splats does).
 // Drawing a stream in any split into batches and any order of its chunks gives the image of
 // rasterize_splats over the whole stream. scratch.clipped_fragments sums the batches.
 void begin_splats(const CameraFrame& camera, const RenderSettings& settings, ThreadPool& pool,
@@ -61,7 +67,7 @@ void begin_splats(const CameraFrame& camera, const RenderSettings& settings, Thr
 void draw_splats(const SplatStream& stream, std::size_t first_chunk, std::size_t end_chunk,
                  const CameraFrame& camera, const RenderSettings& settings, ThreadPool& pool,
                  RasterScratch& scratch, std::span<float> depth);
-void finish_splats(const CameraFrame& camera, ThreadPool& pool, const RasterScratch& scratch,
-                   std::span<Rgb8> color);
+void finish_splats(const CameraFrame& camera, ThreadPool& pool, RasterScratch& scratch,
+                   std::span<Rgb8> color, std::span<float> depth);
 
 }  // namespace pointillist

@@ -9,19 +9,16 @@
 
 #include <algorithm>
 #include <cstdint>
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
 #include <atomic>
-#include <bit>
 #include <cassert>
 #include <cmath>
-#include <cstring>
 #include <limits>
 
 #include <type_traits>
 
 #include "raster/clip_lanes.hpp"
+#include "raster/clip_pinholes.hpp"
+#include "raster/unpack_rgb.hpp"
 #include "raster/splat_ellipse.hpp"
 #include "simd.hpp"
 
@@ -59,6 +56,7 @@ struct Target {
   int row_begin, row_end;
   float width_f, height_f;
   std::uint64_t* clipped;  // the worker's count of covered pixels discarded by clip planes
+  std::uint8_t* clip_mask;  // the image's pixels where they did (row-major), or null
 };
 
 // v clamped to [lo, hi]; NaN gives lo. Keeps coordinates of splats next to the eye (huge or
@@ -90,7 +88,7 @@ inline void plot(const Target& t, int i, int j, float z, std::uint32_t c) {
 // No clip test: every covered pixel is drawn.
 struct NoClip {
   Int4 operator()(Float4, float) const { return Int4{}; }
-  void tally(Int4) const {}
+  void tally(Int4, int, int) const {}
 };
 
 
@@ -104,8 +102,17 @@ struct PixelClip {
   std::uint32_t count;
   ClipMode mode;
   std::uint64_t* discarded;  // the band's count of covered pixels discarded
-  // Adds the lanes of `m` (covered pixels this test discarded) to the count.
-  void tally(Int4 m) const { *discarded += render_detail::lane_count(m); }
+  std::uint8_t* mask;        // the image's pixels where they were, or null
+  int width;
+  // Adds the lanes of `m` (covered pixels this test discarded: pixels x0 + lane of row y) to
+  // the count, and marks them.
+  void tally(Int4 m, int x0, int y) const {
+    *discarded += render_detail::lane_count(m);
+    if (mask == nullptr) return;
+    for (int l = 0; l < kLanes; ++l) {
+      if (m[l] && x0 + l < width) mask[static_cast<std::size_t>(y) * width + x0 + l] = 1;
+    }
+  }
   // Lanes of pixel centres (px, py) whose fragment is discarded.
   Int4 operator()(Float4 px, float py) const {
     const Float4 a = (px - half_w) * inv_f;
@@ -191,7 +198,7 @@ inline void fill_box(const Target& t, const PixelBox& b, float x, float y, float
       Int4 m = cover & ((zv < old_depth) | ((zv == old_depth) & (cv < old_color)));
       if constexpr (!std::is_same_v<Clip, NoClip>) {
         const Int4 cut = cover & clip(px, cy);
-        clip.tally(cut & fresh);
+        clip.tally(cut & fresh, s, j);
         m &= ~cut;
       }
       store4(depth, select4(m, zv, old_depth));
@@ -210,7 +217,7 @@ inline void fill_box_narrow(const Target& t, const PixelBox& b, float x, float y
       const float px = static_cast<float>(i) + 0.5f;
       if (!inside(splat4(px - x))(dy)[0]) continue;
       if (clip(splat4(px), dy + y)[0]) {
-        clip.tally(Int4{-1, 0, 0, 0});
+        clip.tally(Int4{-1, 0, 0, 0}, i, j);
         continue;
       }
       plot(t, i, j, z, c);
@@ -234,7 +241,7 @@ inline void plot_nearest(const Target& t, const NearestCentre& n, float z, std::
                          const Clip& clip) {
   if constexpr (!std::is_same_v<Clip, NoClip>) {
     if (clip(splat4(static_cast<float>(n.i) + 0.5f), static_cast<float>(n.j) + 0.5f)[0]) {
-      clip.tally(Int4{-1, 0, 0, 0});
+      clip.tally(Int4{-1, 0, 0, 0}, n.i, n.j);
       return;
     }
   }
@@ -372,7 +379,7 @@ inline void draw_one(const Target& t, const SplatChunk& s, const RasterScratch::
       const PixelClip clip{ce.x, ce.y, ce.z, ne.x, ne.y, ne.z, dot(ne, ce),
                            0.5f * t.width_f, 0.5f * t.height_f, 1.0f / cam.focal_px, cam.ortho,
                            sc.planes.data() + 4 * static_cast<std::size_t>(s.clip_first[i]),
-                           clip_count(code), clip_mode(code), t.clipped};
+                           clip_count(code), clip_mode(code), t.clipped, t.clip_mask, t.width};
       draw_shape<kShape>(t, s, sc, i, clip);
       return;
     }
@@ -429,47 +436,11 @@ void draw_chunks(const SplatStream& stream, std::size_t first, std::size_t end,
   }
 }
 
-// The band's packed 0x00BBGGRR pixels to 3-byte pixels of the output, four at a time (three
-// little-endian words).
+// The band's packed pixels to the output's 3-byte pixels (raster/unpack_rgb.hpp).
 void unpack_band(const Target& t, std::span<Rgb8> out) {
-  static_assert(sizeof(Rgb8) == 3);
   const std::size_t w = static_cast<std::size_t>(t.width);
-  const std::size_t n = static_cast<std::size_t>(t.row_end - t.row_begin) * w;
-  const std::uint32_t* in = t.color;
-  Rgb8* dst = out.data() + static_cast<std::size_t>(t.row_begin) * w;
-  auto* bytes = reinterpret_cast<unsigned char*>(dst);
-  std::size_t p = 0;
-  if constexpr (std::endian::native == std::endian::little) {
-#if defined(__SSE2__)
-    // Streaming stores: the output is written once per frame and not read back here, so
-    // bypassing the cache saves reading each line before overwriting it. Words must be 4-byte
-    // aligned: go pixel by pixel until the output is.
-    for (; p < n && (reinterpret_cast<std::uintptr_t>(bytes + 3 * p) & 3) != 0; ++p) {
-      const std::uint32_t c = in[p];
-      dst[p] = Rgb8{static_cast<std::uint8_t>(c), static_cast<std::uint8_t>(c >> 8),
-                    static_cast<std::uint8_t>(c >> 16)};
-    }
-    for (; p + 4 <= n; p += 4) {
-      const std::uint32_t a = in[p], b = in[p + 1], c = in[p + 2], d = in[p + 3];
-      int* words = reinterpret_cast<int*>(bytes + 3 * p);
-      _mm_stream_si32(words, static_cast<int>(a | b << 24));
-      _mm_stream_si32(words + 1, static_cast<int>(b >> 8 | c << 16));
-      _mm_stream_si32(words + 2, static_cast<int>(c >> 16 | d << 8));
-    }
-    _mm_sfence();
-#else
-    for (; p + 4 <= n; p += 4) {
-      const std::uint32_t a = in[p], b = in[p + 1], c = in[p + 2], d = in[p + 3];
-      const std::uint32_t words[3] = {a | b << 24, b >> 8 | c << 16, c >> 16 | d << 8};
-      std::memcpy(bytes + 3 * p, words, sizeof words);
-    }
-#endif
-  }
-  for (; p < n; ++p) {
-    const std::uint32_t c = in[p];
-    dst[p] = Rgb8{static_cast<std::uint8_t>(c), static_cast<std::uint8_t>(c >> 8),
-                  static_cast<std::uint8_t>(c >> 16)};
-  }
+  render_detail::unpack_rgb(t.color, static_cast<std::size_t>(t.row_end - t.row_begin) * w,
+                            out.data() + static_cast<std::size_t>(t.row_begin) * w);
 }
 
 // Per-chunk preparation of chunks [first, end): ellipse parameters, row extents, eye-space
@@ -492,7 +463,8 @@ void prepare_chunks(const SplatStream& stream, std::size_t first, std::size_t en
 }
 
 Target band_target(const CameraFrame& camera, const BandLayout& bands, int b,
-                   std::uint32_t* color, float* depth, std::uint64_t* clipped) {
+                   std::uint32_t* color, float* depth, std::uint64_t* clipped,
+                   std::uint8_t* clip_mask = nullptr) {
   return Target{color,
                 depth,
                 camera.width,
@@ -501,7 +473,28 @@ Target band_target(const CameraFrame& camera, const BandLayout& bands, int b,
                 std::min(camera.height, (b + 1) << bands.rows_log2),
                 static_cast<float>(camera.width),
                 static_cast<float>(camera.height),
-                clipped};
+                clipped,
+                clip_mask};
+}
+
+// Sharp features: a cleared mask of the pixels clipping empties, for the frame.
+std::uint8_t* start_clip_mask(const CameraFrame& camera, RasterScratch& scratch) {
+  if (!scratch.clip_mask_active) {
+    scratch.clip_mask.assign(static_cast<std::size_t>(camera.width) * camera.height, 0);
+    scratch.clip_mask_active = true;
+  }
+  return scratch.clip_mask.data();
+}
+
+// After the frame: clipping never opens a pinhole (raster/clip_pinholes.hpp).
+void fill_pinholes(const CameraFrame& camera, RasterScratch& scratch, std::span<Rgb8> color,
+                   std::span<float> depth) {
+  scratch.pinholes_filled =
+      scratch.clip_mask_active && scratch.clipped_fragments > 0 && !depth.empty()
+          ? render_detail::fill_clipped_pinholes(color, depth, scratch.clip_mask, camera.width,
+                                                 camera.height)
+          : 0;
+  scratch.clip_mask_active = false;
 }
 
 }  // namespace
@@ -526,11 +519,13 @@ void rasterize_splats(const SplatStream& stream, const CameraFrame& camera,
   for (std::size_t k = 0; k < workers; ++k) scratch.band_colors[k].resize(band_pixels);
   std::atomic<int> next_band{0};
   std::atomic<std::uint64_t> clipped{0};
+  scratch.clip_mask_active = false;
+  std::uint8_t* mask = stream.has_features ? start_clip_mask(camera, scratch) : nullptr;
   pool.run(workers, [&](std::size_t worker) {
     std::uint64_t clipped_here = 0;
     for (int b = next_band++; b < bands.count; b = next_band++) {
       const Target t = band_target(camera, bands, b, scratch.band_colors[worker].data(),
-                                   depth.data(), &clipped_here);
+                                   depth.data(), &clipped_here, mask);
       clear_band(t, settings.background);
       draw_chunks(stream, 0, stream.chunk_count, scratch, settings.shape, banded, t);
       unpack_band(t, color);
@@ -538,6 +533,7 @@ void rasterize_splats(const SplatStream& stream, const CameraFrame& camera,
     clipped += clipped_here;
   });
   scratch.clipped_fragments = clipped;
+  fill_pinholes(camera, scratch, color, depth);
 }
 
 void begin_splats(const CameraFrame& camera, const RenderSettings& settings, ThreadPool& pool,
@@ -547,6 +543,7 @@ void begin_splats(const CameraFrame& camera, const RenderSettings& settings, Thr
   assert(depth.size() == pixels);
   if (scratch.image.size() < pixels) scratch.image.resize(pixels);
   scratch.clipped_fragments = 0;
+  scratch.clip_mask_active = false;
   const BandLayout bands = choose_bands(camera.width, camera.height, pool.thread_count());
   pool.run(static_cast<std::size_t>(bands.count), [&](std::size_t b) {
     const int band = static_cast<int>(b);
@@ -566,6 +563,7 @@ void draw_splats(const SplatStream& stream, std::size_t first_chunk, std::size_t
   const bool banded = bands.count > 1;
   prepare_chunks(stream, first_chunk, end_chunk, camera, settings, banded, pool, scratch);
   std::atomic<std::uint64_t> clipped{0};
+  std::uint8_t* mask = stream.has_features ? start_clip_mask(camera, scratch) : nullptr;
   pool.run(static_cast<std::size_t>(bands.count), [&](std::size_t b) {
     const int band = static_cast<int>(b);
     std::uint64_t clipped_here = 0;
@@ -573,14 +571,14 @@ void draw_splats(const SplatStream& stream, std::size_t first_chunk, std::size_t
                            (static_cast<std::size_t>(band) << bands.rows_log2) *
                                static_cast<std::size_t>(camera.width);
     draw_chunks(stream, first_chunk, end_chunk, scratch, settings.shape, banded,
-                band_target(camera, bands, band, color, depth.data(), &clipped_here));
+                band_target(camera, bands, band, color, depth.data(), &clipped_here, mask));
     clipped += clipped_here;
   });
   scratch.clipped_fragments += clipped;
 }
 
-void finish_splats(const CameraFrame& camera, ThreadPool& pool, const RasterScratch& scratch,
-                   std::span<Rgb8> color) {
+void finish_splats(const CameraFrame& camera, ThreadPool& pool, RasterScratch& scratch,
+                   std::span<Rgb8> color, std::span<float> depth) {
   const BandLayout bands = choose_bands(camera.width, camera.height, pool.thread_count());
   pool.run(static_cast<std::size_t>(bands.count), [&](std::size_t b) {
     const int band = static_cast<int>(b);
@@ -591,6 +589,7 @@ void finish_splats(const CameraFrame& camera, ThreadPool& pool, const RasterScra
                             nullptr),
                 color);
   });
+  fill_pinholes(camera, scratch, color, depth);
 }
 
 }  // namespace pointillist
