@@ -177,7 +177,14 @@ int run_render(const RenderOptions& o) {
                           ? read_scene(o.inputs[0], open, pool, progress)
                           : scene_of_models(o.inputs, open, pool, progress);
   std::vector<std::string> models;  // a scene file's models are inputs too
-  for (const auto& m : scene.models()) models.push_back(m->path());
+  for (const auto& m : scene.models()) {
+    models.push_back(m->path());
+    if (!o.frame.features || m->features() == nullptr) continue;
+    const std::string noisy = noisy_features_warning(m->features()->stats, m->features()->options);
+    if (!noisy.empty()) {
+      std::fprintf(stderr, "pointillist render: warning: %s: %s\n", m->path().c_str(), noisy.c_str());
+    }
+  }
   check_outputs(models, {{"-o", o.output}, {"--depth", o.depth_output},
                          {"--stats", o.stats_output}});
   const Sphere view_sphere = scene.view_sphere();

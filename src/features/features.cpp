@@ -1,6 +1,7 @@
 // compute_features: the graph, then every splat's sharp edges, partners and planes in parallel
 // blocks (concatenated in splat order), then the surface ids.
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <string>
 
@@ -97,6 +98,23 @@ void validate_feature_options(const FeatureOptions& o) {
     throw OptionError("the features' radius scale must be in [1, 2] (the renderer's "
                       "--radius-scale), not " + std::to_string(o.radius_scale));
   }
+}
+
+std::string noisy_features_warning(const FeatureStats& s, const FeatureOptions& o) {
+  if (s.clipped == 0 || s.capped * 4 <= s.clipped) return {};
+  const double degrees = std::acos(std::clamp(o.sharp_threshold, -1.0f, 1.0f)) * 180.0 / kPi;
+  char text[640];
+  std::snprintf(text, sizeof text,
+                "%.0f %% of the clipped splats meet more than %d distinct planes, and %llu "
+                "surfaces were found (%llu with at least 0.5 %% of the splats): the normals "
+                "differ by more than the sharp threshold (%.2f, %.0f degrees) between most "
+                "neighbouring discs, as on a noisy or finely carved scan, so the planes cut the "
+                "surface into ragged pieces. Draw it with --no-features, or find only stronger "
+                "creases with a lower --sharp-threshold (0.7 is 46 degrees, 0.5 is 60)",
+                100.0 * static_cast<double>(s.capped) / static_cast<double>(s.clipped),
+                kMaxClipPlanes, static_cast<unsigned long long>(s.segments),
+                static_cast<unsigned long long>(s.large_segments), o.sharp_threshold, degrees);
+  return text;
 }
 
 FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec3f> normals,

@@ -243,6 +243,8 @@ ConvertResult convert_points(PointSet points, std::span<const std::string> input
         const SphereTree decoded = PtlV2File::open(output)->decode_all();
         const TreeFeatures features = compute_tree_features(
             decoded.view(), pool, for_quantized_model(*o.features), progress);
+        const std::string noisy = noisy_features_warning(features.stats, features.options);
+        if (!noisy.empty()) result.warnings.push_back("--features: " + noisy);
         meta << "features: sharp threshold " << o.features->sharp_threshold << ", "
              << features.stats.clipped << " clipped splats, " << features.stats.segments
              << " surfaces\n";

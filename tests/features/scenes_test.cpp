@@ -9,6 +9,7 @@
 #include <cmath>
 #include <iostream>
 #include <map>
+#include <random>
 
 #include "pointillist/prep/radii.hpp"
 #include "pointillist/scene/csg.hpp"
@@ -326,6 +327,26 @@ TEST(FeatureScenes, NoisyCubeKeepsItsFaces) {
     EXPECT_EQ(p.features.stats.large_segments, 6u);
     EXPECT_LE(off_label(p.features, p.samples.labels), p.features.size() / 200);  // purity
   }
+}
+
+TEST(FeatureScenes, NoiseThatLooksLikeCreasesEverywhereIsReported) {
+  // The test scenes' creases, even under 5° of normal noise with random sampling's large
+  // discs, give no warning; a plane whose normals are tilted at random by up to 50° (the
+  // normals of a rough scan at the scale of its discs) does.
+  for (const char* id : {"T1", "T4", "T10", "T14-5"}) {
+    const Prepared p = prepare(id, SamplingMode::Random);
+    EXPECT_EQ(noisy_features_warning(p.features.stats, p.features.options), "") << id;
+  }
+  Prepared rough = prepare("T11", SamplingMode::Random);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> tilt(-0.6f, 0.6f);
+  std::vector<Vec3f> normals = rough.samples.points.normals;
+  for (Vec3f& n : normals) n = normalized(n + Vec3f{tilt(rng), tilt(rng), tilt(rng)});
+  ThreadPool pool(2);
+  const FeatureData f = compute_features(rough.samples.points.positions, normals, rough.radii, pool);
+  const std::string warning = noisy_features_warning(f.stats, f.options);
+  EXPECT_NE(warning.find("--sharp-threshold"), std::string::npos) << f.stats.capped << " of "
+                                                                  << f.stats.clipped;
 }
 
 TEST(FeatureScenes, DoNotDependOnTheThreadCount) {
