@@ -11,7 +11,7 @@
 #   POINTILLIST_BIN        the binary (default build/release/pointillist, after `make build`)
 #   FEATURES_IMAGES_SIZE   image side in pixels (default 512; the spec's 1024 is slow for a
 #                          routine run)
-#   FEATURES_IMAGES_SCENES scenes (default "T1 T3 T4 T5 T6 T8 T9 T10 T11")
+#   FEATURES_IMAGES_SCENES scenes (default "T1 T2 T3 T4 T5 T6 T8 T9 T10 T11 T14-2 T14-5 T15")
 #   FEATURES_IMAGES_MODES  sampling modes (default "j r")
 #   --markdown             also print the table as markdown
 #   --keep DIR             keep the reference and test images (and the JSON) in DIR
@@ -49,7 +49,7 @@ while (($#)); do
 done
 
 size=${FEATURES_IMAGES_SIZE:-512}
-scenes=${FEATURES_IMAGES_SCENES:-"T1 T3 T4 T5 T6 T8 T9 T10 T11"}
+scenes=${FEATURES_IMAGES_SCENES:-"T1 T2 T3 T4 T5 T6 T8 T9 T10 T11 T14-2 T14-5 T15"}
 modes=${FEATURES_IMAGES_MODES:-"j r"}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
