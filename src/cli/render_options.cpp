@@ -20,6 +20,7 @@ struct RenderText {
   bool no_chunk_culling = false;
   bool features = false, no_features = false;
   FeatureOptions feature;
+  CLI::Option* sharp_threshold = nullptr;
   std::vector<std::string> chc_off;
 };
 
@@ -76,9 +77,11 @@ void add_features(CLI::App* cmd, RenderText& t) {
       ->group(kGroup);
   cmd->add_flag("--no-features", t.no_features, "Draw without the sharp features (to compare)")
       ->group(kGroup);
-  cmd->add_option("--sharp-threshold", t.feature.sharp_threshold,
-                  "With --features: neighbours whose normals' cosine is below W are a sharp "
-                  "edge (0.9: about 26 degrees)")
+  t.sharp_threshold =
+      cmd->add_option("--sharp-threshold", t.feature.sharp_threshold,
+                      "With --features: neighbours whose normals' cosine is below W are a "
+                      "sharp edge (default 0.9, about 26 degrees; on a rough scan, lower: 1.4 "
+                      "times the angle within which 3/4 of the neighbours' normals agree)")
       ->default_val(0.9f)
       ->check(CLI::Range(-1.0f, 1.0f))
       ->group(kGroup);
@@ -290,6 +293,7 @@ Command add_render_command(CLI::App& app) {
             }
             if (t->features) {
               t->feature.radius_scale = o->frame.quality.radius_scale;
+              t->feature.adapt_threshold = t->sharp_threshold->count() == 0;
               o->features = t->feature;
             }
             o->frame.features = !t->no_features;

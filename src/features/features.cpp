@@ -101,7 +101,7 @@ void validate_feature_options(const FeatureOptions& o) {
 }
 
 std::string noisy_features_warning(const FeatureStats& s, const FeatureOptions& o) {
-  if (s.clipped == 0 || s.capped * 4 <= s.clipped) return {};
+  if (s.clipped == 0 || s.capped * 2 <= s.clipped) return {};
   const double degrees = std::acos(std::clamp(o.sharp_threshold, -1.0f, 1.0f)) * 180.0 / kPi;
   char text[640];
   std::snprintf(text, sizeof text,
@@ -142,7 +142,30 @@ FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec
   std::vector<float> noise;
   const bool fit = options.clip_rule == ClipRule::Classified;
   if (fit) shapes.resize(n), noise.resize(n);
-  const float w_s = options.sharp_threshold;
+  // The neighbours' normal spread (every 4th edge: the statistic needs no more; pairs facing
+  // apart, such as a thin part's two sides, are not the surface's roughness), and the
+  // threshold raised above it on rough scans.
+  {
+    std::vector<float> dots;
+    dots.reserve(graph.neighbours.size() / 4 + 1);
+    for (std::size_t i = 0; i < n; ++i) {
+      for (std::uint64_t e = graph.offsets[i]; e < graph.offsets[i + 1]; e += 4) {
+        const float d = dot(normals[i], normals[graph.neighbours[e]]);
+        if (d > 0) dots.push_back(d);
+      }
+    }
+    if (!dots.empty()) {
+      const auto quartile = dots.begin() + static_cast<std::ptrdiff_t>(dots.size() / 4);
+      std::nth_element(dots.begin(), quartile, dots.end());
+      const float spread = std::acos(std::clamp(*quartile, -1.0f, 1.0f));
+      out.stats.spread_deg = spread * 180.0f / kPi;
+      const float raised = std::cos(std::min(kSpreadFactor * spread, kMaxRaisedAngle));
+      if (options.adapt_threshold && raised < out.options.sharp_threshold) {
+        out.options.sharp_threshold = raised;
+      }
+    }
+  }
+  const float w_s = out.options.sharp_threshold;
   pool.run(blocks.size(), [&](std::size_t b) {
     std::vector<Vec3f> around, around_normals;
     for (std::size_t i = b * kBlock, end = std::min(n, i + kBlock); i < end; ++i) {

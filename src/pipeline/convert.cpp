@@ -245,7 +245,7 @@ ConvertResult convert_points(PointSet points, std::span<const std::string> input
             decoded.view(), pool, for_quantized_model(*o.features), progress);
         const std::string noisy = noisy_features_warning(features.stats, features.options);
         if (!noisy.empty()) result.warnings.push_back("--features: " + noisy);
-        meta << "features: sharp threshold " << o.features->sharp_threshold << ", "
+        meta << "features: sharp threshold " << features.options.sharp_threshold << ", "
              << features.stats.clipped << " clipped splats, " << features.stats.segments
              << " surfaces\n";
         v2.features = &features;

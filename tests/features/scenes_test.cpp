@@ -349,6 +349,44 @@ TEST(FeatureScenes, NoiseThatLooksLikeCreasesEverywhereIsReported) {
                                                                   << f.stats.clipped;
 }
 
+TEST(FeatureScenes, TheThresholdRisesOnlyAboveARoughSurfacesSpread) {
+  // On every test scene, and on a coarse cube whose creases are a third of its neighbour
+  // pairs, the threshold stays 0.9; on a plane whose normals are tilted at random by up to 50°
+  // (third quartile of the pairs' angles about 40°) it rises, to at most 45°, unless the
+  // threshold was given.
+  for (const std::string& id : csg_scene_ids()) {
+    for (SamplingMode mode : {SamplingMode::Jittered, SamplingMode::Random}) {
+      const Prepared p = prepare(id, mode);
+      EXPECT_EQ(p.features.options.sharp_threshold, 0.9f) << id << " " << p.features.stats.spread_deg;
+    }
+  }
+  Prepared coarse;
+  coarse.scene = csg_scene("T1");
+  coarse.scene.spacing = 0.25f;
+  coarse.samples = sample_csg(coarse.scene, SamplingMode::Random, 4);
+  ThreadPool pool(2);
+  coarse.radii = cloud_radii(coarse.samples.points.positions, pool, Progress::none(), {});
+  const FeatureData c = compute_features(coarse.samples.points.positions,
+                                         coarse.samples.points.normals, coarse.radii, pool);
+  EXPECT_EQ(c.options.sharp_threshold, 0.9f);
+  EXPECT_GT(c.stats.sharp_edges * 4, c.stats.edges);  // creases are many of the pairs
+  EXPECT_EQ(c.stats.large_segments, 6u);
+  Prepared rough = prepare("T11", SamplingMode::Random);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> tilt(-0.6f, 0.6f);
+  std::vector<Vec3f> normals = rough.samples.points.normals;
+  for (Vec3f& n : normals) n = normalized(n + Vec3f{tilt(rng), tilt(rng), tilt(rng)});
+  const FeatureData raised = compute_features(rough.samples.points.positions, normals, rough.radii, pool);
+  EXPECT_LT(raised.options.sharp_threshold, 0.9f) << raised.stats.spread_deg;
+  EXPECT_NEAR(raised.options.sharp_threshold,
+              std::max(std::cos(kSpreadFactor * raised.stats.spread_deg * kPi / 180), std::cos(0.25f * kPi)), 1e-5f);
+  FeatureOptions given;
+  given.adapt_threshold = false;
+  EXPECT_EQ(compute_features(rough.samples.points.positions, normals, rough.radii, pool, given)
+                .options.sharp_threshold,
+            0.9f);
+}
+
 TEST(FeatureScenes, DoNotDependOnTheThreadCount) {
   const Prepared a = prepare("T8", SamplingMode::Random, {}, 1);
   const Prepared b = prepare("T8", SamplingMode::Random, {}, 2);
