@@ -110,14 +110,7 @@ Command add_convert_command(CLI::App& app) {
                     ".ptl v2: find the sharp edges, corners and intersecting surfaces and store "
                     "them (render draws them)")
           ->group(kGroupOutput);
-  CLI::Option* threshold =
-      cmd->add_option("--sharp-threshold", features->sharp_threshold,
-                      "With --features: cosine between neighbours' normals below which their "
-                      "edge is sharp (default 0.9, about 26 degrees; on a rough scan, lower: "
-                      "1.4 times the angle within which 3/4 of the neighbours' normals agree)")
-          ->default_val(0.9f)
-          ->check(CLI::Range(-1.0f, 1.0f))
-          ->group(kGroupOutput);
+  CLI::Option* threshold = add_sharp_threshold(cmd, *features)->group(kGroupOutput);
   add_enum<EdgeTest>(cmd, "--edge-test", features->edge_test,
                      {{"side", EdgeTest::Side}, {"linsen", EdgeTest::Linsen}},
                      "With --features: side (per pair) or linsen (angular gap)", "side")

@@ -41,11 +41,12 @@ void print_feature_stats(const FeatureStats& s, const FeatureOptions& o) {
               o.sharp_threshold, o.edge_test == EdgeTest::Side ? "side" : "linsen",
               o.radius_scale);
   if (s.spread_deg > 0) {
-    std::printf("  spread:      3/4 of the neighbour pairs' normals differ by at most %.1f degrees%s\n",
-                s.spread_deg,
-                o.adapt_threshold && o.sharp_threshold < 0.9f
-                    ? " (a rough surface: the threshold was raised to 1.4 times that)"
-                    : "");
+    std::printf("  spread:      3/4 of the neighbour pairs' normals differ by at most %.1f degrees",
+                s.spread_deg);
+    if (s.threshold_raised) {
+      std::printf(" (a rough surface: the threshold was raised to %.1f times that)", kSpreadFactor);
+    }
+    std::printf("\n");
   }
   std::printf("  graph:       %llu edges, m = %.2f edges a splat (bounding spheres, eq. 3.1)\n",
               u(s.edges), s.mean_degree());
@@ -220,12 +221,7 @@ Command add_info_command(CLI::App& app) {
   cmd->add_flag("--features", o->features,
                 "Find the sharp features in memory and print their statistics (the "
                 "dissertation's tables: graph, sharp edges, crossings, clipped splats, surfaces)");
-  CLI::Option* threshold =
-      cmd->add_option("--sharp-threshold", o->feature.sharp_threshold,
-                      "With --features: cosine between normals below which an edge is sharp "
-                      "(default 0.9, about 26 degrees, or lower on a rough scan)")
-          ->default_val(0.9f)
-          ->check(CLI::Range(-1.0f, 1.0f));
+  CLI::Option* threshold = add_sharp_threshold(cmd, o->feature);
   cmd->add_flag("--spt", o->spt,
                 "Also build the Sequential Point Tree and report its list and the share of it "
                 "one view scans");

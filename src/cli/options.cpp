@@ -185,6 +185,18 @@ void add_columns(CLI::App* app, std::string& columns) {
       ->group(kGroupScan);
 }
 
+CLI::Option* add_sharp_threshold(CLI::App* app, FeatureOptions& features) {
+  char help[256];
+  std::snprintf(help, sizeof help,
+                "With --features: neighbours whose normals' cosine is below W are a sharp edge "
+                "(default 0.9, about 26 degrees; on a rough scan lower: %.1f times the angle "
+                "within which 3/4 of the neighbours' normals agree, at most 45 degrees)",
+                kSpreadFactor);
+  return app->add_option("--sharp-threshold", features.sharp_threshold, help)
+      ->default_val(0.9f)
+      ->check(CLI::Range(-1.0f, 1.0f));
+}
+
 void add_threads(CLI::App* app, unsigned& threads) {
   const unsigned cap = ThreadPool::max_threads();
   app->add_option("--threads", threads,

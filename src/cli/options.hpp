@@ -13,6 +13,7 @@
 
 #include "commands.hpp"
 #include "pointillist/core/math.hpp"
+#include "pointillist/features/features.hpp"
 #include "pointillist/prep/prepare.hpp"
 #include "pointillist/render/settings.hpp"
 
@@ -82,6 +83,9 @@ void add_edl_and_two_sided(CLI::App* app, RenderSettings& settings,
 float parse_edl(const std::vector<std::string>& edl_text);
 
 void add_columns(CLI::App* app, std::string& columns);
+// --sharp-threshold W into features.sharp_threshold. The option's count() says whether the user
+// gave it: FeatureOptions::adapt_threshold is for when not (the caller sets it after parsing).
+CLI::Option* add_sharp_threshold(CLI::App* app, FeatureOptions& features);
 void add_threads(CLI::App* app, unsigned& threads);
 // The scan preparation options (--normals, --k, --radius-scale, --drop-outliers,
 // --outlier-ratio); `render` has its own --radius-scale (the drawn size).

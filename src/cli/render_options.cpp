@@ -77,14 +77,7 @@ void add_features(CLI::App* cmd, RenderText& t) {
       ->group(kGroup);
   cmd->add_flag("--no-features", t.no_features, "Draw without the sharp features (to compare)")
       ->group(kGroup);
-  t.sharp_threshold =
-      cmd->add_option("--sharp-threshold", t.feature.sharp_threshold,
-                      "With --features: neighbours whose normals' cosine is below W are a "
-                      "sharp edge (default 0.9, about 26 degrees; on a rough scan, lower: 1.4 "
-                      "times the angle within which 3/4 of the neighbours' normals agree)")
-      ->default_val(0.9f)
-      ->check(CLI::Range(-1.0f, 1.0f))
-      ->group(kGroup);
+  t.sharp_threshold = add_sharp_threshold(cmd, t.feature)->group(kGroup);
   add_enum<EdgeTest>(cmd, "--edge-test", t.feature.edge_test,
                      {{"side", EdgeTest::Side}, {"linsen", EdgeTest::Linsen}},
                      "With --features: how a crease is told from an intersection: side (per "

@@ -74,6 +74,24 @@ std::uint64_t segment(const NeighbourGraph& graph, std::span<const std::uint8_t>
   return next_id;
 }
 
+// The angle (radians) within which the normals of three quarters of the neighbour pairs agree,
+// over every 4th edge (the statistic needs no more); pairs facing apart, such as a thin part's
+// two sides, are not the surface's roughness.
+float normal_spread(const NeighbourGraph& graph, std::span<const Vec3f> normals) {
+  std::vector<float> dots;
+  dots.reserve(graph.neighbours.size() / 4 + 1);
+  for (std::size_t i = 0; i < graph.vertex_count(); ++i) {
+    for (std::uint64_t e = graph.offsets[i]; e < graph.offsets[i + 1]; e += 4) {
+      const float d = dot(normals[i], normals[graph.neighbours[e]]);
+      if (d > 0) dots.push_back(d);
+    }
+  }
+  if (dots.empty()) return 0;
+  const auto quartile = dots.begin() + static_cast<std::ptrdiff_t>(dots.size() / 4);
+  std::nth_element(dots.begin(), quartile, dots.end());
+  return std::acos(std::min(*quartile, 1.0f));
+}
+
 }  // namespace
 
 void validate_feature_options(const FeatureOptions& o) {
@@ -140,30 +158,15 @@ FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec
   std::vector<std::uint8_t> kinds(graph.neighbours.size());
   std::vector<Shape> shapes;
   std::vector<float> noise;
-  const bool fit = options.clip_rule == ClipRule::Classified;
-  if (fit) shapes.resize(n), noise.resize(n);
-  // The neighbours' normal spread (every 4th edge: the statistic needs no more; pairs facing
-  // apart, such as a thin part's two sides, are not the surface's roughness), and the
-  // threshold raised above it on rough scans.
-  {
-    std::vector<float> dots;
-    dots.reserve(graph.neighbours.size() / 4 + 1);
-    for (std::size_t i = 0; i < n; ++i) {
-      for (std::uint64_t e = graph.offsets[i]; e < graph.offsets[i + 1]; e += 4) {
-        const float d = dot(normals[i], normals[graph.neighbours[e]]);
-        if (d > 0) dots.push_back(d);
-      }
-    }
-    if (!dots.empty()) {
-      const auto quartile = dots.begin() + static_cast<std::ptrdiff_t>(dots.size() / 4);
-      std::nth_element(dots.begin(), quartile, dots.end());
-      const float spread = std::acos(std::clamp(*quartile, -1.0f, 1.0f));
-      out.stats.spread_deg = spread * 180.0f / kPi;
-      const float raised = std::cos(std::min(kSpreadFactor * spread, kMaxRaisedAngle));
-      if (options.adapt_threshold && raised < out.options.sharp_threshold) {
-        out.options.sharp_threshold = raised;
-      }
-    }
+  const bool classified = options.clip_rule == ClipRule::Classified;
+  if (classified) shapes.resize(n), noise.resize(n);
+  // The threshold raised above a rough scan's spread.
+  const float spread = normal_spread(graph, normals);
+  out.stats.spread_deg = spread * 180.0f / kPi;
+  const float raised = std::cos(std::min(kSpreadFactor * spread, kMaxRaisedAngle));
+  if (options.adapt_threshold && raised < out.options.sharp_threshold) {
+    out.options.sharp_threshold = raised;
+    out.stats.threshold_raised = true;
   }
   const float w_s = out.options.sharp_threshold;
   pool.run(blocks.size(), [&](std::size_t b) {
@@ -186,7 +189,7 @@ FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec
           kinds[e] = kStacked;
         }
       }
-      if (fit && sharp) {
+      if (classified && sharp) {
         shapes[i] = fit_shape(centers[i], normals[i], around, around_normals);
         // The residual less what the model's quantization alone leaves (noise_floor).
         const float residual = fit_residual(centers[i], normals[i], shapes[i], around);
@@ -196,8 +199,8 @@ FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec
     }
   });
   const auto disc = [&](std::size_t j) {
-    return fit ? Disc{centers[j], normals[j], drawn[j], shapes[j], noise[j]}
-               : Disc{centers[j], normals[j], drawn[j]};
+    return classified ? Disc{centers[j], normals[j], drawn[j], shapes[j], noise[j]}
+                      : Disc{centers[j], normals[j], drawn[j]};
   };
   {
     ProgressPhase phase(progress, "sharp features", n);
@@ -207,7 +210,7 @@ FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec
       block.modes.resize(end - first);
       block.plane_counts.resize(end - first);
       std::vector<Vec3f> continuous;
-      std::vector<std::uint32_t> crossing;
+      std::vector<std::size_t> crossing;  // into `sharp`
       std::vector<Disc> partners, through, sharp;
       for (std::size_t i = first; i < end; ++i) {
         const Disc s = disc(i);
@@ -229,7 +232,7 @@ FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec
             block.stats.crossing_edges += x == Crossing::Cross;
             block.stats.antiparallel_edges += x == Crossing::Parallel;
           }
-          if (x == Crossing::Cross) crossing.push_back(j);
+          if (x == Crossing::Cross) crossing.push_back(sharp.size() - 1);
         }
         block.stats.candidates += candidate;
         // Partners: crossing discs at which this splat's surface ends, nearest first.
@@ -237,8 +240,8 @@ FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec
                               linsen_boundary(s, continuous, options.linsen_alpha_deg);
         partners.clear();
         through.clear();
-        for (std::uint32_t j : crossing) {
-          const Disc p = disc(j);
+        for (const std::size_t k : crossing) {
+          const Disc& p = sharp[k];
           const bool ends = options.edge_test == EdgeTest::Linsen ? boundary
                                                                    : surface_ends_at(s, continuous, p);
           (ends ? partners : through).push_back(p);
@@ -264,7 +267,7 @@ FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec
         std::stable_sort(through.begin(), through.end(), nearer);
         ClipResult clip = classify_partners(s, partners, continuous, options.clip_rule, through,
                                             options.clip_margin);
-        if (options.clip_rule == ClipRule::Classified) keep_uncovered(s, clip, sharp, w_s);
+        if (classified) keep_uncovered(s, clip, sharp, w_s);
         block.stats.undefined_4_15 += clip.undefined_4_15;
         block.stats.capped += clip.capped;
         block.modes[i - first] = clip.mode;

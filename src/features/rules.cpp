@@ -74,10 +74,7 @@ float sag_shift(const Disc& s, const Disc& partner, bool keep_positive) {
   const float sign = keep_positive ? 1.0f : -1.0f;
   float shift = 0;
   for (float end : {-half, half}) {
-    const Vec3f w = e * t + along * end - to_partner;
-    const float a = dot(w, f.u), b = dot(w, f.v);
-    const float sag = 0.5f * (k.xx * a * a + 2.0f * k.xy * a * b + k.yy * b * b);
-    shift = std::max(shift, sign * sag);
+    shift = std::max(shift, sign * sag(k, f, e * t + along * end - to_partner));
   }
   // At most kMaxSagShift radii within s's plane, where the line moves by shift / sin(angle).
   return std::min(shift, kMaxSagShift * s.r * e_len);
@@ -236,12 +233,6 @@ Classification classify_4_15(const Disc& s, std::span<const Disc> partners) {
 
 }  // namespace
 
-TangentFrame tangent_frame(Vec3f n) {
-  const Vec3f helper = std::fabs(n.x) < 0.9f ? Vec3f{1, 0, 0} : Vec3f{0, 1, 0};
-  const Vec3f u = normalized(cross(n, helper));
-  return {u, cross(n, u)};
-}
-
 Shape fit_shape(Vec3f c, Vec3f n, std::span<const Vec3f> neighbour_centres,
                 std::span<const Vec3f> neighbour_normals) {
   const TangentFrame f = tangent_frame(n);
@@ -270,9 +261,7 @@ float fit_residual(Vec3f c, Vec3f n, const Shape& shape, std::span<const Vec3f> 
   const TangentFrame f = tangent_frame(n);
   double sum = 0;
   for (const Vec3f x : neighbour_centres) {
-    const Vec3f w = x - c;
-    const float a = dot(w, f.u), b = dot(w, f.v);
-    const float off = dot(w, n) + 0.5f * (shape.xx * a * a + 2.0f * shape.xy * a * b + shape.yy * b * b);
+    const float off = dot(x - c, n) + sag(shape, f, x - c);
     sum += double(off) * off;
   }
   return static_cast<float>(std::sqrt(sum / static_cast<double>(neighbour_centres.size())));

@@ -107,9 +107,7 @@ void sample_primitive(const Primitive& p, float spacing, SamplingMode mode, std:
           const double phi = golden * k;
           d = {static_cast<float>(rho * std::cos(phi)), static_cast<float>(z),
                static_cast<float>(rho * std::sin(phi))};
-          const Vec3f t1 = normalized(cross(d, std::fabs(d.x) < 0.9f ? Vec3f{1, 0, 0}
-                                                                      : Vec3f{0, 1, 0}));
-          const Vec3f t2 = cross(d, t1);
+          const auto [t1, t2] = tangent_frame(d);
           d = normalized(d * p.radius + (t1 * jitter(rng) + t2 * jitter(rng)) * spacing);
         } else {
           const float z = 2 * unit(rng) - 1, phi = static_cast<float>(kTwoPi) * unit(rng);
@@ -254,6 +252,8 @@ bool member(const CsgScene& scene, const std::vector<Interval>& iv,
 
 }  // namespace
 
+std::uint32_t CsgScene::label_count() const { return first_label(primitives.size()); }
+
 std::uint32_t CsgScene::first_label(std::size_t primitive) const {
   std::uint32_t n = 0;
   for (std::size_t k = 0; k < primitive && k < primitives.size(); ++k) n += face_count(primitives[k]);
@@ -271,8 +271,7 @@ void add_noise(const CsgScene& scene, std::uint64_t seed, PointSet& points) {
   std::uniform_real_distribution<float> turn(0.0f, static_cast<float>(kTwoPi));
   for (std::size_t i = 0; i < points.size(); ++i) {
     const Vec3f n = points.normals[i];
-    const Vec3f t1 = normalized(cross(n, std::fabs(n.x) < 0.9f ? Vec3f{1, 0, 0} : Vec3f{0, 1, 0}));
-    const Vec3f t2 = cross(n, t1);
+    const auto [t1, t2] = tangent_frame(n);
     const float phi = turn(rng), angle = scene.normal_noise_degrees > 0 ? tilt(rng) : 0.0f;
     const Vec3f toward = t1 * std::cos(phi) + t2 * std::sin(phi);
     points.normals[i] = normalized(n * std::cos(angle) + toward * std::sin(angle));

@@ -9,35 +9,17 @@ namespace pointillist {
 namespace {
 
 Primitive box(Vec3f center, Vec3f half) {
-  Primitive p;
-  p.kind = PrimitiveKind::Box;
-  p.center = center;
-  p.half = half;
-  return p;
+  return {.kind = PrimitiveKind::Box, .center = center, .half = half};
 }
 Primitive sphere(Vec3f center, float radius) {
-  Primitive p;
-  p.kind = PrimitiveKind::Sphere;
-  p.center = center;
-  p.radius = radius;
-  return p;
+  return {.kind = PrimitiveKind::Sphere, .center = center, .radius = radius};
 }
 Primitive cylinder(Vec3f center, float radius, float half_length, int axis) {
-  Primitive p;
-  p.kind = PrimitiveKind::Cylinder;
-  p.center = center;
-  p.radius = radius;
-  p.half_length = half_length;
-  p.axis = axis;
-  return p;
+  return {.kind = PrimitiveKind::Cylinder, .center = center, .radius = radius,
+          .half_length = half_length, .axis = axis};
 }
 Primitive quad(Vec3f corner, Vec3f edge_u, Vec3f edge_v) {
-  Primitive p;
-  p.kind = PrimitiveKind::Quad;
-  p.center = corner;
-  p.edge_u = edge_u;
-  p.edge_v = edge_v;
-  return p;
+  return {.kind = PrimitiveKind::Quad, .center = corner, .edge_u = edge_u, .edge_v = edge_v};
 }
 
 const int kWedgeAngles[] = {20, 30, 45, 60, 90, 120, 150, 165};
@@ -55,8 +37,6 @@ void wedge(CsgScene& s, int degrees) {
 }
 
 }  // namespace
-
-std::uint32_t CsgScene::label_count() const { return first_label(primitives.size()); }
 
 std::vector<std::string> csg_scene_ids() {
   std::vector<std::string> ids = {"T1", "T2", "T3", "T4", "T5", "T6", "T7", "T8", "T9", "T10", "T11"};
@@ -111,9 +91,7 @@ CsgScene csg_scene(const std::string& id) {
     s.primitives = {sphere({0, 0, 0}, 1)};
     s.spacing = 0.025f;
   } else if (id == "T15") {
-    Primitive crease;
-    crease.kind = PrimitiveKind::Crease;
-    s.primitives = {crease};
+    s.primitives = {Primitive{.kind = PrimitiveKind::Crease}};
     s.op = CsgOp::Separate;
     s.spacing = 0.03f;
   }

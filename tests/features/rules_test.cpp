@@ -19,8 +19,7 @@ constexpr Vec3f kX{1, 0, 0}, kY{0, 1, 0}, kZ{0, 0, 1};
 // `kept` (points within 1e-4 of the region's boundary are skipped).
 double wrong_share(const Disc& s, const ClipResult& clip, const std::function<bool(Vec3f)>& kept,
                    const std::function<float(Vec3f)>& boundary_distance) {
-  const Vec3f helper = std::fabs(s.n.x) < 0.9f ? kX : kY;
-  const Vec3f u = normalized(cross(s.n, helper)), v = cross(s.n, u);
+  const auto [u, v] = tangent_frame(s.n);
   int total = 0, wrong = 0;
   constexpr int kSteps = 101;
   for (int a = 0; a < kSteps; ++a) {
@@ -38,8 +37,7 @@ double wrong_share(const Disc& s, const ClipResult& clip, const std::function<bo
 
 // Continuous neighbours of a splat on a plane: a ring around it within the face's region.
 std::vector<Vec3f> ring(const Disc& s, const std::function<bool(Vec3f)>& inside) {
-  const Vec3f helper = std::fabs(s.n.x) < 0.9f ? kX : kY;
-  const Vec3f u = normalized(cross(s.n, helper)), v = cross(s.n, u);
+  const auto [u, v] = tangent_frame(s.n);
   std::vector<Vec3f> out;
   for (int k = 0; k < 8; ++k) {
     const float a = k * kPi / 4;

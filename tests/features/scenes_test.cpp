@@ -40,14 +40,6 @@ Prepared prepare(const std::string& id, SamplingMode mode, FeatureOptions option
   return p;
 }
 
-struct Frame2 {
-  Vec3f u, v;
-};
-Frame2 tangent_frame(Vec3f n) {
-  const Vec3f u = normalized(cross(n, std::fabs(n.x) < 0.9f ? Vec3f{1, 0, 0} : Vec3f{0, 1, 0}));
-  return {u, cross(n, u)};
-}
-
 struct ClipCheck {
   std::size_t needs = 0, needs_and_clipped = 0;
   std::size_t points = 0, wrong = 0;  // disc points tested, and those the planes get wrong
@@ -88,7 +80,7 @@ ClipCheck check_clipping(const Prepared& p) {
     if (!csg_face_is_planar(p.scene, label)) continue;
     const Vec3f center = p.samples.points.positions[i], n = p.samples.points.normals[i];
     const float r = p.radii[i] * scale;
-    const Frame2 f = tangent_frame(n);
+    const TangentFrame f = tangent_frame(n);
     bool needs = false;
     for (int k = 0; k < 64 && !needs; ++k) {
       const float a = k * 2 * kPi / 64;

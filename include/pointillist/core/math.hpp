@@ -47,6 +47,16 @@ inline Vec3f normalized(Vec3f a, Vec3f fallback = {0, 0, 1}) {
   return len > 1e-30f ? a / len : fallback;
 }
 
+// Two unit vectors (u, v) completing a unit normal n to a right-handed frame, u = n × helper
+// normalised (helper +X, or +Y when n is near ±X), v = n × u: deterministic in n.
+struct TangentFrame {
+  Vec3f u, v;
+};
+inline TangentFrame tangent_frame(Vec3f n) {
+  const Vec3f u = normalized(cross(n, std::fabs(n.x) < 0.9f ? Vec3f{1, 0, 0} : Vec3f{0, 1, 0}));
+  return {u, cross(n, u)};
+}
+
 inline bool is_finite(Vec3f a) {
   return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z);
 }

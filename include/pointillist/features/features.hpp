@@ -159,6 +159,7 @@ struct FeatureStats {
   std::uint64_t nearest_rule = 0;   // splats clipped by ClipMode::Nearest
   std::uint64_t capped = 0;         // splats that had more than kMaxClipPlanes distinct planes
   float spread_deg = 0;             // neighbour normals: 3/4 of the pairs differ by at most this
+  bool threshold_raised = false;    // FeatureOptions::adapt_threshold raised it above the spread
   std::uint64_t segments = 0;       // surface ids
   std::uint64_t large_segments = 0;  // segments with at least 0.5 % of the splats
   // [k] = splats with k clip planes, k = 1..kMaxClipPlanes ([0] unused).

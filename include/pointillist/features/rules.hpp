@@ -35,11 +35,12 @@ struct Disc {
   float noise = 0;
 };
 
-// The tangent frame (u, v) of a unit normal n that Shape refers to (deterministic in n).
-struct TangentFrame {
-  Vec3f u, v;
-};
-TangentFrame tangent_frame(Vec3f n);
+// The surface's offset from its tangent plane along the normal at tangent offset w, in the
+// frame f that the shape refers to (tangent_frame of the normal): ½ wᵀ S w (toward −n).
+inline float sag(const Shape& k, const TangentFrame& f, Vec3f w) {
+  const float a = dot(w, f.u), b = dot(w, f.v);
+  return 0.5f * (k.xx * a * a + 2.0f * k.xy * a * b + k.yy * b * b);
+}
 
 // The shape operator at a splat (centre c, unit normal n) fitted by least squares to its
 // continuous neighbours: normal differences against centre differences, projected into the

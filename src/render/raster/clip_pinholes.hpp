@@ -6,8 +6,17 @@
 #include <span>
 
 #include "pointillist/core/math.hpp"
+#include "simd.hpp"
 
 namespace pointillist::render_detail {
+
+// Marks the lanes of `m` (pixels x0 + lane of row y) in `mask`, a row-major image `width` wide:
+// where a rasterizer's clip test discarded a covered pixel.
+inline void mark_lanes(std::uint8_t* mask, int width, Int4 m, int x0, int y) {
+  for (int l = 0; l < kLanes; ++l) {
+    if (m[l] && x0 + l < width) mask[static_cast<std::size_t>(y) * width + x0 + l] = 1;
+  }
+}
 
 // The widest gap filled, in pixels.
 inline constexpr int kMaxPinholeGap = 2;

@@ -111,10 +111,7 @@ void draw_splat(const float* s, const float* planes, const View& v, const Band& 
           if (!kAccumulate && (kFeat == kSameSurface || kFeat == kClipOnly)) {
             *band.clipped += render_detail::lane_count(cut);
             if (band.clip_mask != nullptr && any4(cut)) {
-              std::uint8_t* row = band.clip_mask + static_cast<std::size_t>(j) * band.width;
-              for (int l = 0; l < kLanes; ++l) {
-                if (cut[l] && k * kLanes + l < band.width) row[k * kLanes + l] = 1;
-              }
+              render_detail::mark_lanes(band.clip_mask, band.width, cut, k * kLanes, j);
             }
           }
           cover &= ~cut;

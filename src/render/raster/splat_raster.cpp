@@ -108,10 +108,7 @@ struct PixelClip {
   // the count, and marks them.
   void tally(Int4 m, int x0, int y) const {
     *discarded += render_detail::lane_count(m);
-    if (mask == nullptr) return;
-    for (int l = 0; l < kLanes; ++l) {
-      if (m[l] && x0 + l < width) mask[static_cast<std::size_t>(y) * width + x0 + l] = 1;
-    }
+    if (mask != nullptr) render_detail::mark_lanes(mask, width, m, x0, y);
   }
   // Lanes of pixel centres (px, py) whose fragment is discarded.
   Int4 operator()(Float4 px, float py) const {
