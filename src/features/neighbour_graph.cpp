@@ -8,6 +8,8 @@
 // into those splats' rows, so that one huge splat does not widen everybody's search.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <limits>
 #include <utility>
 
 #include "pointillist/features/neighbour_graph.hpp"
@@ -79,6 +81,68 @@ Grid make_grid(std::span<const Vec3f> centers, std::span<const float> radii) {
   return g;
 }
 
+// Four floats as one value (GCC and Clang vector extensions): the candidate test runs on four
+// candidates at once on any target, with the scalar test's exact rounding.
+using Lanes = float __attribute__((vector_size(16)));
+
+using Index4 = std::uint32_t __attribute__((vector_size(16)));
+
+// For each 4-bit mask of passing lanes, their lane numbers first (the rest is never read).
+constexpr Index4 kPack[16] = {
+    {0, 0, 0, 0}, {0, 0, 0, 0}, {1, 0, 0, 0}, {0, 1, 0, 0}, {2, 0, 0, 0}, {0, 2, 0, 0},
+    {1, 2, 0, 0}, {0, 1, 2, 0}, {3, 0, 0, 0}, {0, 3, 0, 0}, {1, 3, 0, 0}, {0, 1, 3, 0},
+    {2, 3, 0, 0}, {0, 2, 3, 0}, {1, 2, 3, 0}, {0, 1, 2, 3}};
+
+// How many lanes pass, per mask (a table: the baseline x86-64 target has no popcount).
+constexpr std::uint8_t kPassing[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4};
+
+// The lanes of a group of four that lie before the end of the run, `left` candidates on.
+inline unsigned tail_mask(std::uint32_t left) { return left >= 4 ? 15u : (1u << left) - 1u; }
+
+// The bounding spheres in cell order, one array a coordinate, so that a run of cells' candidates
+// is read four at a time; 4 NaN entries of padding make a read past the last one harmless.
+// Spheres wider than r_keep get NaN centres: no test accepts them.
+struct Candidates {
+  std::vector<float> x, y, z, r;
+
+  Candidates() = default;
+  Candidates(std::span<const Vec3f> centers, std::span<const float> radii,
+             std::span<const std::uint32_t> order, float r_keep) {
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const std::size_t n = order.size();
+    for (std::vector<float>* v : {&x, &y, &z, &r}) v->assign(n + 4, nan);
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::uint32_t i = order[k];
+      const bool kept = radii[i] <= r_keep;
+      x[k] = kept ? centers[i].x : nan;
+      y[k] = kept ? centers[i].y : nan;
+      z[k] = kept ? centers[i].z : nan;
+      r[k] = radii[i];
+    }
+  }
+  static Lanes lanes(const std::vector<float>& v, std::size_t k) {
+    Lanes out;
+    std::memcpy(&out, v.data() + k, sizeof out);
+    return out;
+  }
+};
+
+// Writes the distinct values v[0..n) to out in increasing order. Rows are short (a dozen
+// neighbours on a surface): each value's place is the count of smaller ones, found without a
+// branch, which is cheaper there than any comparison sort's mispredicted branches.
+void sort_distinct(const std::uint32_t* v, std::size_t n, std::uint32_t* out) {
+  if (n > 48) {
+    std::copy(v, v + n, out);
+    std::sort(out, out + n);
+    return;
+  }
+  for (std::size_t a = 0; a < n; ++a) {
+    std::uint32_t rank = 0;
+    for (std::size_t b = 0; b < n; ++b) rank += v[b] < v[a];
+    out[rank] = v[a];
+  }
+}
+
 // Adds each oversized splat (radius > r_cut) to the rows of its ordinary neighbours: its own
 // row is complete, theirs did not look that far. Rows stay sorted.
 void merge_oversized(NeighbourGraph& graph, std::span<const float> radii, float r_cut) {
@@ -117,15 +181,13 @@ NeighbourGraph build_neighbour_graph(std::span<const Vec3f> centers, std::span<c
   if (n == 0) return NeighbourGraph{{0}, {}};
   ProgressPhase phase(progress, "neighbour graph", n);
   const Grid grid = make_grid(centers, radii);
-  // Centres and radii in cell order, so that a cell's candidates are read contiguously.
-  std::vector<Vec3f> cell_centers(n);
-  std::vector<float> cell_radii(n);
-  for (std::size_t k = 0; k < n; ++k) {
-    cell_centers[k] = centers[grid.order[k]];
-    cell_radii[k] = radii[grid.order[k]];
-  }
   const float r_max = *std::max_element(radii.begin(), radii.end());
   const float r_cut = std::min(r_max, 2.0f * grid.median_radius);
+  // What ordinary splats search has the oversized splats' centres made NaN, so that the overlap
+  // test itself refuses them (they add their own edges) and the loop tests nothing else.
+  const Candidates ordinary(centers, radii, grid.order, r_cut);
+  const Candidates all = r_cut < r_max ? Candidates(centers, radii, grid.order, r_max) : Candidates{};
+
   // Blocks of splats in index order, each block's rows in one array, then concatenated.
   constexpr std::size_t kBlock = 2048;
   const std::size_t block_count = (n + kBlock - 1) / kBlock;
@@ -134,6 +196,9 @@ NeighbourGraph build_neighbour_graph(std::span<const Vec3f> centers, std::span<c
   graph.offsets.assign(n + 1, 0);
   pool.run(block_count, [&](std::size_t b) {
     std::vector<std::uint32_t>& out = rows[b];
+    // Positions (in cell order) of the candidates that pass, written without a branch: the
+    // test's outcome is close to random, and mispredicting it cost more than the test.
+    std::vector<std::uint32_t> hits(256);
     const std::size_t end = std::min(n, (b + 1) * kBlock);
     for (std::size_t i = b * kBlock; i < end; ++i) {
       const Vec3f ci = centers[i];
@@ -147,22 +212,43 @@ NeighbourGraph build_neighbour_graph(std::span<const Vec3f> centers, std::span<c
         lo[a] = grid.clamp_axis(ci[a] - reach, a);
         hi[a] = grid.clamp_axis(ci[a] + reach, a);
       }
-      const std::size_t first_entry = out.size();
+      const Candidates& cand = oversized ? all : ordinary;
+      const Lanes cx = ci.x - Lanes{}, cy = ci.y - Lanes{}, cz = ci.z - Lanes{},
+                  cr = ri - Lanes{};
+      std::size_t count = 0;
       for (int z = lo[2]; z <= hi[2]; ++z) {
         for (int y = lo[1]; y <= hi[1]; ++y) {
           const std::size_t row = (static_cast<std::size_t>(z) * grid.dims[1] + y) * grid.dims[0];
           const std::uint32_t first = grid.cell_start[row + lo[0]];
           const std::uint32_t last = grid.cell_start[row + hi[0] + 1];
-          for (std::uint32_t k = first; k < last; ++k) {
-            const float rk = cell_radii[k];
-            if ((oversized || rk <= r_cut) && spheres_overlap(ci, ri, cell_centers[k], rk) &&
-                grid.order[k] != i) {
-              out.push_back(grid.order[k]);
-            }
+          if (hits.size() < count + (last - first) + 4) hits.resize(2 * (count + (last - first) + 4));
+          std::uint32_t* const slots = hits.data();
+          for (std::uint32_t k = first; k < last; k += 4) {
+            // The same operations in the same order as spheres_overlap, four candidates at a time.
+            const Lanes dx = cx - cand.lanes(cand.x, k), dy = cy - cand.lanes(cand.y, k),
+                        dz = cz - cand.lanes(cand.z, k);
+            Lanes reach_sum = cr + cand.lanes(cand.r, k);
+            const auto inside = dx * dx + dy * dy + dz * dz < reach_sum * reach_sum;
+            const unsigned mask = ((inside[0] & 1) | (inside[1] & 2) | (inside[2] & 4) |
+                                   (inside[3] & 8)) & tail_mask(last - k);
+            // The passing lanes' positions, packed to the front of four slots.
+            const Index4 packed = k + kPack[mask];
+            std::memcpy(slots + count, &packed, sizeof packed);
+            count += kPassing[mask];
           }
         }
       }
-      std::sort(out.begin() + static_cast<std::ptrdiff_t>(first_entry), out.end());
+      // The hits' indices, i itself dropped, written back over the hits (each index is read
+      // before its slot can be overwritten), then sorted into the row.
+      std::size_t kept = 0;
+      for (std::size_t h = 0; h < count; ++h) {
+        const std::uint32_t j = grid.order[hits[h]];
+        hits[kept] = j;
+        kept += j != i;
+      }
+      const std::size_t first_entry = out.size();
+      out.resize(first_entry + kept);
+      sort_distinct(hits.data(), kept, out.data() + first_entry);
       graph.offsets[i + 1] = out.size() - first_entry;
     }
     progress.advance(end - b * kBlock);

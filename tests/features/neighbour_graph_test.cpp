@@ -70,6 +70,29 @@ TEST(NeighbourGraph, MatchesBruteForceOnAVolumeCloudWithDuplicates) {
                     build_neighbour_graph_brute_force(s.centers, s.radii));
 }
 
+TEST(NeighbourGraph, MatchesBruteForceOnDenseClustersWithLongRows) {
+  // Clusters of 150 splats that all overlap (rows past the short-row sort, runs of every length
+  // modulo four), on a sparse background of single splats.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  Splats s;
+  for (int cluster = 0; cluster < 4; ++cluster) {
+    const Vec3f at{u(rng) * 5, u(rng) * 5, u(rng) * 5};
+    for (int i = 0; i < 150 + cluster; ++i) {
+      s.centers.push_back(at + Vec3f{u(rng), u(rng), u(rng)} * 0.05f);
+      s.radii.push_back(0.06f + 0.01f * u(rng));
+    }
+  }
+  for (int i = 0; i < 3000; ++i) {
+    s.centers.push_back(Vec3f{u(rng), u(rng), u(rng)} * 5.0f);
+    s.radii.push_back(0.05f);
+  }
+  ThreadPool pool(2);
+  const NeighbourGraph grid = build_neighbour_graph(s.centers, s.radii, pool);
+  EXPECT_GE(grid.row(0).size(), 149u);
+  expect_same_graph(grid, build_neighbour_graph_brute_force(s.centers, s.radii));
+}
+
 TEST(NeighbourGraph, IsStrictAndSymmetric) {
   // d = r_a + r_b exactly is not an edge (eq. 3.1 is strict); slightly less is.
   const std::vector<Vec3f> c = {{0, 0, 0}, {1, 0, 0}, {0, 0.999f, 0}};
