@@ -36,6 +36,8 @@ Command add_demo_command(CLI::App& app);
 Command add_generate_command(CLI::App& app);
 Command add_compare_command(CLI::App& app);
 Command add_view_command(CLI::App& app);
+Command add_simplify_command(CLI::App& app);
+Command add_compare_surface_command(CLI::App& app);
 
 struct ConvertCommandOptions {
   std::vector<std::string> inputs;

@@ -27,7 +27,7 @@ int main(int argc, char** argv) {
   const std::vector<pc::Command> commands = {
       pc::add_convert_command(app), pc::add_render_command(app),  pc::add_info_command(app),
       pc::add_demo_command(app),    pc::add_generate_command(app), pc::add_compare_command(app),
-      pc::add_view_command(app)};
+      pc::add_view_command(app),    pc::add_simplify_command(app), pc::add_compare_surface_command(app)};
   if (const std::string error = pc::unknown_word(app, argc, argv); !error.empty()) {
     std::fprintf(stderr, "pointillist: error: %s\n", error.c_str());
     return 2;

@@ -126,6 +126,64 @@ double intersect_torus(const AnalyticShape& s, const double o[3], const double d
   return kInf;
 }
 
+struct LocalClosest {
+  double point[3];
+  double normal[3];
+  double distance;
+};
+
+// Closest surface point of one shape in its local frame (coordinates in double).
+LocalClosest local_closest(const AnalyticShape& s, const double p[3]) {
+  LocalClosest c{};
+  const double a = s.a;
+  switch (s.kind) {
+    case ShapeKind::Sphere: {
+      const double len = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+      for (int i = 0; i < 3; ++i) c.normal[i] = len > 0 ? p[i] / len : (i == 0 ? 1.0 : 0.0);
+      for (int i = 0; i < 3; ++i) c.point[i] = c.normal[i] * a;
+      c.distance = std::abs(len - a);
+      break;
+    }
+    case ShapeKind::Torus: {
+      // The torus is the set at distance b from the tube's centre circle, and the distance to
+      // that circle is 1-Lipschitz, so the nearest surface point lies on the line from the
+      // nearest circle point through p, inside the tube as well as outside.
+      const double rho = std::sqrt(p[0] * p[0] + p[2] * p[2]);
+      const double radial[3] = {rho > 0 ? p[0] / rho : 1.0, 0.0, rho > 0 ? p[2] / rho : 0.0};
+      const double ring[3] = {radial[0] * a, 0.0, radial[2] * a};
+      const double d[3] = {p[0] - ring[0], p[1], p[2] - ring[2]};
+      const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+      for (int i = 0; i < 3; ++i) c.normal[i] = len > 0 ? d[i] / len : radial[i];
+      for (int i = 0; i < 3; ++i) c.point[i] = ring[i] + c.normal[i] * s.b;
+      c.distance = std::abs(len - s.b);
+      break;
+    }
+    case ShapeKind::Cube: {
+      bool outside = false;
+      for (int i = 0; i < 3; ++i) {
+        c.point[i] = std::clamp(p[i], -a, a);
+        outside = outside || std::abs(p[i]) > a;
+      }
+      if (outside) {
+        const double d[3] = {p[0] - c.point[0], p[1] - c.point[1], p[2] - c.point[2]};
+        c.distance = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        for (int i = 0; i < 3; ++i) c.normal[i] = d[i] / c.distance;
+        break;
+      }
+      int axis = 0;
+      for (int i = 1; i < 3; ++i) {
+        if (std::abs(p[i]) > std::abs(p[axis])) axis = i;
+      }
+      const double sign = p[axis] >= 0 ? 1.0 : -1.0;
+      c.point[axis] = sign * a;
+      c.normal[axis] = sign;
+      c.distance = a - std::abs(p[axis]);
+      break;
+    }
+  }
+  return c;
+}
+
 }  // namespace
 
 AnalyticScene demo_scene() {
@@ -280,6 +338,32 @@ Aabb scene_bounds(const AnalyticScene& scene) {
     box.extend(s.center + Vec3f{r, r, r});
   }
   return box;
+}
+
+AnalyticClosest closest_point(const AnalyticScene& scene, Vec3f p) {
+  AnalyticClosest best{{}, {0, 0, 1}, kInf};
+  double best_distance = kInf;
+  for (const AnalyticShape& s : scene.shapes) {
+    const Vec3f axes[3] = {s.axis_x, s.axis_y, s.axis_z};
+    const double d[3] = {double(p.x) - s.center.x, double(p.y) - s.center.y,
+                         double(p.z) - s.center.z};
+    double local[3];
+    for (int i = 0; i < 3; ++i) local[i] = d[0] * axes[i].x + d[1] * axes[i].y + d[2] * axes[i].z;
+    const LocalClosest c = local_closest(s, local);
+    if (!(c.distance < best_distance)) continue;
+    best_distance = c.distance;
+    double point[3] = {s.center.x, s.center.y, s.center.z}, normal[3] = {0, 0, 0};
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) {
+        point[j] += c.point[i] * axes[i][j];
+        normal[j] += c.normal[i] * axes[i][j];
+      }
+    }
+    best.point = {float(point[0]), float(point[1]), float(point[2])};
+    best.normal = normalized(Vec3f{float(normal[0]), float(normal[1]), float(normal[2])});
+    best.distance = float(c.distance);
+  }
+  return best;
 }
 
 }  // namespace pointillist

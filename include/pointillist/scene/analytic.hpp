@@ -79,4 +79,18 @@ RayCastImage ray_cast_image(const AnalyticScene& scene, const Camera& camera);
 // Bounding box of the scene's surfaces.
 Aabb scene_bounds(const AnalyticScene& scene);
 
+struct AnalyticClosest {
+  Vec3f point;     // nearest surface point (world)
+  Vec3f normal;    // unit outward normal there; off the surface near a cube's edge or corner, the
+                   // direction from the point to the query (the distance's gradient)
+  float distance;  // unsigned distance from the query to `point` (world units)
+};
+
+// Exact closest surface point to `p` over all shapes, each in its own frame (center, axis_x/y/z):
+// sphere |‖p−c‖ − a|; torus |√((√(x²+z²) − a)² + y²) − b| (a ≥ b); cube: the box's nearest point,
+// points inside it projected to the nearest face (ties go to the lower axis). Where several
+// surface points are equally near (a sphere's or torus' centre, the torus' axis) one of them is
+// returned; ties between shapes go to the lower shape index. An empty scene gives distance +inf.
+AnalyticClosest closest_point(const AnalyticScene& scene, Vec3f p);
+
 }  // namespace pointillist

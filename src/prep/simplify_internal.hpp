@@ -1,0 +1,111 @@
+// What the simplification methods share (simplify.cpp, simplify_clusters.cpp,
+// simplify_quadric.cpp).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "pointillist/core/point_set.hpp"
+#include "pointillist/core/progress.hpp"
+#include "pointillist/core/thread_pool.hpp"
+#include "pointillist/prep/simplify.hpp"
+
+namespace pointillist::simplify_detail {
+
+// A partition of the input: point i belongs to cluster of[i], ids 0 .. count - 1.
+struct Clusters {
+  std::vector<std::uint32_t> of;
+  std::uint32_t count = 0;
+};
+
+// The mean of `count` colours summed per channel, rounded.
+Rgb8 mean_color(const std::array<double, 3>& sum, double count);
+
+// vᵀAv + 2bᵀv + c, A symmetric (in coordinates relative to an origin the caller chooses).
+struct Quadric {
+  double a[6] = {0, 0, 0, 0, 0, 0};  // xx xy xz yy yz zz
+  double b[3] = {0, 0, 0};
+  double c = 0;
+
+  void add_plane(const double m[3], const double q[3], double weight) {
+    const double d = m[0] * q[0] + m[1] * q[1] + m[2] * q[2];
+    a[0] += weight * m[0] * m[0], a[1] += weight * m[0] * m[1], a[2] += weight * m[0] * m[2];
+    a[3] += weight * m[1] * m[1], a[4] += weight * m[1] * m[2], a[5] += weight * m[2] * m[2];
+    for (int i = 0; i < 3; ++i) b[i] -= weight * d * m[i];
+    c += weight * d * d;
+  }
+  void add_point(const double q[3], double weight) {
+    a[0] += weight, a[3] += weight, a[5] += weight;
+    for (int i = 0; i < 3; ++i) b[i] -= weight * q[i];
+    c += weight * (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+  }
+  Quadric& operator+=(const Quadric& o) {
+    for (int i = 0; i < 6; ++i) a[i] += o.a[i];
+    for (int i = 0; i < 3; ++i) b[i] += o.b[i];
+    c += o.c;
+    return *this;
+  }
+  double at(const double v[3]) const {
+    const double ax = a[0] * v[0] + a[1] * v[1] + a[2] * v[2];
+    const double ay = a[1] * v[0] + a[3] * v[1] + a[4] * v[2];
+    const double az = a[2] * v[0] + a[4] * v[1] + a[5] * v[2];
+    return std::max(0.0, v[0] * ax + v[1] * ay + v[2] * az +
+                             2.0 * (b[0] * v[0] + b[1] * v[1] + b[2] * v[2]) + c);
+  }
+  // The minimiser of the quadric (A must be positive definite) and the value there, c + bᵀv.
+  double minimise(double v[3]) const {
+    const double m00 = a[3] * a[5] - a[4] * a[4], m01 = a[2] * a[4] - a[1] * a[5],
+                 m02 = a[1] * a[4] - a[2] * a[3];
+    const double det = a[0] * m00 + a[1] * m01 + a[2] * m02;
+    const double m11 = a[0] * a[5] - a[2] * a[2], m12 = a[1] * a[2] - a[0] * a[4],
+                 m22 = a[0] * a[3] - a[1] * a[1];
+    const double r[3] = {-b[0], -b[1], -b[2]};
+    v[0] = (m00 * r[0] + m01 * r[1] + m02 * r[2]) / det;
+    v[1] = (m01 * r[0] + m11 * r[1] + m12 * r[2]) / det;
+    v[2] = (m02 * r[0] + m12 * r[1] + m22 * r[2]) / det;
+    return std::max(0.0, c + b[0] * v[0] + b[1] * v[1] + b[2] * v[2]);
+  }
+};
+
+// Where a cluster's point goes on the surface its members sample: the midpoint of their
+// centroid and the point nearest their tangent planes (`planes`: one plane per member, or per
+// member and neighbour; `around`: Σ|v − q|² over the members), which lie on either side of a
+// curved patch by the same second-order amount (simplify_quadric.cpp). `keep_solvable` weighs
+// `around` into the planes' system so that flat and linear clusters have a minimiser.
+void surface_point(const Quadric& planes, const Quadric& around, double keep_solvable,
+                   double v[3]);
+
+// One output point per cluster, in id order: the members' centroid (or, `on_surface`, the
+// surface_point of their tangent planes and centroid), their mean normal (normalized; a
+// member's own when they cancel) and mean colour.
+PointSet cluster_means(const PointSet& in, const Clusters& clusters, bool on_surface = false);
+
+// First and second moments of a set of points, in double, relative to `origin` (scans far from
+// the world origin lose nothing).
+struct Moments {
+  Vec3f origin;
+  double n = 0;
+  double s[3] = {0, 0, 0};
+  double ss[6] = {0, 0, 0, 0, 0, 0};  // xx xy xz yy yz zz
+  void add(Vec3f p);
+  void add(const Moments& other);  // same origin
+};
+
+// The shape of a cluster: centroid, eigenvalues of its covariance (increasing) and the unit
+// eigenvectors of the smallest (normal) and largest (main axis).
+struct Spread {
+  Vec3f centroid;
+  double lambda[3] = {0, 0, 0};
+  Vec3f normal{0, 0, 1}, major{1, 0, 0};
+  double variation() const;  // λ0 / (λ0 + λ1 + λ2): 0 flat, 1/3 isotropic
+};
+Spread spread_of(const Moments& m);
+
+Clusters hierarchical_clusters(const PointSet& in, std::size_t target, Progress& progress);
+Clusters incremental_clusters(const PointSet& in, std::size_t target, std::uint32_t k,
+                              ThreadPool& pool, Progress& progress, int* passes);
+PointSet quadric_simplify(const PointSet& in, const SimplifyOptions& options, ThreadPool& pool,
+                          Progress& progress);
+
+}  // namespace pointillist::simplify_detail
