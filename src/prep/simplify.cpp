@@ -224,26 +224,19 @@ Spread spread_of(const Moments& m) {
   return out;
 }
 
-void surface_point(const Quadric& planes, const Quadric& around, double keep_solvable,
-                   double v[3]) {
-  Quadric q = around;
-  for (double& x : q.a) x *= keep_solvable;
-  for (double& x : q.b) x *= keep_solvable;
-  q.c *= keep_solvable;
-  q += planes;
-  double on_planes[3], centroid[3];
-  q.minimise(on_planes);
-  around.minimise(centroid);
-  for (int i = 0; i < 3; ++i) v[i] = 0.5 * (on_planes[i] + centroid[i]);
+Vec3f fitted_normal(const Moments& m, Vec3f mean_normal) {
+  if (m.n < 3) return mean_normal;
+  const Spread s = spread_of(m);
+  if (!(s.lambda[1] > 4 * s.lambda[0])) return mean_normal;
+  return dot(s.normal, mean_normal) < 0 ? -s.normal : s.normal;
 }
 
-PointSet cluster_means(const PointSet& in, const Clusters& clusters, bool on_surface) {
+PointSet cluster_means(const PointSet& in, const Clusters& clusters, bool fit_plane) {
   const std::size_t k = clusters.count;
   std::vector<Moments> m(k);
   std::vector<Vec3f> normal_sum(k, Vec3f{}), first_normal(k, Vec3f{});
   std::vector<std::array<double, 3>> color_sum(k, {0, 0, 0});
   std::vector<std::uint8_t> seen(k, 0);
-  std::vector<Quadric> planes(on_surface ? k : 0), around(on_surface ? k : 0);
   for (std::size_t i = 0; i < in.size(); ++i) {
     const std::uint32_t c = clusters.of[i];
     if (!seen[c]) {
@@ -252,14 +245,7 @@ PointSet cluster_means(const PointSet& in, const Clusters& clusters, bool on_sur
       first_normal[c] = in.normals[i];
     }
     m[c].add(in.positions[i]);
-    if (on_surface) {  // relative to the cluster's first member, as the moments
-      const Vec3f d = in.positions[i] - m[c].origin;
-      const double q[3] = {d.x, d.y, d.z};
-      const Vec3f nn = normalized(in.normals[i]);
-      const double nd[3] = {nn.x, nn.y, nn.z};
-      planes[c].add_plane(nd, q, 1.0);
-      around[c].add_point(q, 1.0);
-    }
+
     normal_sum[c] += in.normals[i];
     if (in.has_colors()) {
       color_sum[c][0] += in.colors[i].r, color_sum[c][1] += in.colors[i].g;
@@ -277,13 +263,9 @@ PointSet cluster_means(const PointSet& in, const Clusters& clusters, bool on_sur
     const double inv = m[c].n > 0 ? 1.0 / m[c].n : 0.0;
     out.positions[c] = m[c].origin + Vec3f{float(m[c].s[0] * inv), float(m[c].s[1] * inv),
                                            float(m[c].s[2] * inv)};
-    if (on_surface) {
-      double v[3];
-      surface_point(planes[c], around[c], 1e-3, v);
-      out.positions[c] = m[c].origin + Vec3f{float(v[0]), float(v[1]), float(v[2])};
-    }
     const float len = length(normal_sum[c]);
     out.normals[c] = len > 1e-6f ? normal_sum[c] / len : first_normal[c];
+    if (fit_plane) out.normals[c] = fitted_normal(m[c], out.normals[c]);
     if (in.has_colors()) out.colors[c] = mean_color(color_sum[c], m[c].n);
   }
   return out;

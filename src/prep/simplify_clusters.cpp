@@ -128,7 +128,8 @@ Clusters grow(const PointSet& in, std::span<const std::uint32_t> knn, std::uint3
         const std::uint32_t q = knn[std::size_t{j} * k + t];
         if (c.of[q] == kNone) near.push({length_squared(in.positions[q] - at), q});
       }
-      if (size >= 4 && spread_of(m).variation() >= kMaxVariation) break;
+      // (Checked every fourth member: the eigen decomposition costs more than the growth.)
+      if (size >= 4 && size % 4 == 0 && spread_of(m).variation() >= kMaxVariation) break;
     }
     while (!near.empty()) {  // the border: the next clusters start here
       if (c.of[near.top().second] == kNone) seeds.push(near.top().second);
@@ -200,26 +201,33 @@ Clusters incremental_clusters(const PointSet& in, std::size_t target, std::uint3
   k = static_cast<std::uint32_t>(std::min<std::size_t>(k, n - 1));
   const std::vector<std::uint32_t> knn =
       k_nearest_neighbours(in.positions, pool, KnnOptions{.k = k});
-  // The largest cluster size that still gives at least `target` clusters (more clusters with
-  // smaller sizes), found by bisection; then the smallest clusters are merged down to target.
-  // (Sizes below `lo` all give enough; the size-1 clustering, one point each, is only grown
-  // when no larger size does.)
-  std::uint32_t lo = 1, hi = static_cast<std::uint32_t>(std::max<std::size_t>(2, 4 * n / target));
+  // The largest cluster size that still gives at least `target` clusters (the count falls
+  // about as 1 / size: a secant step from n / target, at most 6 passes), then the smallest
+  // clusters are merged down to the target.
+  std::uint32_t size = static_cast<std::uint32_t>(std::max<std::size_t>(1, n / target));
+  std::uint32_t best_size = 0, fewest_too_large = UINT32_MAX;
   Clusters best;
   int count = 0;
-  while (hi - lo > 1) {
-    const std::uint32_t mid = lo + (hi - lo) / 2;
-    Clusters c = grow(in, knn, k, mid);
+  for (int pass = 0; pass < 6; ++pass) {
+    Clusters c = grow(in, knn, k, size);
     ++count;
+    const double step = double(c.count) / double(target);
     if (c.count >= target) {
-      lo = mid;
-      best = std::move(c);
+      if (size > best_size) {
+        best_size = size;
+        best = std::move(c);
+      }
     } else {
-      hi = mid;
+      fewest_too_large = std::min(fewest_too_large, size);
     }
+    auto next = static_cast<std::uint32_t>(std::max(1.0, std::floor(double(size) * step)));
+    if (next >= fewest_too_large) next = fewest_too_large - 1;
+    if (next <= best_size) next = best_size + 1;
+    if (next >= fewest_too_large || next == size) break;
+    size = next;
   }
-  if (best.count == 0) {
-    best = grow(in, knn, k, lo);
+  if (best_size == 0) {  // every size tried gives too few: one point a cluster gives n
+    best = grow(in, knn, k, 1);
     ++count;
   }
   if (passes) *passes = count;

@@ -68,18 +68,11 @@ struct Quadric {
   }
 };
 
-// Where a cluster's point goes on the surface its members sample: the midpoint of their
-// centroid and the point nearest their tangent planes (`planes`: one plane per member, or per
-// member and neighbour; `around`: Σ|v − q|² over the members), which lie on either side of a
-// curved patch by the same second-order amount (simplify_quadric.cpp). `keep_solvable` weighs
-// `around` into the planes' system so that flat and linear clusters have a minimiser.
-void surface_point(const Quadric& planes, const Quadric& around, double keep_solvable,
-                   double v[3]);
-
-// One output point per cluster, in id order: the members' centroid (or, `on_surface`, the
-// surface_point of their tangent planes and centroid), their mean normal (normalized; a
-// member's own when they cancel) and mean colour.
-PointSet cluster_means(const PointSet& in, const Clusters& clusters, bool on_surface = false);
+// One output point per cluster, in id order: the members' centroid, their mean normal
+// (normalized; a member's own when they cancel) and mean colour. With `fit_plane`, the normal
+// of a cluster of three or more members that spread over a plane is their least-squares
+// plane's (fitted_normal).
+PointSet cluster_means(const PointSet& in, const Clusters& clusters, bool fit_plane = false);
 
 // First and second moments of a set of points, in double, relative to `origin` (scans far from
 // the world origin lose nothing).
@@ -101,6 +94,13 @@ struct Spread {
   double variation() const;  // λ0 / (λ0 + λ1 + λ2): 0 flat, 1/3 isotropic
 };
 Spread spread_of(const Moments& m);
+
+// The disc that represents a cluster best is its members' least-squares plane: through their
+// centroid, normal to their covariance's least eigenvector (oriented as `mean_normal`). Used
+// when the members are at least 3 and spread over a plane (λ1 > 4 λ0); else `mean_normal`.
+// Measured against the members' mean normal (5 % of the dragon, quadric clusters): backward
+// distance 0.072 -> 0.066 ×10⁻³ of the diagonal, normal error 4.3° -> 3.7°.
+Vec3f fitted_normal(const Moments& m, Vec3f mean_normal);
 
 Clusters hierarchical_clusters(const PointSet& in, std::size_t target, Progress& progress);
 Clusters incremental_clusters(const PointSet& in, std::size_t target, std::uint32_t k,

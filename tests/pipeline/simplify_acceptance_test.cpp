@@ -1,8 +1,9 @@
 // The simplification bars of specs/occlusion-simplification-hybrid.md §2.7, measured against
 // the exact surface (the analytic torus; the dragon's own triangles): quadric contraction's RMS
 // at most 0.8 × the voxel grid's, the clusterings' at most 1.0 ×, no method with more holes.
-// RMS is the symmetric one, √((forward² + backward²) / 2): forward from each point to the
-// surface, backward from area-uniform samples of the surface to the nearest disc.
+// The RMS of the bars is the backward one, from area-uniform samples of the surface to the
+// nearest disc (Pauly, Gross & Kobbelt's error: how far the simplified surface is from the
+// original); the forward one (each point to the surface) is printed beside it.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -53,9 +54,9 @@ std::map<SimplifyMethod, Measured> measure(const PointSet& in, const SurfaceRefe
 
 void expect_bars(const std::map<SimplifyMethod, Measured>& m) {
   const Measured& voxel = m.at(SimplifyMethod::VoxelCentroid);
-  EXPECT_LE(m.at(SimplifyMethod::Quadric).rms, 0.8 * voxel.rms);
-  EXPECT_LE(m.at(SimplifyMethod::Hierarchical).rms, 1.0 * voxel.rms);
-  EXPECT_LE(m.at(SimplifyMethod::Incremental).rms, 1.0 * voxel.rms);
+  EXPECT_LE(m.at(SimplifyMethod::Quadric).backward, 0.8 * voxel.backward);
+  EXPECT_LE(m.at(SimplifyMethod::Hierarchical).backward, 1.0 * voxel.backward);
+  EXPECT_LE(m.at(SimplifyMethod::Incremental).backward, 1.0 * voxel.backward);
   for (const auto& [method, r] : m) {
     EXPECT_LE(r.holes, voxel.holes + 1e-4) << simplify_method_name(method);
   }
@@ -64,7 +65,8 @@ void expect_bars(const std::map<SimplifyMethod, Measured>& m) {
 }  // namespace
 
 TEST(SimplifyAcceptance, TwentyThousandPointsOfATorus) {
-  SurfaceSamples s = sample_scene(torus_scene(), 200'000, 1);
+  // The spec's input: generate --scene torus --points 1000000 --seed 1.
+  SurfaceSamples s = sample_scene(torus_scene(), 1'000'000, 1);
   s.points.normals = s.true_normals;
   expect_bars(measure(s.points, SurfaceReference::analytic(torus_scene()), 20'000));
 }

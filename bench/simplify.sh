@@ -1,0 +1,73 @@
+#!/usr/bin/env bash
+# Point-set simplification, the table of specs/occlusion-simplification-hybrid.md §2.7: every
+# method on the analytic sphere, torus and cube (1 M samples to 100 k, 20 k and 5 k; exact
+# distances), the dragon at 10, 5 and 1 % (against its own triangles) and the lion scan (against
+# its points' local planes), with the time and peak memory of each `simplify` process.
+#   bash bench/simplify.sh [WORKDIR]      (SIMPLIFY_QUICK=1: the torus at 20 k and the dragon at 5 % only)
+# Distances are in 1e-3 of the reference's bounding-box diagonal; rms is the symmetric one,
+# sqrt((forward^2 + backward^2) / 2); "×voxel" is the backward RMS (the spec's bars) against the
+# voxel grid's, the baseline of each row group.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cli=build/release/pointillist
+[ -x "$cli" ] || { echo "bench: build first (make build)" >&2; exit 1; }
+models="${POINTILLIST_MODELS:-${XDG_CACHE_HOME:-$HOME/.cache}/pointillist/models}"
+work=${1:-$(mktemp -d)}
+mkdir -p "$work"
+methods="voxel voxel-nearest random hierarchical incremental quadric"
+
+echo "| input | points | method | forward rms | backward rms | rms | ×voxel | Hausdorff | holes % | normal° mean / p95 | s | peak MB |"
+echo "| --- | ---: | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"
+
+# row NAME INPUT TARGET REFERENCE-ARGS...
+row_group() {
+  local name=$1 input=$2 target=$3
+  shift 3
+  local voxel_rms=""
+  for m in $methods; do
+    local t
+    t=$( { /usr/bin/time -f "%e %M" "$cli" simplify $input -o "$work/s.ply" --points "$target" \
+           --method "$m" -q; } 2>&1 | tail -1)
+    "$cli" compare-surface "$work/s.ply" "$@" --json "$work/e.json" > /dev/null
+    local rms
+    rms=$(jq -r '((.forward.rms * .forward.rms + .backward.rms * .backward.rms) / 2 | sqrt)' "$work/e.json")
+    [ "$m" = voxel ] && voxel_rms=$(jq -r '.backward.rms' "$work/e.json")
+    jq -r --arg name "$name" --arg m "$m" --arg rms "$rms" --arg base "$voxel_rms" --arg t "$t" '
+      ($t | split(" ")) as $tm |
+      "| \($name) | \(.splats) | \($m) | \(.forward.rms * 1e4 | round / 1e4) | \(.backward.rms * 1e4 | round / 1e4) | \($rms | tonumber * 1e4 | round / 1e4) | \(.backward.rms / ($base | tonumber) * 100 | round / 100) | \(.hausdorff * 1e3 | round / 1e3) | \(.hole_fraction * 1e5 | round / 1e3) | \(.normal_mean_deg * 100 | round / 100) / \(.normal_p95_deg * 100 | round / 100) | \($tm[0]) | \($tm[1] | tonumber / 1024 | round) |"' \
+      "$work/e.json"
+  done
+}
+
+if [ -n "${SIMPLIFY_QUICK:-}" ]; then
+  "$cli" generate --scene torus --points 1000000 --seed 1 --with-normals -o "$work/torus.ply" -q
+  row_group "torus" "$work/torus.ply" 20000 --reference-scene torus
+else
+  for shape in sphere torus cube; do
+    "$cli" generate --scene $shape --points 1000000 --seed 1 --with-normals -o "$work/$shape.ply" -q
+    for target in 100000 20000 5000; do
+      row_group "$shape" "$work/$shape.ply" $target --reference-scene $shape
+    done
+  done
+fi
+
+dragon="$models/dragon_vrip.ply.gz"
+if [ -f "$dragon" ]; then
+  targets="43765 21882 4376"
+  [ -n "${SIMPLIFY_QUICK:-}" ] && targets=21882
+  for target in $targets; do
+    row_group "dragon" "$dragon" $target --reference "$dragon"
+  done
+else
+  echo "(dragon not fetched: bash scripts/fetch-models.sh)"
+fi
+
+lion="$models/lion_takanawa_las"
+if [ -d "$lion" ] && [ -z "${SIMPLIFY_QUICK:-}" ]; then
+  # The lion's 200 tiles as one cloud (its reference: the same points' local planes).
+  "$cli" convert "$lion"/*.las -o "$work/lion.ply" -q
+  n=$(head -c 4096 "$work/lion.ply" | grep -a "element vertex" | awk '{print $3}')
+  for pct in 10 5 1; do
+    row_group "lion" "$work/lion.ply" $(( n * pct / 100 )) --reference "$work/lion.ply"
+  done
+fi
