@@ -2,7 +2,8 @@
 # Point-set simplification, the table of specs/occlusion-simplification-hybrid.md §2.7: every
 # method on the analytic sphere, torus and cube (1 M samples to 100 k, 20 k and 5 k; exact
 # distances), the dragon at 10, 5 and 1 % (against its own triangles) and the lion scan (against
-# its points' local planes), with the time and peak memory of each `simplify` process.
+# its points' local planes), with the time and peak memory of each `simplify` process; and the
+# cut of our own QSplat hierarchy at one node size (qsplat-cut), what it draws above the leaves.
 #   bash bench/simplify.sh [WORKDIR]      (SIMPLIFY_QUICK=1: the torus at 20 k and the dragon at 5 % only)
 # Distances are in 1e-3 of the reference's bounding-box diagonal; rms is the symmetric one,
 # sqrt((forward^2 + backward^2) / 2); "×voxel" is the backward RMS (the spec's bars) against the
@@ -14,7 +15,7 @@ cli=build/release/pointillist
 models="${POINTILLIST_MODELS:-${XDG_CACHE_HOME:-$HOME/.cache}/pointillist/models}"
 work=${1:-$(mktemp -d)}
 mkdir -p "$work"
-methods="voxel voxel-nearest random hierarchical incremental quadric"
+methods="voxel voxel-nearest random hierarchical incremental quadric qsplat-cut"
 
 echo "| input | points | method | forward rms | backward rms | rms | ×voxel | Hausdorff | holes % | normal° mean / p95 | s | peak MB |"
 echo "| --- | ---: | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"
@@ -34,7 +35,7 @@ row_group() {
     [ "$m" = voxel ] && voxel_rms=$(jq -r '.backward.rms' "$work/e.json")
     jq -r --arg name "$name" --arg m "$m" --arg rms "$rms" --arg base "$voxel_rms" --arg t "$t" '
       ($t | split(" ")) as $tm |
-      "| \($name) | \(.splats) | \($m) | \(.forward.rms * 1e4 | round / 1e4) | \(.backward.rms * 1e4 | round / 1e4) | \($rms | tonumber * 1e4 | round / 1e4) | \(.backward.rms / ($base | tonumber) * 100 | round / 100) | \(.hausdorff * 1e3 | round / 1e3) | \(.hole_fraction * 1e5 | round / 1e3) | \(.normal_mean_deg * 100 | round / 100) / \(.normal_p95_deg * 100 | round / 100) | \($tm[0]) | \($tm[1] | tonumber / 1024 | round) |"' \
+      "| \($name) | \(.splats) | \($m) | \(.forward.rms * 1e4 | round / 1e4) | \(.backward.rms * 1e4 | round / 1e4) | \($rms | tonumber * 1e4 | round / 1e4) | \(if ($base | tonumber) > 0 then (.backward.rms / ($base | tonumber) * 100 | round / 100) else "-" end) | \(.hausdorff * 1e3 | round / 1e3) | \(.hole_fraction * 1e5 | round / 1e3) | \(.normal_mean_deg * 100 | round / 100) / \(.normal_p95_deg * 100 | round / 100) | \($tm[0]) | \($tm[1] | tonumber / 1024 | round) |"' \
       "$work/e.json"
   done
 }

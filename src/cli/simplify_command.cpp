@@ -13,6 +13,7 @@
 #include "util.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/io/merge.hpp"
+#include "pointillist/lod/sphere_tree.hpp"
 #include "pointillist/pipeline/convert.hpp"
 #include "pointillist/prep/simplify.hpp"
 
@@ -44,7 +45,9 @@ int run_simplify(SimplifyCommandOptions& o) {
   if (o.ratio > 0 && !(o.ratio <= 1)) {
     throw OptionError("simplify: --ratio must be in (0, 1], the share of the points to keep");
   }
-  o.simplify.method = parse_simplify_method(o.method);
+  // The hierarchy's own interior nodes, as a simplification to measure the others against.
+  const bool tree_cut = o.method == "qsplat-cut";
+  if (!tree_cut) o.simplify.method = parse_simplify_method(o.method);
   ThreadPool pool(o.threads);
   TerminalProgress progress(!o.quiet && TerminalProgress::stderr_is_terminal());
   std::vector<std::string> warnings;
@@ -58,13 +61,21 @@ int run_simplify(SimplifyCommandOptions& o) {
   prepare.input_name = input_names(o.inputs);
   prepare_splats(points, pool, progress, prepare);  // normals (the radii are not kept)
   SimplifyReport report;
-  PointSet simplified =
-      simplify_points(points, o.simplify, pool, progress, &report, prepare.input_name);
+  PointSet simplified;
+  if (tree_cut) {
+    simplified = sphere_tree_cut(build_sphere_tree(points, pool, progress), o.simplify.target);
+    simplified.comments = points.comments;
+    simplified.origin = points.origin;
+    simplified.up = points.up;
+    report.output = simplified.size();
+  } else {
+    simplified = simplify_points(points, o.simplify, pool, progress, &report, prepare.input_name);
+  }
   points = PointSet{};
   const double simplify_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  // The new points are a cloud: their radii come from their own spacing (cloud_radii), the
-  // normals are the clusters'.
+  // The new points are a cloud: their radii come from their own spacing (cloud_radii; the
+  // hierarchy's nodes keep their spheres' radii), the normals are the clusters'.
   ConvertOptions convert = o.convert;
   convert.prepare.normals = NormalSource::Keep;
   const ConvertResult r = convert_points(std::move(simplified), o.inputs, o.output, convert, pool,
@@ -74,7 +85,7 @@ int run_simplify(SimplifyCommandOptions& o) {
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::printf("simplified %zu points to %zu (%s", input_points, report.output,
-                std::string(simplify_method_name(o.simplify.method)).c_str());
+                tree_cut ? "qsplat-cut" : std::string(simplify_method_name(o.simplify.method)).c_str());
     if (report.voxel_size > 0) std::printf(", cells of %g", double(report.voxel_size));
     std::printf(") in %.2f s, written in %.2f s -> %s\n", simplify_seconds,
                 seconds - simplify_seconds, o.output.c_str());
@@ -102,7 +113,8 @@ Command add_simplify_command(CLI::App& app) {
                   "quadric (pairs contracted by quadric error: the least error, the default), "
                   "voxel (a centroid per grid cell, as PCL and Open3D), voxel-nearest (the "
                   "point nearest each cell's centroid), hierarchical or incremental "
-                  "(clustering), random")
+                  "(clustering), random; or qsplat-cut (the nodes the QSplat hierarchy draws at "
+                  "one sphere size, to compare)")
       ->default_val("quadric");
   cmd->add_option("--voxel-size", o->simplify.voxel_size,
                   "voxel methods: the cell side in model units (default: the size that gives "

@@ -114,4 +114,13 @@ SphereTree build_top_tree(std::span<const SphereNode> roots, bool has_colors);
 // Point Tree) be built from a model file that stores a sphere tree.
 PointSet sphere_tree_leaves(const SphereTreeView& tree);
 
+// What QSplat draws when it stops above the leaves, as points: the cut of `tree` at one sphere
+// size, each node whose radius is at most r (or a leaf) under a parent larger than r, with r
+// chosen (bisected) so that the cut has the number of nodes nearest `target`. A node gives its
+// sphere's centre and radius, its mean normal and colour (the tree's colours, when it has them).
+// This is what a view-independent threshold selects from the hierarchy, and measures how well
+// its interior nodes stand for the surface (simplify --method qsplat-cut). Comments, origin and
+// up are the caller's to set.
+PointSet sphere_tree_cut(const SphereTree& tree, std::size_t target);
+
 }  // namespace pointillist
