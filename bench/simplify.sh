@@ -72,3 +72,35 @@ if [ -d "$lion" ] && [ -z "${SIMPLIFY_QUICK:-}" ]; then
     row_group "lion" "$work/lion.ply" $(( n * pct / 100 )) --reference "$work/lion.ply"
   done
 fi
+
+# Images (spec §2.7): each method's 5 % of the dragon rendered at the README's four views with
+# circle and ellipse splats, against the mesh drawn by `render --mode reference`, all with the
+# mesh's camera (its view sphere, as `info` prints it; the default orbit distance of fov 30°).
+if [ -f "$dragon" ]; then
+  read -r cx cy cz r < <("$cli" info "$dragon" | awk '/^view sphere:/ {
+    gsub(/[(),]/, " "); print $4, $5, $6, $8 }')
+  views="0,0 135,20 270,-10 60,45"
+  cam() {  # cam AZ EL: the --eye/--target of orbit_camera for up = +y
+    awk -v az="$1" -v el="$2" -v cx="$cx" -v cy="$cy" -v cz="$cz" -v r="$r" 'BEGIN {
+      pi = atan2(0, -1); a = az * pi / 180; e = el * pi / 180; d = 1.05 / sin(15 * pi / 180) * r
+      printf "--eye %.7g,%.7g,%.7g --target %.7g,%.7g,%.7g\n", cx + d * cos(e) * sin(a),
+        cy + d * sin(e), cz + d * cos(e) * cos(a), cx, cy, cz }'
+  }
+  for v in $views; do
+    "$cli" render "$dragon" --mode reference -o "$work/ref_${v}.png" --size 640x480 $(cam ${v%,*} ${v#*,}) -q
+  done
+  echo
+  echo "| dragon 5 % | splat | PSNR dB | SSIM | silhouette IoU | hole px |"
+  echo "| --- | --- | ---: | ---: | ---: | ---: |"
+  for m in voxel hierarchical incremental quadric qsplat-cut; do
+    "$cli" simplify "$dragon" -o "$work/img.ptl" --points 21882 --method "$m" -q
+    for k in circle ellipse; do
+      : > "$work/img.jsonl"
+      for v in $views; do
+        "$cli" render "$work/img.ptl" -o "$work/img.png" --size 640x480 --splat $k $(cam ${v%,*} ${v#*,}) -q
+        "$cli" compare "$work/ref_${v}.png" "$work/img.png" --json - >> "$work/img.jsonl"
+      done
+      jq -s -r --arg m "$m" --arg k "$k" '"| \($m) | \($k) | \(map(.psnr_db) | add / length * 100 | round / 100) | \(map(.ssim) | add / length * 1000 | round / 1000) | \(map(.silhouette_iou) | add / length * 1000 | round / 1000) | \(map(.hole_pixels) | add) |"' "$work/img.jsonl"
+    done
+  done
+fi

@@ -39,8 +39,14 @@ int run_simplify(SimplifyCommandOptions& o) {
     throw OptionError("simplify: the output '" + o.output +
                       "' must end in .ply (points with normals and radii), .ptl or .qs");
   }
-  if ((o.points > 0) == (o.ratio > 0)) {
-    throw OptionError("simplify: give the size of the result with one of --points N or --ratio R");
+  const bool by_cell_size = o.simplify.voxel_size > 0 && o.points == 0 && o.ratio == 0;
+  if (by_cell_size && o.method != "voxel" && o.method != "voxel-nearest") {
+    throw OptionError("simplify: --voxel-size sets the size of the result for --method voxel or "
+                      "voxel-nearest only; give --points N or --ratio R");
+  }
+  if (!by_cell_size && (o.points > 0) == (o.ratio > 0)) {
+    throw OptionError("simplify: give the size of the result with one of --points N or --ratio R "
+                      "(or, for the voxel methods, --voxel-size S)");
   }
   if (o.ratio > 0 && !(o.ratio <= 1)) {
     throw OptionError("simplify: --ratio must be in (0, 1], the share of the points to keep");
@@ -54,9 +60,11 @@ int run_simplify(SimplifyCommandOptions& o) {
   PointSet points = merge_inputs(o.inputs, pool, progress, {.columns = o.convert.columns}, &warnings);
   for (const auto& w : warnings) std::fprintf(stderr, "pointillist simplify: warning: %s\n", w.c_str());
   const std::size_t input_points = points.size();
-  o.simplify.target = o.points > 0 ? o.points
-                                   : std::max<std::size_t>(1, static_cast<std::size_t>(std::llround(
-                                                                  o.ratio * double(input_points))));
+  o.simplify.target =
+      by_cell_size ? input_points  // not used: the cell size decides
+      : o.points > 0 ? o.points
+                     : std::max<std::size_t>(1, static_cast<std::size_t>(
+                                                    std::llround(o.ratio * double(input_points))));
   PrepareOptions prepare = o.convert.prepare;
   prepare.input_name = input_names(o.inputs);
   prepare_splats(points, pool, progress, prepare);  // normals (the radii are not kept)
@@ -74,8 +82,8 @@ int run_simplify(SimplifyCommandOptions& o) {
   points = PointSet{};
   const double simplify_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  // The new points are a cloud: their radii come from their own spacing (cloud_radii; the
-  // hierarchy's nodes keep their spheres' radii), the normals are the clusters'.
+  // The new points keep the normals and radii simplify_points gave them (the hierarchy's nodes
+  // their spheres'); --radius-scale scales the radii as it does a file's.
   ConvertOptions convert = o.convert;
   convert.prepare.normals = NormalSource::Keep;
   const ConvertResult r = convert_points(std::move(simplified), o.inputs, o.output, convert, pool,

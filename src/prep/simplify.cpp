@@ -11,6 +11,7 @@
 
 #include "pointillist/core/error.hpp"
 #include "pointillist/core/morton.hpp"
+#include "pointillist/prep/radii.hpp"
 #include "simplify_internal.hpp"
 
 namespace pointillist {
@@ -151,6 +152,21 @@ PointSet nearest_members(const PointSet& in, const sd::Clusters& c) {
   out.triangles.clear();
   keep_points(out, keep);
   return out;
+}
+
+// Widens each cluster's disc to the farthest of its members, measured in the disc's plane, and
+// half the member's own radius past it: an uneven cluster (a merged small one, a long one on a
+// ridge) covers its own patch. (On 5 % of the dragon the incremental clusters left 0.006 % of
+// the surface uncovered without it.)
+void widen_to_members(const PointSet& in, const sd::Clusters& members, PointSet& out) {
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    const std::uint32_t c = members.of[i];
+    const Vec3f d = in.positions[i] - out.positions[c];
+    const Vec3f n = out.normals[c];
+    // Past the member by half its own disc, when it has one (what it stood for).
+    const float own = in.has_radii() ? 0.5f * in.radii[i] : 0.0f;
+    out.radii[c] = std::max(out.radii[c], length(d - n * dot(d, n)) + own);
+  }
 }
 
 }  // namespace
@@ -303,6 +319,7 @@ PointSet simplify_points(const PointSet& points, const SimplifyOptions& options,
   const bool voxel = options.method == SimplifyMethod::VoxelCentroid ||
                      options.method == SimplifyMethod::VoxelNearest;
   PointSet out;
+  sd::Clusters members;  // which output point each input point went into (cluster methods)
   if (options.target >= points.size() && !(voxel && options.voxel_size > 0)) {
     out = points;
     out.radii.clear();
@@ -314,21 +331,30 @@ PointSet simplify_points(const PointSet& points, const SimplifyOptions& options,
     r.voxel_size = options.voxel_size > 0
                        ? options.voxel_size
                        : voxel_size_for(points.positions, box, options.target, pool, r.passes);
-    const sd::Clusters c = voxel_clusters(points.positions, voxel_grid(box, r.voxel_size), pool);
-    out = options.method == SimplifyMethod::VoxelCentroid ? sd::cluster_means(points, c)
-                                                          : nearest_members(points, c);
+    sd::Clusters c = voxel_clusters(points.positions, voxel_grid(box, r.voxel_size), pool);
+    if (options.method == SimplifyMethod::VoxelCentroid) {
+      out = sd::cluster_means(points, c);
+      members = std::move(c);
+    } else {
+      out = nearest_members(points, c);
+    }
   } else if (options.method == SimplifyMethod::Hierarchical) {
-    out = sd::cluster_means(points, sd::hierarchical_clusters(points, options.target, progress),
-                            true);
+    members = sd::hierarchical_clusters(points, options.target, phase);
+    out = sd::cluster_means(points, members, true);
   } else if (options.method == SimplifyMethod::Incremental) {
-    out = sd::cluster_means(points, sd::incremental_clusters(points, options.target,
-                                                             options.neighbours, pool, progress,
-                                                             &r.passes),
-                            true);
+    members = sd::incremental_clusters(points, options.target, options.neighbours, pool, phase,
+                                       &r.passes);
+    out = sd::cluster_means(points, members, true);
   } else {
-    out = sd::quadric_simplify(points, options, pool, progress);
+    out = sd::quadric_simplify(points, options, pool, phase, members);
   }
-  phase.advance(points.size());
+  // Radii: the cloud rule, with the coverage of evenly spread points (a random subset keeps
+  // the default); a cluster's disc is at least as wide as its members reach in its plane.
+  CloudRadiusOptions radius;
+  radius.coverage = options.method == SimplifyMethod::Random ? kDefaultCloudCoverage
+                                                             : kSimplifiedCoverage;
+  out.radii = cloud_radii(out.positions, pool, Progress::none(), radius);
+  if (members.count == out.size()) widen_to_members(points, members, out);
   r.output = out.size();
   return out;
 }

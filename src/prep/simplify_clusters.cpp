@@ -41,7 +41,7 @@ Range make_range(const PointSet& in, const std::vector<std::uint32_t>& perm, std
 
 }  // namespace
 
-Clusters hierarchical_clusters(const PointSet& in, std::size_t target, Progress& /*progress*/) {
+Clusters hierarchical_clusters(const PointSet& in, std::size_t target, ProgressPhase& /*phase*/) {
   const auto n = static_cast<std::uint32_t>(in.size());
   std::vector<std::uint32_t> perm(n);
   std::iota(perm.begin(), perm.end(), 0u);
@@ -196,7 +196,7 @@ Clusters merge_smallest(const PointSet& in, Clusters c, std::span<const std::uin
 }  // namespace
 
 Clusters incremental_clusters(const PointSet& in, std::size_t target, std::uint32_t k,
-                              ThreadPool& pool, Progress& /*progress*/, int* passes) {
+                              ThreadPool& pool, ProgressPhase& phase, int* passes) {
   const std::size_t n = in.size();
   k = static_cast<std::uint32_t>(std::min<std::size_t>(k, n - 1));
   const std::vector<std::uint32_t> knn =
@@ -211,6 +211,7 @@ Clusters incremental_clusters(const PointSet& in, std::size_t target, std::uint3
   for (int pass = 0; pass < 6; ++pass) {
     Clusters c = grow(in, knn, k, size);
     ++count;
+    phase.advance(n / 8);  // at most 6 passes and the merge
     const double step = double(c.count) / double(target);
     if (c.count >= target) {
       if (size > best_size) {

@@ -102,10 +102,13 @@ Spread spread_of(const Moments& m);
 // distance 0.072 -> 0.066 ×10⁻³ of the diagonal, normal error 4.3° -> 3.7°.
 Vec3f fitted_normal(const Moments& m, Vec3f mean_normal);
 
-Clusters hierarchical_clusters(const PointSet& in, std::size_t target, Progress& progress);
+// The methods advance `phase` (whose total is the input's point count) as they go, by at most
+// that total.
+Clusters hierarchical_clusters(const PointSet& in, std::size_t target, ProgressPhase& phase);
 Clusters incremental_clusters(const PointSet& in, std::size_t target, std::uint32_t k,
-                              ThreadPool& pool, Progress& progress, int* passes);
+                              ThreadPool& pool, ProgressPhase& phase, int* passes);
+// `members`: which output point each input point went into.
 PointSet quadric_simplify(const PointSet& in, const SimplifyOptions& options, ThreadPool& pool,
-                          Progress& progress);
+                          ProgressPhase& phase, Clusters& members);
 
 }  // namespace pointillist::simplify_detail

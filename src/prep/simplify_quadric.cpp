@@ -39,7 +39,7 @@ struct Costlier {  // x after y: by cost, then by (a, b), a total order
 }  // namespace
 
 PointSet quadric_simplify(const PointSet& in, const SimplifyOptions& options, ThreadPool& pool,
-                          Progress& /*progress*/) {
+                          ProgressPhase& phase, Clusters& members) {
   const std::size_t n = in.size();
   const auto k = static_cast<std::uint32_t>(std::min<std::size_t>(options.neighbours, n - 1));
   const std::vector<std::uint32_t> knn =
@@ -206,6 +206,7 @@ PointSet quadric_simplify(const PointSet& in, const SimplifyOptions& options, Th
       partner[i] = UINT32_MAX;
     }
     live.swap(next_live);
+    phase.advance(done);
   }
 
   PointSet out;
@@ -218,6 +219,12 @@ PointSet quadric_simplify(const PointSet& in, const SimplifyOptions& options, Th
     out.normals.push_back(fitted_normal(moments[i], len > 1e-6f ? normal_sum[i] / len : in.normals[i]));
     if (!color_sum.empty()) out.colors.push_back(mean_color(color_sum[i], mass[i]));
   }
+  // Each input point's output point: its survivor's place among the survivors.
+  std::vector<std::uint32_t> place_of(n, 0);
+  for (std::uint32_t j = 0; j < live.size(); ++j) place_of[live[j]] = j;
+  members.of.resize(n);
+  for (std::size_t i = 0; i < n; ++i) members.of[i] = place_of[rep[i]];
+  members.count = static_cast<std::uint32_t>(live.size());
   return out;
 }
 

@@ -28,6 +28,14 @@ std::string_view simplify_method_name(SimplifyMethod method);
 // The method of a name above; throws OptionError naming the choices otherwise.
 SimplifyMethod parse_simplify_method(std::string_view name);
 
+// Coverage factor of the cloud radii of a simplified point set (CloudRadiusOptions::coverage):
+// its points are spread evenly, where the default 2.5 (measured for random samples) draws discs
+// more than twice as wide as needed. Measured on 5 % of the dragon (quadric; voxel alike): at
+// 2.5 the images at 480×360 are 15.7 dB from the mesh (blobs past the silhouette, IoU 0.84), at
+// 1.2 20.4 dB (IoU 0.94) with no hole in the images nor among 400 k surface samples; at 1.0 the
+// samples show holes (0.03 %). A random subset keeps the default.
+inline constexpr float kSimplifiedCoverage = 1.2f;
+
 struct SimplifyOptions {
   SimplifyMethod method = SimplifyMethod::Quadric;
   std::size_t target = 0;  // points wanted, 1 ≤ target; more than the input keeps the input
@@ -50,14 +58,15 @@ struct SimplifyReport {
   int passes = 0;        // voxel counting passes, or incremental growth passes
 };
 
-// The simplified points: positions, unit normals (the members' mean, or the kept point's),
-// colours (mean, or the kept point's) when the input has them; no radii and no triangles (a
-// simplified mesh is a point cloud: give it radii with cloud_radii). Comments, origin and up
-// axis are kept. The output has exactly `target` points except for the voxel methods, whose
-// count is the occupied cells' (within 0.5 % of the target where any cell size gives that),
-// and when the input has fewer distinct positions. Requires normals (prepare the input first);
-// throws Error naming `input_name` when they are missing or a position is not finite.
-// Progress phase "simplify".
+// The simplified points: positions, unit normals (a cluster's least-squares plane's, or the
+// kept point's), colours (mean, or the kept point's) when the input has them, and radii (the
+// cloud rule with kSimplifiedCoverage, kDefaultCloudCoverage for a random subset; a cluster's
+// disc widened to reach its farthest member in its plane); no triangles (a simplified mesh is a
+// point cloud). Comments, origin and up axis are kept. The output has exactly `target` points
+// except for the voxel methods, whose count is the occupied cells' (within 0.5 % of the target
+// where any cell size gives that), and when the input has fewer distinct positions. Requires
+// normals (prepare the input first); throws Error naming `input_name` when they are missing or
+// a position is not finite. Progress phase "simplify".
 PointSet simplify_points(const PointSet& points, const SimplifyOptions& options, ThreadPool& pool,
                          Progress& progress = Progress::none(), SimplifyReport* report = nullptr,
                          std::string_view input_name = "the input");
