@@ -320,9 +320,9 @@ PointSet simplify_points(const PointSet& points, const SimplifyOptions& options,
                      options.method == SimplifyMethod::VoxelNearest;
   PointSet out;
   sd::Clusters members;  // which output point each input point went into (cluster methods)
-  if (options.target >= points.size() && !(voxel && options.voxel_size > 0)) {
+  const bool whole = options.target >= points.size() && !(voxel && options.voxel_size > 0);
+  if (whole) {  // nothing to take away: the input as it is, its radii kept if it has them
     out = points;
-    out.radii.clear();
     out.triangles.clear();
   } else if (options.method == SimplifyMethod::Random) {
     out = random_subset(points, options.target, options.seed);
@@ -351,9 +351,11 @@ PointSet simplify_points(const PointSet& points, const SimplifyOptions& options,
   // Radii: the cloud rule, with the coverage of evenly spread points (a random subset keeps
   // the default); a cluster's disc is at least as wide as its members reach in its plane.
   CloudRadiusOptions radius;
-  radius.coverage = options.method == SimplifyMethod::Random ? kDefaultCloudCoverage
-                                                             : kSimplifiedCoverage;
-  out.radii = cloud_radii(out.positions, pool, Progress::none(), radius);
+  radius.coverage = options.method == SimplifyMethod::Random || whole ? kDefaultCloudCoverage
+                                                                      : kSimplifiedCoverage;
+  if (!(whole && out.has_radii())) {
+    out.radii = cloud_radii(out.positions, pool, Progress::none(), radius);
+  }
   if (members.count == out.size()) widen_to_members(points, members, out);
   r.output = out.size();
   return out;

@@ -222,7 +222,11 @@ TEST(Simplify, RefusesInputItCannotUse) {
   o.target = 0;
   EXPECT_THROW(simplify_points(plane(10, 5), o, pool), OptionError);
   EXPECT_THROW(parse_simplify_method("octree"), OptionError);
-  // More points asked for than there are: the input comes back whole.
+  // More points asked for than there are: the input comes back whole, with its radii.
   o.target = 50;
-  EXPECT_EQ(simplify_points(plane(10, 5), o, pool).size(), 10u);
+  PointSet with_radii = plane(10, 5);
+  with_radii.radii.assign(10, 0.125f);
+  const PointSet whole = simplify_points(with_radii, o, pool);
+  EXPECT_EQ(whole.size(), 10u);
+  EXPECT_EQ(whole.radii, with_radii.radii);
 }

@@ -61,7 +61,8 @@ struct SimplifyReport {
 // The simplified points: positions, unit normals (a cluster's least-squares plane's, or the
 // kept point's), colours (mean, or the kept point's) when the input has them, and radii (the
 // cloud rule with kSimplifiedCoverage, kDefaultCloudCoverage for a random subset; a cluster's
-// disc widened to reach its farthest member in its plane); no triangles (a simplified mesh is a
+// disc widened to reach its farthest member in its plane; an input no larger than the target
+// comes back whole, with its own radii or the default rule's); no triangles (a simplified mesh is a
 // point cloud). Comments, origin and up axis are kept. The output has exactly `target` points
 // except for the voxel methods, whose count is the occupied cells' (within 0.5 % of the target
 // where any cell size gives that), and when the input has fewer distinct positions. Requires
