@@ -28,6 +28,16 @@ constexpr std::array<std::pair<SimplifyMethod, std::string_view>, 6> kNames = {{
     {SimplifyMethod::Quadric, "quadric"},
 }};
 
+// The points with keep[i] set, with their attributes; no radii and no faces (a subset is a
+// cloud whose spacing is not the input's).
+PointSet subset(const PointSet& in, std::span<const std::uint8_t> keep) {
+  PointSet out = in;
+  out.radii.clear();
+  out.triangles.clear();
+  keep_points(out, keep);
+  return out;
+}
+
 // ---- random ----
 
 PointSet random_subset(const PointSet& in, std::size_t target, std::uint64_t seed) {
@@ -40,11 +50,7 @@ PointSet random_subset(const PointSet& in, std::size_t target, std::uint64_t see
   }
   std::vector<std::uint8_t> keep(in.size(), 0);
   for (std::size_t i = 0; i < target; ++i) keep[index[i]] = 1;
-  PointSet out = in;
-  out.radii.clear();
-  out.triangles.clear();
-  keep_points(out, keep);
-  return out;
+  return subset(in, keep);
 }
 
 // ---- voxel grid ----
@@ -147,11 +153,7 @@ PointSet nearest_members(const PointSet& in, const sd::Clusters& c) {
   }
   std::vector<std::uint8_t> keep(in.size(), 0);
   for (std::uint32_t i : best) keep[i] = 1;
-  PointSet out = in;
-  out.radii.clear();
-  out.triangles.clear();
-  keep_points(out, keep);
-  return out;
+  return subset(in, keep);
 }
 
 // Widens each cluster's disc to the farthest of its members, measured in the disc's plane, and
@@ -219,7 +221,7 @@ Spread spread_of(const Moments& m) {
   if (m.n <= 0) return out;
   const double inv = 1.0 / m.n;
   const double mx = m.s[0] * inv, my = m.s[1] * inv, mz = m.s[2] * inv;
-  out.centroid = m.origin + Vec3f{float(mx), float(my), float(mz)};
+  out.centroid = m.centroid();
   Eigen::Matrix3d c;
   c(0, 0) = m.ss[0] * inv - mx * mx;
   c(0, 1) = c(1, 0) = m.ss[1] * inv - mx * my;
@@ -261,7 +263,6 @@ PointSet cluster_means(const PointSet& in, const Clusters& clusters, bool fit_pl
       first_normal[c] = in.normals[i];
     }
     m[c].add(in.positions[i]);
-
     normal_sum[c] += in.normals[i];
     if (in.has_colors()) {
       color_sum[c][0] += in.colors[i].r, color_sum[c][1] += in.colors[i].g;
@@ -276,9 +277,7 @@ PointSet cluster_means(const PointSet& in, const Clusters& clusters, bool fit_pl
   out.normals.resize(k);
   if (in.has_colors()) out.colors.resize(k);
   for (std::size_t c = 0; c < k; ++c) {
-    const double inv = m[c].n > 0 ? 1.0 / m[c].n : 0.0;
-    out.positions[c] = m[c].origin + Vec3f{float(m[c].s[0] * inv), float(m[c].s[1] * inv),
-                                           float(m[c].s[2] * inv)};
+    out.positions[c] = m[c].centroid();
     const float len = length(normal_sum[c]);
     out.normals[c] = len > 1e-6f ? normal_sum[c] / len : first_normal[c];
     if (fit_plane) out.normals[c] = fitted_normal(m[c], out.normals[c]);
@@ -338,15 +337,16 @@ PointSet simplify_points(const PointSet& points, const SimplifyOptions& options,
     } else {
       out = nearest_members(points, c);
     }
-  } else if (options.method == SimplifyMethod::Hierarchical) {
-    members = sd::hierarchical_clusters(points, options.target, phase);
+  } else {  // a clustering, each cluster drawn as its least-squares disc
+    if (options.method == SimplifyMethod::Hierarchical) {
+      members = sd::hierarchical_clusters(points, options.target, phase);
+    } else if (options.method == SimplifyMethod::Incremental) {
+      members = sd::incremental_clusters(points, options.target, options.neighbours, pool, phase,
+                                         &r.passes);
+    } else {
+      members = sd::quadric_clusters(points, options, pool, phase);
+    }
     out = sd::cluster_means(points, members, true);
-  } else if (options.method == SimplifyMethod::Incremental) {
-    members = sd::incremental_clusters(points, options.target, options.neighbours, pool, phase,
-                                       &r.passes);
-    out = sd::cluster_means(points, members, true);
-  } else {
-    out = sd::quadric_simplify(points, options, pool, phase, members);
   }
   // Radii: the cloud rule, with the coverage of evenly spread points (a random subset keeps
   // the default); a cluster's disc is at least as wide as its members reach in its plane.

@@ -151,7 +151,7 @@ Clusters merge_smallest(const PointSet& in, Clusters c, std::span<const std::uin
     m[id].origin = in.positions[members[id].front()];
     for (std::uint32_t i : members[id]) m[id].add(in.positions[i]);
   }
-  const auto centroid = [&](std::uint32_t id) { return spread_of(m[id]).centroid; };
+  const auto centroid = [&](std::uint32_t id) { return m[id].centroid(); };
   using Entry = std::pair<std::size_t, std::uint32_t>;  // (size, id)
   std::priority_queue<Entry, std::vector<Entry>, std::greater<>> small;
   for (std::uint32_t id = 0; id < c.count; ++id) small.push({members[id].size(), id});

@@ -2,6 +2,7 @@
 // simplify_quadric.cpp).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -35,11 +36,6 @@ struct Quadric {
     for (int i = 0; i < 3; ++i) b[i] -= weight * d * m[i];
     c += weight * d * d;
   }
-  void add_point(const double q[3], double weight) {
-    a[0] += weight, a[3] += weight, a[5] += weight;
-    for (int i = 0; i < 3; ++i) b[i] -= weight * q[i];
-    c += weight * (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
-  }
   Quadric& operator+=(const Quadric& o) {
     for (int i = 0; i < 6; ++i) a[i] += o.a[i];
     for (int i = 0; i < 3; ++i) b[i] += o.b[i];
@@ -52,19 +48,6 @@ struct Quadric {
     const double az = a[2] * v[0] + a[4] * v[1] + a[5] * v[2];
     return std::max(0.0, v[0] * ax + v[1] * ay + v[2] * az +
                              2.0 * (b[0] * v[0] + b[1] * v[1] + b[2] * v[2]) + c);
-  }
-  // The minimiser of the quadric (A must be positive definite) and the value there, c + bᵀv.
-  double minimise(double v[3]) const {
-    const double m00 = a[3] * a[5] - a[4] * a[4], m01 = a[2] * a[4] - a[1] * a[5],
-                 m02 = a[1] * a[4] - a[2] * a[3];
-    const double det = a[0] * m00 + a[1] * m01 + a[2] * m02;
-    const double m11 = a[0] * a[5] - a[2] * a[2], m12 = a[1] * a[2] - a[0] * a[4],
-                 m22 = a[0] * a[3] - a[1] * a[1];
-    const double r[3] = {-b[0], -b[1], -b[2]};
-    v[0] = (m00 * r[0] + m01 * r[1] + m02 * r[2]) / det;
-    v[1] = (m01 * r[0] + m11 * r[1] + m12 * r[2]) / det;
-    v[2] = (m02 * r[0] + m12 * r[1] + m22 * r[2]) / det;
-    return std::max(0.0, c + b[0] * v[0] + b[1] * v[1] + b[2] * v[2]);
   }
 };
 
@@ -83,6 +66,15 @@ struct Moments {
   double ss[6] = {0, 0, 0, 0, 0, 0};  // xx xy xz yy yz zz
   void add(Vec3f p);
   void add(const Moments& other);  // same origin
+  // The mean, relative to the origin, and in world coordinates (n > 0).
+  std::array<double, 3> mean() const { return {s[0] / n, s[1] / n, s[2] / n}; }
+  Vec3f centroid() const {
+    return origin + Vec3f{float(s[0] / n), float(s[1] / n), float(s[2] / n)};
+  }
+  // Σ|p − mean|², the members' squared spread about their mean.
+  double scatter() const {
+    return std::max(0.0, ss[0] + ss[3] + ss[5] - (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]) / n);
+  }
 };
 
 // The shape of a cluster: centroid, eigenvalues of its covariance (increasing) and the unit
@@ -107,8 +99,7 @@ Vec3f fitted_normal(const Moments& m, Vec3f mean_normal);
 Clusters hierarchical_clusters(const PointSet& in, std::size_t target, ProgressPhase& phase);
 Clusters incremental_clusters(const PointSet& in, std::size_t target, std::uint32_t k,
                               ThreadPool& pool, ProgressPhase& phase, int* passes);
-// `members`: which output point each input point went into.
-PointSet quadric_simplify(const PointSet& in, const SimplifyOptions& options, ThreadPool& pool,
-                          ProgressPhase& phase, Clusters& members);
+Clusters quadric_clusters(const PointSet& in, const SimplifyOptions& options, ThreadPool& pool,
+                          ProgressPhase& phase);
 
 }  // namespace pointillist::simplify_detail

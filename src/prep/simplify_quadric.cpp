@@ -38,8 +38,8 @@ struct Costlier {  // x after y: by cost, then by (a, b), a total order
 
 }  // namespace
 
-PointSet quadric_simplify(const PointSet& in, const SimplifyOptions& options, ThreadPool& pool,
-                          ProgressPhase& phase, Clusters& members) {
+Clusters quadric_clusters(const PointSet& in, const SimplifyOptions& options, ThreadPool& pool,
+                          ProgressPhase& phase) {
   const std::size_t n = in.size();
   const auto k = static_cast<std::uint32_t>(std::min<std::size_t>(options.neighbours, n - 1));
   const std::vector<std::uint32_t> knn =
@@ -51,9 +51,8 @@ PointSet quadric_simplify(const PointSet& in, const SimplifyOptions& options, Th
     q[0] = d.x, q[1] = d.y, q[2] = d.z;
   };
 
-  // Quadrics, in parallel (each point's own): the tangent planes', and the squared distance to
-  // the point itself (summed over a cluster: its members' spread about the position).
-  std::vector<Quadric> quadric(n), spread(n);
+  // Quadrics of the tangent planes, in parallel (each point's own).
+  std::vector<Quadric> quadric(n);
   parallel_for(pool, n, 4096, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       double q[3];
@@ -69,7 +68,6 @@ PointSet quadric_simplify(const PointSet& in, const SimplifyOptions& options, Th
         const double md[3] = {m.x / len, m.y / len, m.z / len};
         quadric[i].add_plane(md, q, 1.0);
       }
-      spread[i].add_point(q, 1.0);
     }
   });
 
@@ -88,36 +86,27 @@ PointSet quadric_simplify(const PointSet& in, const SimplifyOptions& options, Th
     row.erase(std::unique(row.begin(), row.end()), row.end());
   }
 
-  std::vector<Vec3f> position = in.positions;
-  std::vector<double> mass(n, 1.0);
-  std::vector<Vec3f> normal_sum = in.normals;
+  // Each live point's members, their moments about the box centre (the quadrics' origin).
   std::vector<Moments> moments(n);
   for (std::size_t i = 0; i < n; ++i) {
     moments[i].origin = centre;
     moments[i].add(in.positions[i]);
   }
-  std::vector<std::array<double, 3>> color_sum(in.has_colors() ? n : 0);
-  for (std::size_t i = 0; i < color_sum.size(); ++i) {
-    color_sum[i] = {double(in.colors[i].r), double(in.colors[i].g), double(in.colors[i].b)};
-  }
   std::vector<std::uint32_t> rep(n), live(n);  // rep: the live point a point was merged into
   for (std::uint32_t i = 0; i < n; ++i) rep[i] = live[i] = i;
-  // A pair's point is its members' centroid (the minimiser of `spread`), the disc through it
-  // being their least-squares plane: the disc that fits the patch it stands for best (below).
-  // Its cost: the tangent planes' quadric there plus the spread, weighted: the planes alone
-  // cost nothing on a flat region in any order of contraction, which would leave it unevenly
-  // sampled.
+  // A pair's point is its members' centroid, the disc through it being their least-squares
+  // plane (cluster_means): the disc that fits the patch it stands for best (above). Its cost:
+  // the tangent planes' quadric there plus the members' squared spread about it, weighted: the
+  // planes alone cost nothing on a flat region in any order of contraction, which would leave
+  // it unevenly sampled.
   const double spread_weight = double(options.quadric_regularization) * k;
-  const auto place = [&](const Quadric&, const Quadric& around, double v[3]) {
-    around.minimise(v);
-  };
   const auto cost_of = [&](std::uint32_t a, std::uint32_t b) {
-    Quadric planes = quadric[a], around = spread[a];
+    Quadric planes = quadric[a];
     planes += quadric[b];
-    around += spread[b];
-    double v[3];
-    place(planes, around, v);
-    return static_cast<float>(planes.at(v) + spread_weight * around.at(v));
+    Moments m = moments[a];
+    m.add(moments[b]);
+    const std::array<double, 3> v = m.mean();
+    return static_cast<float>(planes.at(v.data()) + spread_weight * m.scatter());
   };
 
   // Rounds: every live point finds its cheapest pair (in parallel); those pairs are contracted
@@ -159,16 +148,7 @@ PointSet quadric_simplify(const PointSet& in, const SimplifyOptions& options, Th
       rep[p.b] = p.a;
       ++done;
       quadric[p.a] += quadric[p.b];
-      spread[p.a] += spread[p.b];
-      double v[3];
-      place(quadric[p.a], spread[p.a], v);
-      position[p.a] = centre + Vec3f{float(v[0]), float(v[1]), float(v[2])};
-      mass[p.a] += mass[p.b];
-      normal_sum[p.a] += normal_sum[p.b];
       moments[p.a].add(moments[p.b]);
-      if (!color_sum.empty()) {
-        for (int c = 0; c < 3; ++c) color_sum[p.a][c] += color_sum[p.b][c];
-      }
     }
     // Every point's survivor in one step (points merged in earlier rounds point at a survivor
     // of the last round, which may have been merged in this one).
@@ -209,23 +189,14 @@ PointSet quadric_simplify(const PointSet& in, const SimplifyOptions& options, Th
     phase.advance(done);
   }
 
-  PointSet out;
-  out.comments = in.comments;
-  out.origin = in.origin;
-  out.up = in.up;
-  for (std::uint32_t i : live) {
-    out.positions.push_back(position[i]);
-    const float len = length(normal_sum[i]);
-    out.normals.push_back(fitted_normal(moments[i], len > 1e-6f ? normal_sum[i] / len : in.normals[i]));
-    if (!color_sum.empty()) out.colors.push_back(mean_color(color_sum[i], mass[i]));
-  }
-  // Each input point's output point: its survivor's place among the survivors.
+  // Each input point's cluster: its survivor's place among the survivors.
   std::vector<std::uint32_t> place_of(n, 0);
   for (std::uint32_t j = 0; j < live.size(); ++j) place_of[live[j]] = j;
+  Clusters members;
   members.of.resize(n);
   for (std::size_t i = 0; i < n; ++i) members.of[i] = place_of[rep[i]];
   members.count = static_cast<std::uint32_t>(live.size());
-  return out;
+  return members;
 }
 
 }  // namespace pointillist::simplify_detail
