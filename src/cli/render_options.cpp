@@ -163,6 +163,16 @@ void add_detail(CLI::App* cmd, RenderOptions& o, RenderText& t) {
                 "With --lod spt: scan every chunk's list even when the chunk is outside the "
                 "view (to measure what chunk culling saves)")
       ->group(kGroupDetail);
+  cmd->add_flag("--hybrid", o.frame.hybrid,
+                "With --lod spt, for meshes: draw the mesh's triangles near the eye instead of "
+                "the points they cover (hybrid point/polygon rendering)")
+      ->group(kGroupDetail);
+  cmd->add_option("--triangle-px", o.frame.triangle_px_per_epsilon,
+                  "With --hybrid: a triangle replaces points while its longest edge is longer "
+                  "than this many times --epsilon pixels")
+      ->default_val(4.0f)
+      ->check(CLI::Range(0.01f, 10000.0f))
+      ->group(kGroupDetail);
 }
 
 void add_sequences_and_paging(CLI::App* cmd, RenderOptions& o, RenderText& t) {
@@ -222,6 +232,7 @@ std::vector<std::string> ignored_options(const CLI::App& cmd, const RenderOption
     ignored("--epsilon", "it is the Sequential Point Tree's detail; add --lod spt");
     ignored("--no-chunk-culling", "it applies to --lod spt");
   }
+  if (!o.frame.hybrid) ignored("--triangle-px", "it applies with --hybrid");
   if (!t.features) {
     for (const char* name : {"--sharp-threshold", "--edge-test", "--clip-rule"}) {
       ignored(name, "it applies with --features");

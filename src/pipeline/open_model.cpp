@@ -152,8 +152,11 @@ Model Model::from_scans(std::span<const std::string> paths, const OpenModelOptio
                        .has_radii = points.has_radii(),
                        .is_mesh = points.is_mesh()};
   prepare_splats(points, pool, progress, options.prepare);
-  model.built_ = build_sphere_tree(points, pool, progress);
+  std::vector<std::uint32_t> split_order;
+  model.built_ = build_sphere_tree(points, pool, progress, {},
+                                   points.is_mesh() ? &split_order : nullptr);
   model.view_ = model.built_.view();
+  if (points.is_mesh()) model.triangles_ = leaf_triangles(model.view_, split_order, points.triangles);
   model.paging_reason_ = "in memory: built from the scan";
   if (options.keep_source) *model.source_ = std::move(points);
   return model;
@@ -195,6 +198,7 @@ Model Model::finish(Model model, const OpenModelOptions& options, ThreadPool& po
                   .mesh = options.keep_source && model.kind_ == ModelKind::Scan
                               ? model.source_.get()
                               : nullptr,
+                  .triangles = model.triangles_,
                   .name = model.path_});
   return model;
 }

@@ -77,6 +77,13 @@ std::string render_report_json(const RenderReport& r) {
         spt.entries_total ? double(spt.entries_scanned) / double(spt.entries_total) : 0.0;
     j["chunks"] = spt.chunks_total;
     j["chunks_culled"] = spt.chunks_culled;
+    if (f.hybrid) {
+      j["hybrid"] = true;
+      j["triangle_px_per_epsilon"] = f.triangle_px_per_epsilon;
+      j["triangles_selected"] = r.renderer->triangles_selected();
+      j["triangles"] = s.triangles;
+      j["triangle_entries_scanned"] = r.renderer->triangle_entries_scanned();
+    }
   }
   if (f.occlusion.method != OcclusionMethod::None) j["occlusion"] = occlusion_json(f.occlusion, s.occlusion);
   if (r.renderer && r.renderer->paging()) {
@@ -126,6 +133,7 @@ std::string render_report_json(const RenderReport& r) {
       if (fr.azimuth_deg) o["azimuth"] = *fr.azimuth_deg;  // orbit frames
       o["detail"] = fr.detail;
       o["splats"] = fr.stats.splats;
+      if (f.hybrid) o["triangles"] = fr.stats.triangles;
       o["ms"] = ms(fr.stats.ms_total);
       o["ms_select"] = ms(fr.stats.ms_select);
       o["ms_raster"] = ms(fr.stats.ms_raster);

@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "frame_pass.hpp"
+#include "raster/triangle_draw.hpp"
 #include "renderer_state.hpp"
 #include "select/stream_features.hpp"
 #include "pointillist/core/error.hpp"
@@ -25,7 +26,15 @@ bool InstanceTransform::is_identity() const {
          rotation[1] == Vec3f{0, 1, 0} && rotation[2] == Vec3f{0, 0, 1};
 }
 
-Renderer::Renderer(const RendererOptions& options) : options_(options) {}
+// Hybrid mode: each instance's selected triangles, and the triangle rasterizer's buffers.
+struct Renderer::TriangleState {
+  std::vector<std::vector<std::uint32_t>> selected;  // per instance
+  std::vector<TriangleBatch> batches;
+  TriangleScratch scratch;
+};
+
+Renderer::Renderer(const RendererOptions& options)
+    : options_(options), triangles_(std::make_unique<TriangleState>()) {}
 Renderer::~Renderer() = default;
 
 Renderer::ModelState& Renderer::state_for(const RenderModel& model, ThreadPool& pool,
@@ -52,10 +61,21 @@ Renderer::ModelState& Renderer::state_for(const RenderModel& model, ThreadPool& 
     }
   }
   ModelState* state = slot.get();
-  if (fs.lod == LodScheme::Spt && !state->spt) {
-    state->spt = build_sequential_point_tree(sphere_tree_leaves(model.tree), pool);
-    if (model.tree.features) {
-      state->spt_features = spt_features(*state->spt, model.tree.nodes, *model.tree.features);
+  const bool hybrid = fs.lod == LodScheme::Spt && fs.hybrid && !model.triangles.empty();
+  const bool hybrid_stale =
+      hybrid && (!state->hybrid ||
+                 state->hybrid->triangle_px_per_epsilon != fs.triangle_px_per_epsilon);
+  if ((fs.lod == LodScheme::Spt && !state->spt) || hybrid_stale) {
+    const PointSet leaves = sphere_tree_leaves(model.tree);
+    if (!state->spt) {
+      state->spt = build_sequential_point_tree(leaves, pool);
+      if (model.tree.features) {
+        state->spt_features = spt_features(*state->spt, model.tree.nodes, *model.tree.features);
+      }
+    }
+    if (hybrid_stale) {
+      state->hybrid = build_hybrid_lod(*state->spt, leaves, model.triangles,
+                                       {.triangle_px_per_epsilon = fs.triangle_px_per_epsilon});
     }
   }
   return *state;
@@ -74,6 +94,26 @@ void Renderer::render(std::span<const SceneInstance> scene, const Camera& camera
     if (several) {
       throw OptionError("--mode reference draws one mesh as it is; give a single input without "
                         "a transform");
+    }
+  }
+  if (fs.hybrid) {
+    const char* drop = fs.lod != LodScheme::Spt                       ? "or add --lod spt"
+                       : fs.rasterizer != Rasterizer::Fast            ? "or --mode"
+                       : fs.occlusion.method != OcclusionMethod::None ? "or --occlusion"
+                                                                      : nullptr;
+    if (drop) {
+      throw OptionError(std::string("--hybrid draws a mesh's triangles beside the points of a "
+                                    "Sequential Point Tree with the fast rasterizer; drop "
+                                    "--hybrid ") +
+                        drop);
+    }
+    const bool any = std::any_of(scene.begin(), scene.end(), [](const SceneInstance& i) {
+      return !i.model->triangles.empty();
+    });
+    if (!any) {
+      throw OptionError((scene.empty() ? std::string("the scene") : scene[0].model->name) +
+                        ": --hybrid draws a mesh's triangles, and no model here has any; give "
+                        "a mesh (.ply, .obj) or a .ptl converted from one, or drop --hybrid");
     }
   }
   if (fs.rasterizer == Rasterizer::Quality) validate_quality_settings(fs.quality);
@@ -119,6 +159,8 @@ void Renderer::render(std::span<const SceneInstance> scene, const Camera& camera
   }
   last_frame_.clear();
   spt_stats_ = {};
+  triangles_selected_ = triangle_entries_scanned_ = 0;
+  triangles_->batches.clear();
   ++frame_number_;
   frame.splats.trim();
   scratch_stream_.trim();
@@ -133,6 +175,16 @@ void Renderer::render(std::span<const SceneInstance> scene, const Camera& camera
                               [&](const CameraFrame& world, SplatStream& stream) {
                                 return select(scene, camera, world, settings, fs, pool, stream);
                               });
+    if (!triangles_->batches.empty()) {
+      // The hybrid mode's triangles, into the splats' image (timed as rasterization).
+      const auto start = Clock::now();
+      frame.stats.triangles =
+          draw_triangles(triangles_->batches, make_camera_frame(camera), settings, pool,
+                         triangles_->scratch, frame.color, frame.depth);
+      const double ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+      frame.stats.ms_raster += ms;
+      frame.stats.ms_total += ms;
+    }
   }
   if (settings.edl_strength != 0.0f) apply_eye_dome_lighting(frame, settings.edl_strength, pool);
 }
@@ -171,11 +223,26 @@ SelectionStats Renderer::select(std::span<const SceneInstance> scene, const Came
     SelectionStats selected;
     if (fs.lod == LodScheme::Spt) {
       SptSelectionStats spt;
+      const bool hybrid = fs.hybrid && state.hybrid && !inst.model->triangles.empty();
       select_splats_spt(*state.spt, cam, settings,
-                        {.epsilon_px = fs.epsilon_px, .chunk_culling = fs.spt_chunk_culling},
+                        {.epsilon_px = fs.epsilon_px,
+                         .chunk_culling = fs.spt_chunk_culling,
+                         .errors = hybrid ? std::span<const float>(state.hybrid->entry_error)
+                                          : std::span<const float>()},
                         pool, into, spt);
       selected = spt.as_selection();
       spt_stats_ += spt;
+      if (hybrid) {
+        TriangleState& ts = *triangles_;
+        if (ts.selected.size() <= i) ts.selected.resize(i + 1);
+        ts.selected[i].clear();
+        TriangleSelectionStats tri;
+        select_triangles(*state.hybrid, cam, settings, fs.epsilon_px, pool, ts.selected[i], tri);
+        triangles_selected_ += tri.triangles;
+        triangle_entries_scanned_ += tri.scanned;
+        ts.batches.push_back({&*state.hybrid, identity ? nullptr : &inst.transform,
+                              ts.selected[i]});
+      }
     } else if (state.paged) {
       selected = state.paged->select(cam, settings, pool, into, !first_use,
                                      features && state.pages->features());

@@ -11,6 +11,7 @@
 #include "pointillist/lod/tree_features.hpp"
 #include "pointillist/render/occlusion.hpp"
 #include "pointillist/render/paged.hpp"
+#include "pointillist/lod/hybrid_lod.hpp"
 #include "pointillist/render/renderer.hpp"
 #include "raster/quality_occluders.hpp"
 #include "select/stream_features.hpp"
@@ -192,6 +193,7 @@ struct Renderer::ModelState {
   std::optional<PagedRenderer> paged;
   std::optional<SequentialPointTree> spt;
   std::optional<TreeFeatures> spt_features;  // the model's features on the SPT's entries
+  std::optional<HybridLod> hybrid;  // the hybrid point/polygon lists over `spt` (--hybrid)
   std::uint64_t frame = 0;  // the last frame that drew the model
   std::uint64_t model_bytes = 0;  // storage bytes of a paged model (open + every page)
   std::optional<render_detail::ModelCullTree> cull_tree;      // occlusion culling (QSplat)

@@ -114,6 +114,14 @@ SphereTree build_top_tree(std::span<const SphereNode> roots, bool has_colors);
 // Point Tree) be built from a model file that stores a sphere tree.
 PointSet sphere_tree_leaves(const SphereTreeView& tree);
 
+// A mesh's faces renumbered onto the tree's leaves (sphere_tree_leaves order), for a tree built
+// from the mesh's points by build_sphere_tree with `split_order`: leaf k in depth-first order is
+// points[split_order[k]]. Throws Error when the tree's leaf count and split_order differ or a
+// face refers to a point beyond them.
+std::vector<std::array<std::uint32_t, 3>> leaf_triangles(
+    const SphereTreeView& tree, std::span<const std::uint32_t> split_order,
+    std::span<const std::array<std::uint32_t, 3>> triangles);
+
 // What QSplat draws when it stops above the leaves, as points: the cut of `tree` at one sphere
 // size, each node whose radius is at most r (or a leaf) under a parent larger than r, with r
 // chosen (bisected) so that the cut has the number of nodes nearest `target`. A node gives its

@@ -82,6 +82,9 @@ class Model {
   const std::string& paging_reason() const { return paging_reason_; }
   // A scan's prepared points (with OpenModelOptions::keep_source; empty otherwise).
   const PointSet& source() const { return *source_; }
+  // A mesh's faces over the hierarchy's leaves (sphere_tree_leaves order): scans with faces and
+  // .ptl files converted from them; empty otherwise.
+  std::span<const std::array<std::uint32_t, 3>> triangles() const { return triangles_; }
   // What the renderer draws (its address stays the same for the model's life, moves included).
   const RenderModel& renderable() const { return *renderable_; }
   // The file's metadata text (.ptl, .qs), one "key: value" per line.
@@ -126,6 +129,8 @@ class Model {
   std::uint64_t file_size_ = 0;
   ScanInput scan_input_;
   std::unique_ptr<TreeFeatures> features_;
+  // A mesh's faces over the hierarchy's leaves (scans with faces, .ptl files that keep them).
+  std::vector<std::array<std::uint32_t, 3>> triangles_;
 };
 
 // Opens the model at `path`, chosen by its contents (.ptl, .qs) or, for anything else, read as a

@@ -33,7 +33,9 @@ struct RenderReport {
 // The report as a JSON document (two-space indent, keys in a fixed order, times in ms rounded
 // to microseconds), ending with a newline. Keys: splats, nodes_visited, culled_frustum,
 // culled_backface, width, height, threads; lod and mode; reconstruction and opacity (quality);
-// list_length, entries_scanned, fraction_scanned, chunks, chunks_culled (SPT); paged, pages,
+// list_length, entries_scanned, fraction_scanned, chunks, chunks_culled (SPT); hybrid,
+// triangle_px_per_epsilon, triangles_selected, triangles (drawn after near clipping),
+// triangle_entries_scanned (SPT --hybrid; frames also get triangles); paged, pages,
 // model_bytes, memory_cap, bytes_read, resident_bytes, resident_bytes_peak, pages_loaded,
 // pages_evicted, complete (paged); models [{path, kind, paging}]; ms {select, raster, total};
 // target_ms, hit_rate, frames [...] (sequences).

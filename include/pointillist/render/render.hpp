@@ -19,6 +19,7 @@ namespace pointillist {
 // Counts as in SelectionStats (selection.hpp).
 struct RenderStats {
   std::uint64_t splats = 0;           // splats rasterized
+  std::uint64_t triangles = 0;        // triangles rasterized (hybrid mode; after near clipping)
   std::uint64_t nodes_visited = 0;    // nodes whose sphere was tested
   std::uint64_t culled_frustum = 0;   // subtrees skipped outside the frustum (or nodes behind the eye)
   std::uint64_t culled_backface = 0;  // subtrees (or terminal nodes) skipped facing away

@@ -4,6 +4,7 @@
 // frames keeps (page caches, Sequential Point Trees built on first use).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -51,6 +52,9 @@ struct RenderModel {
   SphereTreeView tree;
   const PageSource* pages = nullptr;  // paged: draw from these pages
   const PointSet* mesh = nullptr;     // prepared points with faces, or null
+  // A mesh's faces over the hierarchy's leaves (indices in sphere_tree_leaves order), for the
+  // hybrid point/polygon mode; empty for point clouds and files that do not keep them.
+  std::span<const std::array<std::uint32_t, 3>> triangles;
   std::string name;                   // for messages (a path)
 };
 
@@ -83,6 +87,13 @@ struct FrameSettings {
   float epsilon_px = 1.0f;
   // SPT: skip chunks outside the view frustum (turn off only to measure what it saves).
   bool spt_chunk_culling = true;
+  // SPT: hybrid point/polygon rendering (lod/hybrid_lod.hpp): near the eye a mesh's triangles
+  // replace the points they cover, drawn by the fast rasterizer with per-pixel depth and
+  // shading. Models without triangles draw points only.
+  bool hybrid = false;
+  // Hybrid: a triangle replaces points while its longest edge projects to more than this many
+  // times epsilon_px pixels. > 0.
+  float triangle_px_per_epsilon = 4.0f;
   QualitySettings quality;
   // Every splat is drawn this many times its size (a point-size control); the level of detail
   // is chosen as at 1. > 0.
@@ -153,6 +164,9 @@ class Renderer {
   PagingStats paging_stats() const;
   // SPT selection details of the last frame (summed over instances).
   const SptSelectionStats& spt_stats() const { return spt_stats_; }
+  // Hybrid mode: triangles of the last frame (selected; scanned list entries).
+  std::uint64_t triangles_selected() const { return triangles_selected_; }
+  std::uint64_t triangle_entries_scanned() const { return triangle_entries_scanned_; }
 
  private:
   struct ModelState;
@@ -171,6 +185,10 @@ class Renderer {
   SplatStream scratch_stream_;
   QualityScratch quality_scratch_;
   SptSelectionStats spt_stats_;
+  std::uint64_t triangles_selected_ = 0, triangle_entries_scanned_ = 0;
+  // Hybrid mode: each instance's selected triangles, and the triangle rasterizer's buffers.
+  struct TriangleState;
+  std::unique_ptr<TriangleState> triangles_;
   std::uint64_t frame_number_ = 0;
   std::unique_ptr<SceneCull> cull_;  // occlusion culling: the scene's hierarchy and state
 };

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 
 #include "pointillist/core/camera.hpp"
 #include "pointillist/core/thread_pool.hpp"
@@ -50,6 +51,10 @@ struct SptRenderOptions {
   // Skip chunks whose bounding sphere lies outside the view frustum (the extension of the paper
   // this project adds). Turn off only to measure what it saves.
   bool chunk_culling = true;
+  // The entries' errors to select by instead of the tree's own (one per entry): the hybrid
+  // point/polygon lists' (HybridLod::entry_error), where leaves near the eye give way to
+  // triangles. Empty: the tree's.
+  std::span<const float> errors;
 };
 
 // Chooses the entries of `tree` to draw for `camera` and writes them as splats into `stream`:

@@ -36,6 +36,7 @@ struct ViewConstants {
   float epsilon2;      // (epsilon_px / f)²: compared with error² / r² (orthographic: r = 1)
   float facing_limit;  // 0 with backface culling (drop (c − eye)·n > 0), else +infinity
   bool ortho;          // orthographic: parallel rays along forward
+  const float* error = nullptr;  // the entries' e_g; null: the tree's own
 };
 
 // Entry i of [begin, end) is selected (mask 1) iff error² ≤ r²ε² < parent_error² and it faces the
@@ -51,7 +52,7 @@ void select_mask(const SequentialPointTree& t, std::uint32_t begin, std::uint32_
   const float* __restrict nx = t.normal_x.data() + begin;
   const float* __restrict ny = t.normal_y.data() + begin;
   const float* __restrict nz = t.normal_z.data() + begin;
-  const float* __restrict err = t.error.data() + begin;
+  const float* __restrict err = (v.error ? v.error : t.error.data()) + begin;
   const float* __restrict perr = t.parent_error.data() + begin;
   const float ex = v.eye.x, ey = v.eye.y, ez = v.eye.z, eps2 = v.epsilon2;
   const float facing_limit = v.facing_limit;
@@ -299,8 +300,14 @@ void select_splats_spt(const SequentialPointTree& tree, const CameraFrame& camer
   stats.chunks_total = tree.chunks.size();
   if (tree.node_count() == 0) return;
 
+  if (!options.errors.empty() && options.errors.size() != tree.node_count()) {
+    throw Error("SPT selection: " + std::to_string(options.errors.size()) +
+                " entry errors given for " + std::to_string(tree.node_count()) +
+                " entries; build the hybrid lists from this tree");
+  }
   const render_detail::Shader shader(settings, camera);
-  const ViewConstants v = spt_view(camera, settings, options.epsilon_px);
+  ViewConstants v = spt_view(camera, settings, options.epsilon_px);
+  if (!options.errors.empty()) v.error = options.errors.data();
 
   // The ranges to scan and their prefixes, cut into blocks.
   std::vector<Block> blocks;
