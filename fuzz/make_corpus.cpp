@@ -291,6 +291,17 @@ void make_models(const fs::path& root, ThreadPool& pool) {
     write_ptl_v2((v2 / "features.ptl").string(), tree, "seed: features", {.features = &features});
   }
 
+  {
+    // A small mesh with its faces kept (the hybrid mode's section).
+    PointSet mesh = grid_mesh();
+    prepare_splats(mesh, pool, Progress::none());
+    std::vector<std::uint32_t> order;
+    const SphereTree tree = build_sphere_tree(mesh, pool, Progress::none(), {}, &order);
+    const auto faces = leaf_triangles(tree.view(), order, mesh.triangles);
+    write_ptl_v2((v2 / "faces.ptl").string(), tree, "seed: faces",
+                 {.page_bytes = 1024, .triangles = faces});
+  }
+
   write_qs((root / "qs" / "colors.qs").string(), small);
   write_qs((root / "qs" / "mesh.qs").string(), grid_mesh(), {.write_comments = true});
   write_qs((root / "qs" / "plain.qs").string(), plain, {.write_comments = false});

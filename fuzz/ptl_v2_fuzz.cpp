@@ -1,5 +1,5 @@
 // libFuzzer harness for .ptl version 2 (quantized pages): PtlV2File::open (header, schema, page
-// table), decode_all, the sharp-features section, every page through the page source (as the paged renderer loads them),
+// table), decode_all, the sharp-features section, the mesh faces' section, every page through the page source (as the paged renderer loads them),
 // and the model opened decoded and paged by open_model, each drawn at 32x24.
 #include "fuzz_support.hpp"
 #include "pointillist/format/ptl_v2.hpp"
@@ -14,6 +14,13 @@ void load_every_page(const std::string& path) {
   const std::unique_ptr<PtlV2File> file = PtlV2File::open(path);
   fuzz::expect_reader_errors(path, [&] { (void)file->decode_all(); });
   fuzz::expect_reader_errors(path, [&] { (void)file->features(); });
+  fuzz::expect_reader_errors(path, [&] {
+    for (const auto& t : file->triangles()) {
+      for (const std::uint32_t c : t) {
+        if (c >= file->leaf_count()) fuzz::finding("a triangle corner beyond the leaves");
+      }
+    }
+  });
   const std::unique_ptr<PageSource> source = ptl_v2_page_source(*file);
   (void)source->summary();
   HierarchyPage page;

@@ -104,6 +104,10 @@ Command add_convert_command(CLI::App& app) {
                             "before 2026-11-24 reads)");
   trim_option->group(kGroupOutput);
   cmd->add_flag("--ascii", o->convert.ascii, "Write .ply output as ascii")->group(kGroupOutput);
+  cmd->add_flag("--no-faces{false}", o->convert.keep_faces,
+                ".ptl v2 of a mesh: leave out its faces (kept by default, about 5 bytes a "
+                "triangle, for render --lod spt --hybrid)")
+      ->group(kGroupOutput);
   auto features = std::make_shared<FeatureOptions>();
   auto with_features = std::make_shared<bool>(false);
   cmd->add_flag("--features", *with_features,

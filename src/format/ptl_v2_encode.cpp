@@ -11,6 +11,7 @@
 #include "ptl_header.hpp"
 #include "ptl_v2_codec.hpp"
 #include "ptl_v2_features.hpp"
+#include "ptl_v2_mesh.hpp"
 #include "pointillist/core/error.hpp"
 
 namespace pointillist::ptl2 {
@@ -412,7 +413,9 @@ std::vector<std::uint8_t> header_and_table(const HeaderFields& f,
   // The frame only when it is not the default, so such files keep their old bytes.
   const bool frame = f.origin != std::array<double, 3>{} || !(f.up == Vec3f{0, 1, 0});
   store_u32(h + offset::kCompatFlags,
-            (frame ? kCompatFrame : 0) | (f.features_size == 0 ? 0 : kCompatFeatures));
+            (frame ? kCompatFrame : 0) | (f.features_size == 0 ? 0 : kCompatFeatures) |
+                (f.mesh_offset == 0 ? 0 : kCompatMesh));
+  if (f.mesh_offset != 0) store_u64(h + kMeshOffsetAt, f.mesh_offset);
   if (f.features_size != 0) {
     store_u64(h + kFeaturesOffsetAt, f.features_offset);
     store_u64(h + kFeaturesSizeAt, f.features_size);

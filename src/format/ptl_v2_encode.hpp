@@ -108,6 +108,7 @@ struct HeaderFields {
   std::uint32_t page_bytes = 0;
   std::uint64_t metadata_offset = 0, metadata_size = 0;
   std::uint64_t features_offset = 0, features_size = 0;  // size 0: no features section
+  std::uint64_t mesh_offset = 0;  // 0: no mesh section
   Sphere root_sphere;
   Aabb bounds;
   Sphere view_sphere;

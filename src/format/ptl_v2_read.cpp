@@ -12,6 +12,7 @@
 #include "ptl_header.hpp"
 #include "ptl_v2_codec.hpp"
 #include "ptl_v2_features.hpp"
+#include "ptl_v2_mesh.hpp"
 #include "ptl_v2_layout.hpp"
 #include "ptl_v2_mapping.hpp"
 #include "pointillist/core/file_bytes.hpp"
@@ -250,6 +251,16 @@ std::unique_ptr<PtlV2File> PtlV2File::open(const std::string& path) {
     }
     file->features_offset_ = at;
     file->features_size_ = bytes;
+  }
+  if (load_u32(b + offset::kCompatFlags) & kCompatMesh) {
+    const std::uint64_t at = load_u64(b + kMeshOffsetAt);
+    if (at < header_size || at > size) {
+      fail_at(path, kMeshOffsetAt,
+              "the mesh faces' section starts at byte " + str(at) + ", outside the file (" +
+                  str(size) + " bytes); it was probably truncated");
+    }
+    file->mesh_size_ = mesh_section_size(view.substr(at), at, path);
+    file->mesh_offset_ = at;
   }
   return file;
 }

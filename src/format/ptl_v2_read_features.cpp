@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "ptl_v2_features.hpp"
+#include "ptl_v2_mesh.hpp"
 #include "ptl_v2_mapping.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/format/ptl_v2.hpp"
@@ -109,6 +110,12 @@ void PtlV2File::gather_features(const SphereTree& tree, std::span<const PtlV2Pag
     out.clip_planes.insert(out.clip_planes.end(), planes.begin(), planes.end());
     out.clip_offset[i + 1] = static_cast<std::uint32_t>(out.clip_planes.size());
   }
+}
+
+std::vector<std::array<std::uint32_t, 3>> PtlV2File::triangles() const {
+  if (mesh_offset_ == 0) return {};
+  return decode_mesh(map_->bytes.view().substr(mesh_offset_, mesh_size_), mesh_offset_,
+                     leaf_count_, page_count(), path_);
 }
 
 }  // namespace pointillist

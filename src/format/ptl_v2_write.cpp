@@ -5,6 +5,7 @@
 
 #include "ptl_v2_encode.hpp"
 #include "ptl_v2_features.hpp"
+#include "ptl_v2_mesh.hpp"
 #include "pointillist/core/atomic_file.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/format/ptl_v2.hpp"
@@ -55,11 +56,20 @@ PtlV2WriteReport write_ptl_v2(const std::string& path, const SphereTree& tree,
     table.push_back(page_entry(pg, page_offset));
     page_offset += pg.byte_size;
   }
-  std::vector<std::uint8_t> feature_bytes;
-  if (options.features) {
-    std::vector<std::span<const std::uint32_t>> page_nodes;
-    for (const PagePlan& pg : pages) page_nodes.emplace_back(pg.nodes);
-    feature_bytes = encode_features(nodes, *options.features, page_nodes);
+  std::vector<std::span<const std::uint32_t>> page_nodes;
+  for (const PagePlan& pg : pages) page_nodes.emplace_back(pg.nodes);
+  std::vector<std::uint8_t> feature_bytes, mesh_bytes;
+  if (options.features) feature_bytes = encode_features(nodes, *options.features, page_nodes);
+  if (!options.triangles.empty()) {
+    for (std::size_t t = 0; t < options.triangles.size(); ++t) {
+      for (const std::uint32_t c : options.triangles[t]) {
+        if (c >= leaves) {
+          throw Error("cannot write " + path + ": triangle " + std::to_string(t) +
+                      " refers to leaf " + std::to_string(c) + " of " + std::to_string(leaves));
+        }
+      }
+    }
+    mesh_bytes = encode_mesh(nodes, options.triangles, page_nodes);
   }
   HeaderFields fields;
   fields.colors = colors;
@@ -73,6 +83,8 @@ PtlV2WriteReport write_ptl_v2(const std::string& path, const SphereTree& tree,
   fields.metadata_size = metadata.size();
   fields.features_offset = feature_bytes.empty() ? 0 : page_offset + metadata.size();
   fields.features_size = feature_bytes.size();
+  fields.mesh_offset =
+      mesh_bytes.empty() ? 0 : page_offset + metadata.size() + feature_bytes.size();
   fields.root_sphere = enc.root_parent;
   fields.bounds = tree.bounds;
   fields.view_sphere = tree.view_sphere;
@@ -102,9 +114,11 @@ PtlV2WriteReport write_ptl_v2(const std::string& path, const SphereTree& tree,
   }
   file.write(metadata.data(), metadata.size());
   file.write(feature_bytes.data(), feature_bytes.size());
+  file.write(mesh_bytes.data(), mesh_bytes.size());
   file.commit();
 
-  report.file_size = page_offset + metadata.size() + feature_bytes.size();
+  report.file_size = page_offset + metadata.size() + feature_bytes.size() + mesh_bytes.size();
+  report.mesh_bytes = mesh_bytes.size();
   report.record_bytes = std::uint64_t{n} * record_size;
   report.node_count = n;
   report.leaf_count = leaves;

@@ -220,8 +220,17 @@ ConvertResult convert_points(PointSet points, std::span<const std::string> input
     // The faces have given their normals and radii; the points, once in the tree, are no longer
     // needed. Freed early, their memory is reused by the next phase instead of fresh pages
     // (each first touch costs; the dragon's faces alone are 10 MB).
+    // .ptl v2 keeps them for the hybrid point/polygon mode (--no-faces drops them), moved out
+    // first and put on the leaves once the tree is built.
+    const bool keep_faces = o.keep_faces && o.ptl_version == 2 && points.is_mesh();
+    std::vector<std::array<std::uint32_t, 3>> faces = std::move(points.triangles);
     points.triangles = {};
-    const SphereTree tree = build_sphere_tree(points, pool, progress);
+    if (!keep_faces) faces = {};
+    std::vector<std::uint32_t> split_order;
+    const SphereTree tree =
+        build_sphere_tree(points, pool, progress, {}, keep_faces ? &split_order : nullptr);
+    if (keep_faces) faces = leaf_triangles(tree.view(), split_order, faces);
+    split_order = {};
     phase_done("hierarchy");
     std::ostringstream meta;
     meta << metadata_head(inputs, o);
@@ -234,6 +243,8 @@ ConvertResult convert_points(PointSet points, std::span<const std::string> input
     } else {
       PtlV2WriteOptions v2;
       if (o.leaf_trim) v2.leaf_trim = *o.leaf_trim;
+      v2.triangles = faces;
+      if (keep_faces) meta << "faces: " << faces.size() << " triangles kept (render --hybrid)\n";
       write_ptl_v2(output, tree, meta.str(), v2, pool);
       phase_done("write");
       if (o.features) {

@@ -105,6 +105,8 @@ Model Model::open_file(const std::string& path, const OpenModelOptions& options,
       if (stored) model.features_ = std::make_unique<TreeFeatures>();
       model.built_ = model.v2_->decode_all(model.features_.get());
       model.view_ = model.built_.view();
+      // A mesh's faces (hybrid rendering draws models held whole).
+      if (model.v2_->has_triangles()) model.triangles_ = model.v2_->triangles();
     }
     return model;
   }

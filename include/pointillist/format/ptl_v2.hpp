@@ -65,12 +65,17 @@ struct PtlV2WriteOptions {
   // Sharp features of the tree's nodes to store (the leaves' surface ids and clip planes, in a
   // section after the metadata), or null.
   const TreeFeatures* features = nullptr;
+  // A mesh's faces over the tree's leaves (leaf k = the k-th node without children in node
+  // order, as sphere_tree_leaves lists them), kept for the hybrid point/polygon mode in a section
+  // after the features, a block per page (about 5 bytes a triangle); empty: none.
+  std::span<const std::array<std::uint32_t, 3>> triangles;
 };
 
 // What write_ptl_v2 did.
 struct PtlV2WriteReport {
   std::uint64_t file_size = 0;     // bytes
   std::uint64_t record_bytes = 0;  // bytes of node records alone
+  std::uint64_t mesh_bytes = 0;    // bytes of the mesh faces' section (0 without)
   std::uint64_t node_count = 0;
   std::uint64_t leaf_count = 0;
   std::uint32_t page_count = 0;
@@ -238,6 +243,11 @@ class PtlV2File {
   // Memory page `page`'s features take when loaded (PageFeatures::memory_bytes; 0 without page
   // features).
   std::uint64_t page_feature_memory(std::uint32_t page) const;
+  // Whether the file keeps a mesh's faces, and the faces over the leaves (indices in node order
+  // of the leaves, as decode_all's), every page's block in page order. Throws FormatError for a
+  // damaged section.
+  bool has_triangles() const { return mesh_offset_ != 0; }
+  std::vector<std::array<std::uint32_t, 3>> triangles() const;
   std::uint64_t file_size() const { return size_; }
   const std::string& path() const { return path_; }
 
@@ -280,6 +290,7 @@ class PtlV2File {
   Vec3f up_{0, 1, 0};
   std::string metadata_;
   std::uint64_t features_offset_ = 0, features_size_ = 0;
+  std::uint64_t mesh_offset_ = 0, mesh_size_ = 0;
   std::vector<PtlV2PageInfo> pages_;
 };
 

@@ -29,6 +29,9 @@ struct ConvertOptions {
   std::optional<quant::LeafTrim> leaf_trim;
   // .ptl v2 output: compute the sharp features on the hierarchy's leaves and store them.
   std::optional<FeatureOptions> features;
+  // .ptl v2 output of a mesh: keep its faces (about 5 bytes a triangle) for the hybrid
+  // point/polygon mode (render --lod spt --hybrid). Off: points only.
+  bool keep_faces = true;
   // Bytes of memory the conversion may use; 0: half of the physical memory. Point clouds that
   // need more in one piece (about 220 bytes a point) are converted to .ptl v2 in chunks that
   // fit; other outputs and meshes that do not fit are refused before any work.
