@@ -194,14 +194,18 @@ TEST(HybridSelection, MatchesBruteForceAndCoversEverySuppressedVertex) {
         for (int k = 0; k < 3; ++k) all = all && pl.distance(b.leaves.positions[tri[k]]) < 0;
         all_outside_one = all_outside_one || all;
       }
-      for (int k = 0; k < 3; ++k) r = std::min(r, double(distance(b.leaves.positions[tri[k]], cf.eye)));
+      bool away = true;
+      for (int k = 0; k < 3; ++k) {
+        r = std::min(r, double(distance(b.leaves.positions[tri[k]], cf.eye)));
+        away = away && dot(b.leaves.normals[tri[k]], cf.eye - b.leaves.positions[tri[k]]) < 0;
+      }
       // Away from the boundary of the test (rounding), the rule decides.
       const double lhs = r * epsilon, rhs = b.hybrid.triangle_error[t];
       if (std::abs(lhs - rhs) < 1e-5 * rhs) {
         if (got.count(t)) want.insert(t);
         continue;
       }
-      if (lhs < rhs && !all_outside_one) want.insert(t);
+      if (lhs < rhs && !all_outside_one && !away) want.insert(t);
     }
     ASSERT_EQ(got, want) << "trial " << trial;
     drawn_total += got.size();
@@ -213,7 +217,8 @@ TEST(HybridSelection, MatchesBruteForceAndCoversEverySuppressedVertex) {
       const bool suppressed = in_interval && r * epsilon < b.hybrid.entry_error[e];
       bool in_view = true;
       for (const Plane& pl : cf.planes) in_view = in_view && pl.distance(b.leaves.positions[v]) >= 0;
-      if (!suppressed || !in_view) continue;
+      const bool facing = dot(b.leaves.normals[v], cf.eye - b.leaves.positions[v]) >= 0;
+      if (!suppressed || !in_view || !facing) continue;
       ++suppressed_total;
       for (std::uint32_t t : around[v]) {
         ASSERT_TRUE(got.count(t)) << "trial " << trial << ": vertex " << v << " suppressed but "

@@ -28,7 +28,8 @@ bool sphere_outside(const CameraFrame& cam, const Sphere& s) {
 
 // Scans one group's prefix into `out`.
 void select_group(const HybridLod& lod, const HybridTriangleGroup& g, const CameraFrame& cam,
-                  float epsilon, std::vector<std::uint32_t>& out, std::uint64_t& scanned) {
+                  float epsilon, bool backface_culling, std::vector<std::uint32_t>& out,
+                  std::uint64_t& scanned) {
   const float r_lo =
       cam.ortho ? 1.0f : std::max(0.0f, distance(g.bounds.center, cam.eye) - g.bounds.radius);
   const float limit = r_lo * epsilon;
@@ -52,6 +53,15 @@ void select_group(const HybridLod& lod, const HybridTriangleGroup& g, const Came
     }
     const float e = lod.triangle_error[t];
     if (!(r2 * eps2 < e * e)) continue;
+    if (backface_culling) {
+      // Dropped as the splats are: when every corner's normal faces away from the eye.
+      bool away = true;
+      for (int k = 0; k < 3; ++k) {
+        const Vec3f p = lod.positions[tri[k]];
+        away = away && dot(lod.normals[tri[k]], cam.ortho ? -cam.forward : eye - p) < 0.0f;
+      }
+      if (away) continue;
+    }
     bool outside = false;
     for (const Plane& pl : cam.planes) {
       outside = outside || (pl.distance(lod.positions[tri[0]]) < 0 &&
@@ -124,7 +134,8 @@ void select_triangles(const HybridLod& lod, const CameraFrame& camera,
   std::vector<std::vector<std::uint32_t>> parts(visible.size());
   std::vector<std::uint64_t> scanned(visible.size(), 0);
   pool.run(visible.size(), [&](std::size_t k) {
-    select_group(lod, lod.groups[visible[k]], camera, epsilon, parts[k], scanned[k]);
+    select_group(lod, lod.groups[visible[k]], camera, epsilon, settings.culls_backfaces(),
+                 parts[k], scanned[k]);
   });
   const std::size_t before = out.size();
   for (std::size_t k = 0; k < parts.size(); ++k) {

@@ -99,6 +99,7 @@ void raster_triangle(const CameraFrame& cam, const Shader& shader, ScreenVertex 
   const double lo_y = std::max(double(row_begin), std::ceil(std::min({a.y, b.y, c.y}) - 0.5));
   const double hi_y = std::min(double(row_end - 1), std::floor(std::max({a.y, b.y, c.y}) - 0.5));
   if (!(lo_x <= hi_x && lo_y <= hi_y)) return;
+  const double inv_area = 1.0 / area;
   const float half_w = 0.5f * static_cast<float>(cam.width);
   const float half_h = 0.5f * static_cast<float>(cam.height);
   for (int j = static_cast<int>(lo_y); j <= static_cast<int>(hi_y); ++j) {
@@ -110,7 +111,7 @@ void raster_triangle(const CameraFrame& cam, const Shader& shader, ScreenVertex 
                           (e_bc > 0 || (e_bc == 0 && tl_bc)) &&
                           (e_ca > 0 || (e_ca == 0 && tl_ca));
       if (!inside) continue;
-      const double wa = e_bc / area, wb = e_ca / area, wc = e_ab / area;
+      const double wa = e_bc * inv_area, wb = e_ca * inv_area, wc = e_ab * inv_area;
       const double inv_z = wa * a.inv_z + wb * b.inv_z + wc * c.inv_z;
       const float z = static_cast<float>(cam.ortho ? inv_z : 1.0 / inv_z);
       const std::size_t idx = static_cast<std::size_t>(j) * cam.width + i;
