@@ -103,6 +103,7 @@ int run_view(const CLI::App& cmd, ViewCommandOptions& o) {
     open.paging = Paging::Never;
   }
   open.stored_features = o.frame.features;
+  if (o.frame.hybrid) o.frame.lod = LodScheme::Spt;
   if ((o.frame.occlusion.method != OcclusionMethod::None || o.frame.lod == LodScheme::Spt) &&
       memory_cap == 0) {
     open.paging = Paging::Never;
@@ -183,6 +184,10 @@ Command add_view_command(CLI::App& app) {
   cmd->add_option("--epsilon", o->frame.epsilon_px, "SPT full detail: geometric error, pixels")
       ->default_val(1.0f)
       ->check(CLI::Range(0.001f, 1000.0f))
+      ->group(kGroupDetail);
+  cmd->add_flag("--hybrid", o->frame.hybrid,
+                "Meshes: draw triangles near the eye instead of the points they cover (with "
+                "the SPT; key p switches)")
       ->group(kGroupDetail);
   cmd->add_option("--fps", o->fps,
                   "Frame rate held while the camera moves (the detail drops to hold it)")

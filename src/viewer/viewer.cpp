@@ -85,6 +85,10 @@ std::string render_command_line(std::span<const std::string> base, const Camera&
   if (f.lod == LodScheme::Spt) {
     add("--lod", "spt");
     if (f.epsilon_px != 1.0f) add("--epsilon", number_text(f.epsilon_px));
+    if (f.hybrid) add("--hybrid", "");
+    if (f.hybrid && f.triangle_px_per_epsilon != 4.0f) {
+      add("--triangle-px", number_text(f.triangle_px_per_epsilon));
+    }
   } else if (s.threshold_px != 1.0f) {
     add("--threshold", number_text(s.threshold_px));
   }
@@ -108,6 +112,7 @@ std::string viewer_help() {
          "keys:  1-6 front, back, left, right, top, bottom views; 0 or r reset the view\n"
          "       m fast / quality mode; k splat kernel (square, circle, ellipse)\n"
          "       l QSplat / Sequential Point Tree; plus / minus splat size\n"
+         "       p hybrid points and triangles (meshes; switches to the SPT)\n"
          "       e eye-dome lighting on / off; t two-sided lighting on / off\n"
          "       o orthographic / perspective camera\n"
          "       f sharp features on / off; c occlusion culling (none / chc++)\n"

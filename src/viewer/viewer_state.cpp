@@ -141,6 +141,12 @@ bool ViewerState::toggle(const std::string& k) {
   } else if (k == "l") {
     // Full detail follows (finest()): the other scheme's parameter as the viewer started with.
     frame_.lod = frame_.lod == LodScheme::QSplat ? LodScheme::Spt : LodScheme::QSplat;
+    if (frame_.lod == LodScheme::QSplat) frame_.hybrid = false;  // it draws with SPT only
+  } else if (k == "p") {
+    // Hybrid point/polygon rendering needs the Sequential Point Tree: switching it on switches
+    // to SPT, switching it off leaves the scheme alone.
+    frame_.hybrid = !frame_.hybrid;
+    if (frame_.hybrid) frame_.lod = LodScheme::Spt;
   } else if (k == "plus") {
     frame_.splat_scale = std::min(100.0f, frame_.splat_scale * kSplatScaleStep);
   } else if (k == "minus") {
@@ -271,6 +277,7 @@ std::string ViewerState::title(const Renderer& renderer, double now_ms,
   t += name(settings_.shape);
   t += ' ';
   t += name(frame_.lod);
+  if (frame_.hybrid) t += " hybrid";
   if (frame_.splat_scale != 1.0f) {
     std::snprintf(s, sizeof s, " size x%.2f", double(frame_.splat_scale));
     t += s;

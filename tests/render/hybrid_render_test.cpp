@@ -195,10 +195,16 @@ TEST(HybridSelection, MatchesBruteForceAndCoversEverySuppressedVertex) {
         all_outside_one = all_outside_one || all;
       }
       bool away = true;
+      Vec3f sum{0, 0, 0};
       for (int k = 0; k < 3; ++k) {
         r = std::min(r, double(distance(b.leaves.positions[tri[k]], cf.eye)));
         away = away && dot(b.leaves.normals[tri[k]], cf.eye - b.leaves.positions[tri[k]]) < 0;
+        sum = sum + b.leaves.normals[tri[k]];
       }
+      const Vec3f p0 = b.leaves.positions[tri[0]];
+      Vec3f face = cross(b.leaves.positions[tri[1]] - p0, b.leaves.positions[tri[2]] - p0);
+      if (dot(face, sum) < 0) face = -face;
+      away = away && dot(face, cf.eye - p0) < 0;
       // Away from the boundary of the test (rounding), the rule decides.
       const double lhs = r * epsilon, rhs = b.hybrid.triangle_error[t];
       if (std::abs(lhs - rhs) < 1e-5 * rhs) {

@@ -9,6 +9,7 @@
 #include <fstream>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <deque>
 #include <memory>
@@ -17,6 +18,7 @@
 
 #include "pointillist/core/progress.hpp"
 #include "pointillist/format/ptl_v2.hpp"
+#include "pointillist/io/ply.hpp"
 #include "pointillist/io/png.hpp"
 #include "pointillist/lod/sphere_tree.hpp"
 #include "pointillist/pipeline/model.hpp"
@@ -250,4 +252,63 @@ TEST(ViewerLoop, RenderCommandLineNamesTheCameraExactlyAndTheToggledModes) {
   EXPECT_EQ(std::strtof("0.100000001", nullptr), c.eye.x);
   EXPECT_EQ(std::strtof("-2.49999999e-07", nullptr), c.eye.y);
   EXPECT_EQ(std::strtof("0.333333343", nullptr), c.target.x);
+}
+
+// Key p: hybrid points and triangles. On a mesh the settled view is the headless hybrid render
+// of its camera (triangles drawn); on a point cloud the toggle is refused and undone.
+TEST(ViewerLoop, HybridKeyDrawsTrianglesOnMeshesAndIsRefusedOnClouds) {
+  ThreadPool pool(2);
+  pointillist::testing::TempDir dir;
+  // A UV sphere mesh of radius 1.
+  PointSet mesh;
+  const int stacks = 30, slices = 60;
+  for (int i = 0; i <= stacks; ++i) {
+    const float t = 3.14159265f * float(i) / float(stacks);
+    for (int j = 0; j < slices; ++j) {
+      const float p = 2 * 3.14159265f * float(j) / float(slices);
+      mesh.positions.push_back({std::sin(t) * std::cos(p), std::cos(t), -std::sin(t) * std::sin(p)});
+    }
+  }
+  for (int i = 0; i < stacks; ++i) {
+    for (int j = 0; j < slices; ++j) {
+      const auto a = std::uint32_t(i * slices + j), b = std::uint32_t(i * slices + (j + 1) % slices);
+      mesh.triangles.push_back({a, a + slices, b + slices});
+      mesh.triangles.push_back({a, b + slices, b});
+    }
+  }
+  write_ply(dir.file("sphere.ply"), mesh);
+  const Model model = open_model(dir.file("sphere.ply"), {}, pool, Progress::none());
+  ASSERT_FALSE(model.triangles().empty());
+  const std::vector<SceneInstance> scene{{.model = &model.renderable()}};
+  const Camera home = orbit_camera(model.tree().view_sphere, {.distance = 1.6f, .width = 320,
+                                                              .height = 240});
+  Navigator nav(home, model.tree().view_sphere, {0, 1, 0});
+  ViewerOptions o = scripted(dir, "key p\nsettle\nscreenshot " + dir.file("h.png") + "\n");
+  Renderer renderer;
+  RecordingWindow window;
+  const ViewerResult r = run_viewer(renderer, scene, nav, window, pool, o, stdout);
+  ASSERT_EQ(r.screenshots.size(), 1u);
+  EXPECT_THAT(window.titles.back(), HasSubstr("spt hybrid"));
+  ViewerOptions hybrid = o;
+  hybrid.frame.lod = LodScheme::Spt;
+  hybrid.frame.hybrid = true;
+  Renderer fresh;
+  Frame want;
+  render_settled(fresh, scene, nav.camera(), hybrid.settings, hybrid.frame, pool, want);
+  EXPECT_GT(want.stats.triangles, 0u);
+  const ImageRgb8 h = read_png_rgb8(dir.file("h.png"));
+  EXPECT_TRUE(std::equal(h.pixels.begin(), h.pixels.end(), want.color.begin()));
+
+  Fixture fx;  // a point cloud: refused
+  Navigator cloud_nav(fx.home, fx.tree.view_sphere, {0, 1, 0});
+  ViewerOptions c = scripted(dir, "key p\nsettle\n");
+  Renderer cloud_renderer;
+  RecordingWindow cloud_window;
+  run_viewer(cloud_renderer, fx.scene, cloud_nav, cloud_window, fx.pool, c, stdout);
+  bool refused = false;
+  for (const std::string& t : cloud_window.titles) {
+    refused = refused || t.find("refused: ") != std::string::npos;
+  }
+  EXPECT_TRUE(refused);
+  EXPECT_THAT(cloud_window.titles.back(), HasSubstr("fast circle qsplat \xc2\xb7"));  // undone
 }

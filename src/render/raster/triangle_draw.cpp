@@ -26,6 +26,25 @@ bool sphere_outside(const CameraFrame& cam, const Sphere& s) {
   return false;
 }
 
+// Whether a triangle is dropped by backface culling: every corner's normal faces away from the
+// eye (as the splats are dropped), and so does its plane (oriented by the corners' normals), so
+// that at a silhouette, where smoothed normals turn away before the surface does, the triangle
+// is still drawn as the reference draws it.
+bool faces_away(const HybridLod& lod, const std::array<std::uint32_t, 3>& tri,
+                const CameraFrame& cam) {
+  const Vec3f a = lod.positions[tri[0]];
+  const auto to_eye = [&](Vec3f p) { return cam.ortho ? -cam.forward : cam.eye - p; };
+  Vec3f sum{0, 0, 0};
+  for (int k = 0; k < 3; ++k) {
+    const Vec3f n = lod.normals[tri[k]];
+    if (!(dot(n, to_eye(lod.positions[tri[k]])) < 0.0f)) return false;
+    sum = sum + n;
+  }
+  Vec3f face = cross(lod.positions[tri[1]] - a, lod.positions[tri[2]] - a);
+  if (dot(face, sum) < 0.0f) face = -face;
+  return dot(face, to_eye(a)) < 0.0f;
+}
+
 // Scans one group's prefix into `out`.
 void select_group(const HybridLod& lod, const HybridTriangleGroup& g, const CameraFrame& cam,
                   float epsilon, bool backface_culling, std::vector<std::uint32_t>& out,
@@ -53,15 +72,7 @@ void select_group(const HybridLod& lod, const HybridTriangleGroup& g, const Came
     }
     const float e = lod.triangle_error[t];
     if (!(r2 * eps2 < e * e)) continue;
-    if (backface_culling) {
-      // Dropped as the splats are: when every corner's normal faces away from the eye.
-      bool away = true;
-      for (int k = 0; k < 3; ++k) {
-        const Vec3f p = lod.positions[tri[k]];
-        away = away && dot(lod.normals[tri[k]], cam.ortho ? -cam.forward : eye - p) < 0.0f;
-      }
-      if (away) continue;
-    }
+    if (backface_culling && faces_away(lod, tri, cam)) continue;
     bool outside = false;
     for (const Plane& pl : cam.planes) {
       outside = outside || (pl.distance(lod.positions[tri[0]]) < 0 &&

@@ -29,8 +29,9 @@ struct TriangleSelectionStats {
 // group whose sphere meets the frustum (when settings.frustum_culling), the prefix with
 // E_t > r_lo·ε is scanned and triangle t kept iff r_t·ε < E_t (r_t the smallest eye distance
 // of its vertices; orthographic: 1), no frustum plane has all three vertices outside, and (with
-// settings.culls_backfaces(), as for the splats) not every corner's normal faces away from the
-// eye. A vertex that faces the eye never loses its triangles to the last rule.
+// settings.culls_backfaces(), as for the splats) not both every corner's normal and the
+// triangle's plane (oriented by those normals) face away from the eye. A vertex that faces the
+// eye never loses its triangles to the last rule.
 // Group order, then list order: the same for any thread count.
 void select_triangles(const HybridLod& lod, const CameraFrame& camera,
                       const RenderSettings& settings, float epsilon_px, ThreadPool& pool,

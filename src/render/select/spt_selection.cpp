@@ -37,7 +37,17 @@ struct ViewConstants {
   float facing_limit;  // 0 with backface culling (drop (c − eye)·n > 0), else +infinity
   bool ortho;          // orthographic: parallel rays along forward
   const float* error = nullptr;  // the entries' e_g; null: the tree's own
+  // With `error` (the hybrid lists): leaves seen within this cosine of edge-on keep their splats
+  // where triangles replace them, squared.
+  float silhouette_cos2 = 0;
 };
+
+// Hybrid mode: a leaf seen nearly edge-on (|cos| of the angle between its normal and the view
+// direction below kSilhouetteCos) keeps its splat even where the triangles around it are drawn.
+// There the triangles of a quantized model (.ptl leaf positions are within a fraction of a splat
+// radius of the mesh's vertices) can fall up to a pixel short of the true silhouette, and the
+// splat, as in the pure SPT, covers it.
+constexpr float kSilhouetteCos = 0.05f;
 
 // Entry i of [begin, end) is selected (mask 1) iff error² ≤ r²ε² < parent_error² and it faces the
 // eye, (c − eye)·n ≤ facing_limit (mask 2: in its interval but facing away). Written without
@@ -57,6 +67,23 @@ void select_mask(const SequentialPointTree& t, std::uint32_t begin, std::uint32_
   const float ex = v.eye.x, ey = v.eye.y, ez = v.eye.z, eps2 = v.epsilon2;
   const float facing_limit = v.facing_limit;
   const std::uint32_t n = end - begin;
+  if (v.error) {
+    // Hybrid lists: as below, and the silhouette leaves (tree error 0) kept.
+    const float* __restrict own = t.error.data() + begin;
+    const float s2 = v.silhouette_cos2;
+    const float fx = v.forward.x, fy = v.forward.y, fz = v.forward.z;
+    for (std::uint32_t i = 0; i < n; ++i) {
+      const float dx = v.ortho ? fx : cx[i] - ex, dy = v.ortho ? fy : cy[i] - ey,
+                  dz = v.ortho ? fz : cz[i] - ez;
+      const float d2 = dx * dx + dy * dy + dz * dz;
+      const float re2 = v.ortho ? eps2 : d2 * eps2;
+      const float facing = dx * nx[i] + dy * ny[i] + dz * nz[i];
+      const int silhouette = (own[i] == 0.0f) & (facing * facing < s2 * d2);
+      const int in = ((err[i] * err[i] <= re2) | silhouette) & (re2 < perr[i] * perr[i]);
+      mask[i] = static_cast<std::uint8_t>(in + (in & (facing > facing_limit)));
+    }
+    return;
+  }
   if (v.ortho) {
     // Every entry is seen at the same scale and from the same direction.
     const float fx = v.forward.x, fy = v.forward.y, fz = v.forward.z;
@@ -307,7 +334,10 @@ void select_splats_spt(const SequentialPointTree& tree, const CameraFrame& camer
   }
   const render_detail::Shader shader(settings, camera);
   ViewConstants v = spt_view(camera, settings, options.epsilon_px);
-  if (!options.errors.empty()) v.error = options.errors.data();
+  if (!options.errors.empty()) {
+    v.error = options.errors.data();
+    v.silhouette_cos2 = kSilhouetteCos * kSilhouetteCos;
+  }
 
   // The ranges to scan and their prefixes, cut into blocks.
   std::vector<Block> blocks;
