@@ -47,7 +47,7 @@ HybridLod build_hybrid_lod(const SequentialPointTree& tree, const PointSet& leav
   h.positions = leaves.positions;
   h.normals = leaves.normals;
   if (tree.has_colors) h.colors = leaves.colors;
-  h.entry_error = tree.error;
+  h.suppress_below.assign(tree.node_count(), 0.0f);
   h.groups.resize(tree.chunks.size());
   if (n == 0 || tree.chunks.empty()) return h;
 
@@ -64,11 +64,11 @@ HybridLod build_hybrid_lod(const SequentialPointTree& tree, const PointSet& leav
     }
   }
 
-  // e_t and e'_v.
+  // e_t, and m_N bottom-up (a parent's index is smaller than its children's).
   const float per_edge = 1.0f / options.triangle_px_per_epsilon;
   const float inf = std::numeric_limits<float>::infinity();
-  std::vector<float> leaf_error(n, inf);
-  std::vector<float> own(triangles.size());
+  const std::size_t entries = tree.node_count();
+  std::vector<float> m(entries, inf);
   for (std::size_t t = 0; t < triangles.size(); ++t) {
     const auto& tri = triangles[t];
     for (int k = 0; k < 3; ++k) {
@@ -80,16 +80,22 @@ HybridLod build_hybrid_lod(const SequentialPointTree& tree, const PointSet& leav
     }
     const Vec3f a = leaves.positions[tri[0]], b = leaves.positions[tri[1]],
                 c = leaves.positions[tri[2]];
-    const float longest = std::max({length(b - a), length(c - b), length(a - c)});
-    own[t] = longest * per_edge;
-    for (int k = 0; k < 3; ++k) leaf_error[tri[k]] = std::min(leaf_error[tri[k]], own[t]);
+    const float own = std::max({length(b - a), length(c - b), length(a - c)}) * per_edge;
+    for (int k = 0; k < 3; ++k) m[entry_of[tri[k]]] = std::min(m[entry_of[tri[k]]], own);
   }
-  for (std::size_t v = 0; v < n; ++v) {
-    const std::uint32_t e = entry_of[v];
-    const float raised = leaf_error[v] == inf ? 0.0f : std::min(leaf_error[v], tree.parent_error[e]);
-    leaf_error[v] = raised;
-    h.entry_error[e] = raised;
-    h.suppressible_leaves += raised > 0.0f;
+  for (std::size_t e = entries; e-- > 1;) {
+    const std::uint32_t p = tree.parent[e];
+    if (p != kSptNoParent) m[p] = std::min(m[p], m[e]);
+  }
+  // s_N, then top-down the largest s on each path from the root (in m's place).
+  for (std::size_t e = 0; e < entries; ++e) {
+    const float s = m[e] == inf ? 0.0f
+                                : std::min(std::max(tree.error[e], m[e]), tree.parent_error[e]);
+    const bool suppressible = s > tree.error[e];
+    h.suppress_below[e] = suppressible ? s : 0.0f;
+    (tree.is_leaf[e] ? h.suppressible_leaves : h.suppressible_interior) += suppressible;
+    const std::uint32_t p = tree.parent[e];
+    m[e] = std::max(p == kSptNoParent ? 0.0f : m[p], h.suppress_below[e]);
   }
 
   // E_t, the groups, and the order within each group.
@@ -98,7 +104,7 @@ HybridLod build_hybrid_lod(const SequentialPointTree& tree, const PointSet& leav
   std::vector<std::uint32_t> group_size(tree.chunks.size() + 1, 0);
   for (std::size_t t = 0; t < triangles.size(); ++t) {
     const auto& tri = triangles[t];
-    big_e[t] = std::max({leaf_error[tri[0]], leaf_error[tri[1]], leaf_error[tri[2]]}) *
+    big_e[t] = std::max({m[entry_of[tri[0]]], m[entry_of[tri[1]]], m[entry_of[tri[2]]]}) *
                kTriangleSlack;
     group_of[t] = chunk_of(tree, entry_of[tri[0]]);
     ++group_size[group_of[t] + 1];

@@ -227,7 +227,8 @@ SelectionStats Renderer::select(std::span<const SceneInstance> scene, const Came
       select_splats_spt(*state.spt, cam, settings,
                         {.epsilon_px = fs.epsilon_px,
                          .chunk_culling = fs.spt_chunk_culling,
-                         .errors = hybrid ? std::span<const float>(state.hybrid->entry_error)
+                         .suppress_below =
+                             hybrid ? std::span<const float>(state.hybrid->suppress_below)
                                           : std::span<const float>()},
                         pool, into, spt);
       selected = spt.as_selection();
@@ -268,6 +269,19 @@ SelectionStats Renderer::select(std::span<const SceneInstance> scene, const Came
     place.with_discs = with_discs;
     for (std::size_t c = 0; c < into.chunk_count; ++c) {
       place_chunk(into.chunks[c], place, settings);
+    }
+    if (fs.lod == LodScheme::Spt && fs.hybrid && state.hybrid && !inst.model->triangles.empty()) {
+      // Where splats and triangles of one surface overlap, the triangles show: each splat (a
+      // disc flat at its centre's depth, which pokes half out of a curved or tilted surface) is
+      // drawn one radius deeper. Surfaces farther apart than a splat radius keep their order.
+      for (std::size_t c = 0; c < into.chunk_count; ++c) {
+        SplatChunk& ch = into.chunks[c];
+        for (std::size_t k = 0; k < ch.count; ++k) {
+          const float radius_px = 0.5f * ch.size_px[k];
+          ch.depth[k] += world.ortho ? radius_px / world.focal_px
+                                     : ch.depth[k] * radius_px / world.focal_px;
+        }
+      }
     }
     if (model_f) id_base += model_f->surface_count;
     if (i > 0) append_chunks(stream, into);

@@ -104,38 +104,62 @@ TEST(HybridLod, LeafTrianglesAreTheMeshFacesOnTheLeaves) {
   }
 }
 
-TEST(HybridLod, LeafAndTriangleErrorsFollowTheRule) {
+// The leaves under every entry, by walking up from each leaf.
+std::vector<std::vector<std::uint32_t>> leaves_under(const SequentialPointTree& spt) {
+  std::vector<std::vector<std::uint32_t>> under(spt.node_count());
+  for (std::uint32_t e = 0; e < spt.node_count(); ++e) {
+    if (!spt.is_leaf[e]) continue;
+    for (std::uint32_t a = e; a != kSptNoParent; a = spt.parent[a]) under[a].push_back(spt.source[e]);
+  }
+  return under;
+}
+
+TEST(HybridLod, SuppressionBoundsAndTriangleErrorsFollowTheRule) {
   ThreadPool pool(2);
   const PointSet mesh = prepared(uv_sphere(16, 24), pool);
   const float ratio = 3.0f;
   const Built b = build(mesh, pool, ratio);
   const std::size_t n = b.leaves.size();
-  // e'_v from its definition, over the mesh's own faces.
-  std::vector<float> own_min(n, std::numeric_limits<float>::infinity());
-  for (const auto& t : b.triangles) {
-    const Vec3f p0 = b.leaves.positions[t[0]], p1 = b.leaves.positions[t[1]],
-                p2 = b.leaves.positions[t[2]];
-    const float longest = std::max({length(p1 - p0), length(p2 - p1), length(p0 - p2)});
-    for (int k = 0; k < 3; ++k) own_min[t[k]] = std::min(own_min[t[k]], longest / ratio);
+  // e_t, the triangles touching each leaf, m_N and s_N from their definitions.
+  std::vector<float> own(b.triangles.size());
+  std::vector<std::vector<std::uint32_t>> around(n);
+  for (std::uint32_t t = 0; t < b.triangles.size(); ++t) {
+    const auto& tri = b.triangles[t];
+    const Vec3f p0 = b.leaves.positions[tri[0]], p1 = b.leaves.positions[tri[1]],
+                p2 = b.leaves.positions[tri[2]];
+    own[t] = std::max({length(p1 - p0), length(p2 - p1), length(p0 - p2)}) / ratio;
+    for (int k = 0; k < 3; ++k) around[tri[k]].push_back(t);
   }
-  std::vector<float> expected(n);
+  const auto under = leaves_under(b.spt);
+  std::vector<float> s(b.spt.node_count(), 0.0f);
+  int interior_suppressible = 0;
   for (std::uint32_t e = 0; e < b.spt.node_count(); ++e) {
-    if (!b.spt.is_leaf[e]) {
-      EXPECT_EQ(b.hybrid.entry_error[e], b.spt.error[e]) << "interior entry " << e;
-      continue;
+    float m = std::numeric_limits<float>::infinity();
+    for (const std::uint32_t v : under[e]) {
+      for (const std::uint32_t t : around[v]) m = std::min(m, own[t]);
     }
-    const std::uint32_t v = b.spt.source[e];
-    expected[v] = std::min(own_min[v], b.spt.parent_error[e]);
-    EXPECT_NEAR(b.hybrid.entry_error[e], expected[v], 1e-6f * expected[v]) << "leaf " << v;
+    if (std::isinf(m)) continue;
+    const float bound = std::min(std::max(b.spt.error[e], m), b.spt.parent_error[e]);
+    s[e] = bound > b.spt.error[e] ? bound : 0.0f;
+    interior_suppressible += !b.spt.is_leaf[e] && s[e] > 0;
+    EXPECT_NEAR(b.hybrid.suppress_below[e], s[e], 1e-6f * s[e]) << "entry " << e;
   }
-  // Every triangle's E_t is at least every vertex's e'_v, and within rounding of the largest.
+  EXPECT_GT(interior_suppressible, 0);  // the extension is exercised
+  // E_t: the largest s on the paths from its corners to the root.
+  std::vector<float> path_max(n, 0.0f);
+  for (std::uint32_t e = 0; e < b.spt.node_count(); ++e) {
+    if (!b.spt.is_leaf[e]) continue;
+    for (std::uint32_t a = e; a != kSptNoParent; a = b.spt.parent[a]) {
+      path_max[b.spt.source[e]] = std::max(path_max[b.spt.source[e]], s[a]);
+    }
+  }
   using Faces = std::multiset<std::array<std::uint32_t, 3>>;
   const Faces listed(b.hybrid.triangles.begin(), b.hybrid.triangles.end());
   const Faces given(b.triangles.begin(), b.triangles.end());
   EXPECT_EQ(listed, given);
   for (std::size_t t = 0; t < b.hybrid.triangles.size(); ++t) {
     const auto& tri = b.hybrid.triangles[t];
-    const float big = std::max({expected[tri[0]], expected[tri[1]], expected[tri[2]]});
+    const float big = std::max({path_max[tri[0]], path_max[tri[1]], path_max[tri[2]]});
     EXPECT_GE(b.hybrid.triangle_error[t], big);
     EXPECT_NEAR(b.hybrid.triangle_error[t], big, 1e-5f * big);
   }
@@ -159,14 +183,11 @@ TEST(HybridSelection, MatchesBruteForceAndCoversEverySuppressedVertex) {
   ThreadPool pool(2);
   const PointSet mesh = prepared(uv_sphere(24, 40), pool);
   const Built b = build(mesh, pool);
-  std::vector<std::uint32_t> entry_of(b.leaves.size());
-  for (std::uint32_t e = 0; e < b.spt.node_count(); ++e) {
-    if (b.spt.is_leaf[e]) entry_of[b.spt.source[e]] = e;
-  }
   std::vector<std::vector<std::uint32_t>> around(b.leaves.size());
   for (std::uint32_t t = 0; t < b.hybrid.triangles.size(); ++t) {
     for (int k = 0; k < 3; ++k) around[b.hybrid.triangles[t][k]].push_back(t);
   }
+  const auto under = leaves_under(b.spt);
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> az(0, 360), el(-80, 80), dist(1.2f, 6.0f), eps(0.5f, 3);
   std::uint64_t suppressed_total = 0, drawn_total = 0;
@@ -184,7 +205,7 @@ TEST(HybridSelection, MatchesBruteForceAndCoversEverySuppressedVertex) {
     const std::set<std::uint32_t> got(selected.begin(), selected.end());
     ASSERT_EQ(got.size(), selected.size()) << "a triangle selected twice";
     const float epsilon = epsilon_px / cf.focal_px;
-    std::set<std::uint32_t> want;
+    std::set<std::uint32_t> want, dropped;
     for (std::uint32_t t = 0; t < b.hybrid.triangles.size(); ++t) {
       const auto& tri = b.hybrid.triangles[t];
       double r = 1e30;
@@ -211,24 +232,31 @@ TEST(HybridSelection, MatchesBruteForceAndCoversEverySuppressedVertex) {
         if (got.count(t)) want.insert(t);
         continue;
       }
+      if (all_outside_one || away) dropped.insert(t);
       if (lhs < rhs && !all_outside_one && !away) want.insert(t);
     }
     ASSERT_EQ(got, want) << "trial " << trial;
     drawn_total += got.size();
-    // Suppressed vertices in view: all their triangles drawn.
-    for (std::uint32_t v = 0; v < b.leaves.size(); ++v) {
-      const std::uint32_t e = entry_of[v];
-      const float r = distance(b.leaves.positions[v], cf.eye);
-      const bool in_interval = r * epsilon < b.spt.parent_error[e];
-      const bool suppressed = in_interval && r * epsilon < b.hybrid.entry_error[e];
-      bool in_view = true;
-      for (const Plane& pl : cf.planes) in_view = in_view && pl.distance(b.leaves.positions[v]) >= 0;
-      const bool facing = dot(b.leaves.normals[v], cf.eye - b.leaves.positions[v]) >= 0;
-      if (!suppressed || !in_view || !facing) continue;
+    // Every entry left out for its triangles (facing the eye, in its interval, (r + ρ)·ε < s,
+    // not edge-on): all triangles touching its leaves are drawn, but for those the frustum or
+    // backface rule dropped.
+    for (std::uint32_t e = 0; e < b.spt.node_count(); ++e) {
+      const Vec3f c{b.spt.center_x[e], b.spt.center_y[e], b.spt.center_z[e]};
+      const Vec3f nrm{b.spt.normal_x[e], b.spt.normal_y[e], b.spt.normal_z[e]};
+      const float r = distance(c, cf.eye);
+      const float rho = b.spt.is_leaf[e] ? 0.0f : 0.5f * b.spt.diameter[e];
+      const bool in_interval =
+          b.spt.error[e] <= r * epsilon && r * epsilon < b.spt.parent_error[e];
+      const float cosine = dot(nrm, normalized(cf.eye - c));
+      const bool suppressed = (r + rho) * epsilon < b.hybrid.suppress_below[e];
+      if (!in_interval || !suppressed || cosine < 0.05f) continue;
       ++suppressed_total;
-      for (std::uint32_t t : around[v]) {
-        ASSERT_TRUE(got.count(t)) << "trial " << trial << ": vertex " << v << " suppressed but "
-                                  << "triangle " << t << " not drawn";
+      for (const std::uint32_t v : under[e]) {
+        for (const std::uint32_t t : around[v]) {
+          ASSERT_TRUE(got.count(t) || dropped.count(t))
+              << "trial " << trial << ": entry " << e << " left out but triangle " << t
+              << " not drawn";
+        }
       }
     }
   }

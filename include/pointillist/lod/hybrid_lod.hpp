@@ -9,7 +9,8 @@
 // more than τ pixels, τ = triangle_px_per_epsilon · epsilon_px: that is while its eye distance
 // is below ℓ_t·f/τ, i.e. e_t / ε with e_t = ℓ_t / triangle_px_per_epsilon.
 //
-// Rule, for every leaf v (a mesh vertex) with SPT interval [0, pe_v) (pe_v its parent's error):
+// The spec's rule, for every leaf v (a mesh vertex) with SPT interval [0, pe_v) (pe_v its
+// parent's error):
 //   e'_v = min(min over the triangles t around v of e_t, pe_v)     (v has no triangle: e'_v = 0)
 // and v is drawn as a point only while e'_v ≤ r_v·ε < pe_v: nearer than e'_v / ε it is
 // suppressed. A triangle t gets E_t = max over its vertices of e'_v and is drawn while
@@ -18,6 +19,18 @@
 // r_t ≤ r_v, so every triangle around v is drawn. Where no vertex of a triangle is suppressed,
 // the triangle is covered by points exactly as in the pure SPT. A point and a triangle both drawn
 // overlap harmlessly under the z-buffer.
+//
+// Our extension to interior entries. With the rule on leaves alone, an interior node whose leaves
+// all gave way to triangles is still drawn wherever its interval says, and its large splat,
+// flat at its centre's depth, pokes through the triangles (on the dragon at 0.45 radii half the
+// splats drawn were such nodes). So every entry N (leaf or not) with error e_N, parent error pe_N
+// and bounding radius ρ_N (0 for a leaf: a vertex is a point) gets
+//   s_N = min(max(e_N, m_N), pe_N),   m_N = min of e_t over the triangles touching N's leaves,
+// kept only when s_N > e_N (else N is never suppressed: s_N = 0), and N is suppressed while
+//   (r_N + ρ_N)·ε < s_N
+// (leaves: the rule above). A triangle gets E_t = max over its vertices v of the largest s_N on
+// the path from v to the root. No hole opens: where N is suppressed, every leaf v under it has
+// r_v ≤ r_N + ρ_N, so r_t·ε ≤ r_v·ε < s_N ≤ E_t for every triangle t touching v.
 //
 // The triangles are grouped by the SPT chunk of their first vertex and, within a group, sorted by
 // E_t descending (ties by input order), so a renderer scans each visible group's prefix with E_t
@@ -49,9 +62,9 @@ struct HybridTriangleGroup {
 };
 
 struct HybridLod {
-  // e_g of every SPT entry, with the leaves' raised to e'_v: replaces SequentialPointTree::error
-  // in the selection (the SPT's parent_error stays).
-  std::vector<float> entry_error;
+  // s_N of every SPT entry (0: never suppressed): an entry in its interval is drawn only while
+  // (r_N + ρ_N)·ε ≥ s_N.
+  std::vector<float> suppress_below;
   // Triangles over the leaves (indices into the leaf arrays below), grouped and sorted as in the
   // file comment, with their E_t.
   std::vector<std::array<std::uint32_t, 3>> triangles;
@@ -61,7 +74,8 @@ struct HybridLod {
   std::vector<Vec3f> positions, normals;
   std::vector<Rgb8> colors;
   float triangle_px_per_epsilon = 4.0f;
-  std::uint64_t suppressible_leaves = 0;  // leaves with e'_v > 0 (drawn as triangles when near)
+  std::uint64_t suppressible_leaves = 0;    // leaves with s > 0 (give way to triangles when near)
+  std::uint64_t suppressible_interior = 0;  // interior entries with s > 0
 
   std::size_t triangle_count() const { return triangles.size(); }
 };

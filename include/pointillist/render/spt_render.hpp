@@ -51,10 +51,11 @@ struct SptRenderOptions {
   // Skip chunks whose bounding sphere lies outside the view frustum (the extension of the paper
   // this project adds). Turn off only to measure what it saves.
   bool chunk_culling = true;
-  // The entries' errors to select by instead of the tree's own (one per entry): the hybrid
-  // point/polygon lists' (HybridLod::entry_error), where leaves near the eye give way to
-  // triangles. Empty: the tree's.
-  std::span<const float> errors;
+  // Hybrid point/polygon lists (HybridLod::suppress_below, one per entry): an entry in its
+  // interval is left out while (r + ρ)·ε < s, ρ its radius (0 for leaves), where the triangles
+  // around its leaves are drawn instead, unless it is seen within about 3° of edge-on. Empty:
+  // none left out.
+  std::span<const float> suppress_below;
 };
 
 // Chooses the entries of `tree` to draw for `camera` and writes them as splats into `stream`:

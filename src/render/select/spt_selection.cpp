@@ -36,13 +36,13 @@ struct ViewConstants {
   float epsilon2;      // (epsilon_px / f)²: compared with error² / r² (orthographic: r = 1)
   float facing_limit;  // 0 with backface culling (drop (c − eye)·n > 0), else +infinity
   bool ortho;          // orthographic: parallel rays along forward
-  const float* error = nullptr;  // the entries' e_g; null: the tree's own
-  // With `error` (the hybrid lists): leaves seen within this cosine of edge-on keep their splats
-  // where triangles replace them, squared.
+  // The hybrid lists' s_N (HybridLod::suppress_below), or null; and the square of the cosine
+  // within which of edge-on a suppressed entry keeps its splat.
+  const float* suppress = nullptr;
   float silhouette_cos2 = 0;
 };
 
-// Hybrid mode: a leaf seen nearly edge-on (|cos| of the angle between its normal and the view
+// Hybrid mode: an entry seen nearly edge-on (|cos| of the angle between its normal and the view
 // direction below kSilhouetteCos) keeps its splat even where the triangles around it are drawn.
 // There the triangles of a quantized model (.ptl leaf positions are within a fraction of a splat
 // radius of the mesh's vertices) can fall up to a pixel short of the true silhouette, and the
@@ -62,14 +62,17 @@ void select_mask(const SequentialPointTree& t, std::uint32_t begin, std::uint32_
   const float* __restrict nx = t.normal_x.data() + begin;
   const float* __restrict ny = t.normal_y.data() + begin;
   const float* __restrict nz = t.normal_z.data() + begin;
-  const float* __restrict err = (v.error ? v.error : t.error.data()) + begin;
+  const float* __restrict err = t.error.data() + begin;
   const float* __restrict perr = t.parent_error.data() + begin;
   const float ex = v.eye.x, ey = v.eye.y, ez = v.eye.z, eps2 = v.epsilon2;
   const float facing_limit = v.facing_limit;
   const std::uint32_t n = end - begin;
-  if (v.error) {
-    // Hybrid lists: as below, and the silhouette leaves (tree error 0) kept.
-    const float* __restrict own = t.error.data() + begin;
+  if (v.suppress) {
+    // Hybrid lists: as below, minus the entries whose triangles replace them, (r + ρ)·ε < s,
+    // unless seen nearly edge-on.
+    const float* __restrict sup = v.suppress + begin;
+    const float* __restrict diameter = t.diameter.data() + begin;
+    const std::uint8_t* __restrict leaf = t.is_leaf.data() + begin;
     const float s2 = v.silhouette_cos2;
     const float fx = v.forward.x, fy = v.forward.y, fz = v.forward.z;
     for (std::uint32_t i = 0; i < n; ++i) {
@@ -77,9 +80,12 @@ void select_mask(const SequentialPointTree& t, std::uint32_t begin, std::uint32_
                   dz = v.ortho ? fz : cz[i] - ez;
       const float d2 = dx * dx + dy * dy + dz * dz;
       const float re2 = v.ortho ? eps2 : d2 * eps2;
+      const float rho = leaf[i] ? 0.0f : 0.5f * diameter[i];
+      const float far = std::sqrt(d2) + rho;
+      const float far2 = v.ortho ? eps2 : far * far * eps2;
       const float facing = dx * nx[i] + dy * ny[i] + dz * nz[i];
-      const int silhouette = (own[i] == 0.0f) & (facing * facing < s2 * d2);
-      const int in = ((err[i] * err[i] <= re2) | silhouette) & (re2 < perr[i] * perr[i]);
+      const int kept = !(far2 < sup[i] * sup[i]) | (facing * facing < s2 * d2);
+      const int in = (err[i] * err[i] <= re2) & (re2 < perr[i] * perr[i]) & kept;
       mask[i] = static_cast<std::uint8_t>(in + (in & (facing > facing_limit)));
     }
     return;
@@ -327,15 +333,15 @@ void select_splats_spt(const SequentialPointTree& tree, const CameraFrame& camer
   stats.chunks_total = tree.chunks.size();
   if (tree.node_count() == 0) return;
 
-  if (!options.errors.empty() && options.errors.size() != tree.node_count()) {
-    throw Error("SPT selection: " + std::to_string(options.errors.size()) +
-                " entry errors given for " + std::to_string(tree.node_count()) +
+  if (!options.suppress_below.empty() && options.suppress_below.size() != tree.node_count()) {
+    throw Error("SPT selection: " + std::to_string(options.suppress_below.size()) +
+                " suppression bounds given for " + std::to_string(tree.node_count()) +
                 " entries; build the hybrid lists from this tree");
   }
   const render_detail::Shader shader(settings, camera);
   ViewConstants v = spt_view(camera, settings, options.epsilon_px);
-  if (!options.errors.empty()) {
-    v.error = options.errors.data();
+  if (!options.suppress_below.empty()) {
+    v.suppress = options.suppress_below.data();
     v.silhouette_cos2 = kSilhouetteCos * kSilhouetteCos;
   }
 
