@@ -227,13 +227,22 @@ struct NodeMaker {
         for (int a = 0; a < 3; ++a) node.color[a] += nodes[c].color[a];
       }
       for (float& channel : node.color) channel /= static_cast<float>(children.size());
+      bool edge = false;
       for (const std::uint32_t c : children) {
         float d2 = 0;
         for (int a = 0; a < 3; ++a) {
           d2 += (nodes[c].color[a] - node.color[a]) * (nodes[c].color[a] - node.color[a]);
         }
         // Over a colour edge the node may only be drawn once its whole disc is below the bound.
-        if (std::sqrt(d2) > color_tolerance) node.error = std::max(node.error, node.diameter);
+        if (std::sqrt(d2) > color_tolerance) edge = true;
+      }
+      if (edge) {
+        node.error = std::max(node.error, node.diameter);
+        // And so may its interior children: even of one colour each, their discs reach across
+        // the edge into their siblings' colour.
+        for (const std::uint32_t c : children) {
+          if (!nodes[c].leaf) nodes[c].error = std::max(nodes[c].error, nodes[c].diameter);
+        }
       }
     }
     for (const std::uint32_t c : children) node.error = std::max(node.error, nodes[c].error);

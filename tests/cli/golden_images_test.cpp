@@ -108,7 +108,7 @@ const Golden kGolden[] = {
     {"mesh.ply", "--view 200,-10 --mode quality --reconstruction zthreshold --opacity 0.6",
      "f3b5db0af2807f1c"},
     {"mesh.ply", "--view 200,-10 --mode reference", "83127789df743124"},
-    {"mesh.ply", "--view 30,20 --lod spt --epsilon 1.5", "8c195a62529e9083"},
+    {"mesh.ply", "--view 30,20 --lod spt --epsilon 1.5", "9cc10f646f9714bd"},
     {"mesh.ply", "--eye 0.1,0.15,0.25 --target 0,0.1,0 --fov 40 --background 20,40,60",
      "ff781be2e10d2da8"},
     {"mesh.ptl", "--view 30,20", "efae7beb268c2b92"},
