@@ -7,7 +7,9 @@
 #  2. a ground of 200 × 200 units with 16 dragons (scaled to about 1.5 units, "statues") seen
 #     from eye height along a 21-frame walk: the ground as 16 M points (0.05 spacing) with
 #     --lod spt, against the ground as its 2 triangles with --lod spt --hybrid; mean ms a frame
-#     (the first frame, which builds the point trees, left out) and the ratio (target <= 0.5).
+#     (the first frame, which builds the point trees, left out) and the ratio (target <= 0.5),
+#     and both against the all-triangle reference (the ground's 2 triangles and the dragon mesh,
+#     --mode reference): mean PSNR and hole pixels.
 #   bash bench/hybrid.sh [WORKDIR]        (HYBRID_QUICK=1: 20 zoom frames, no ground scene)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -92,21 +94,37 @@ scene() {  # scene GROUND OUT.json: the ground and a 4 × 4 grid of dragons 4 un
 }
 scene ground_points.ptl "$work/points.json"
 scene ground_mesh.ptl "$work/hybrid.json"
+cp "$dragon" "$work/dragon_mesh.ply.gz"
+scene ground_mesh.ply "$work/reference.json"
+sed -i 's/"dragon.ptl"/"dragon_mesh.ply.gz"/g' "$work/reference.json"
 awk 'BEGIN { for (k = 0; k <= 20; ++k) printf "0.5 1.7 %g 0 1.2 %g\n", 14 - 0.4 * k, -0.4 * k }' > "$work/walk.path"
+rm -rf "$work/walk_ref" "$work/walk_pts" "$work/walk_hyb"
+mkdir -p "$work/walk_ref" "$work/walk_pts" "$work/walk_hyb"
+"$cli" render "$work/reference.json" --mode reference --path "$work/walk.path" \
+  --frames-out "$work/walk_ref" -o "$work/walk_ref.png" -q
 "$cli" render "$work/points.json" --lod spt --path "$work/walk.path" -o "$work/walk_points.png" \
-  --stats "$work/walk_points.json" -q
+  --frames-out "$work/walk_pts" --stats "$work/walk_points.json" -q
 "$cli" render "$work/hybrid.json" --lod spt --hybrid --path "$work/walk.path" \
-  -o "$work/walk_hybrid.png" --stats "$work/walk_hybrid.json" -q
+  --frames-out "$work/walk_hyb" -o "$work/walk_hybrid.png" --stats "$work/walk_hybrid.json" -q
 echo
 echo "Ground (200 × 200) and 16 statues from eye height, 21 frames, 1280x720 (mean of frames 2-21)"
 echo
-echo "| ground as | splats | triangles | ms a frame |"
-echo "| --- | ---: | ---: | ---: |"
+psnr() {  # mean PSNR and total hole pixels of a frame folder against the reference's
+  for ((i = 0; i <= 20; ++i)); do
+    f=$(printf frame_%05d.png "$i")
+    "$cli" compare --background 0,0,0 --json - "$work/walk_ref/$f" "$1/$f" |
+      jq -r '"\(.psnr_db) \(.hole_pixels)"'
+  done | awk '{ s += $1; h += $2 } END { printf "%.2f %d\n", s / NR, h }'
+}
+read -r pts_psnr pts_holes < <(psnr "$work/walk_pts")
+read -r hyb_psnr hyb_holes < <(psnr "$work/walk_hyb")
+echo "| ground as | splats | triangles | ms a frame | PSNR against the all-triangle reference (mean) | hole pixels (all frames) |"
+echo "| --- | ---: | ---: | ---: | ---: | ---: |"
 jq -r '[.frames[1:][] | .splats] | add / length | floor' "$work/walk_points.json" > "$work/a"
 jq -r '[.frames[1:][] | .ms] | add / length' "$work/walk_points.json" > "$work/b"
 jq -r '[.frames[1:][] | .splats] | add / length | floor' "$work/walk_hybrid.json" > "$work/c"
 jq -r '[.frames[1:][] | .triangles] | add / length | floor' "$work/walk_hybrid.json" > "$work/d"
 jq -r '[.frames[1:][] | .ms] | add / length' "$work/walk_hybrid.json" > "$work/e"
-printf "| 16 M points (--lod spt) | %d | 0 | %.1f |\n" "$(cat "$work/a")" "$(cat "$work/b")"
-printf "| 2 triangles (--lod spt --hybrid) | %d | %d | %.1f |\n" "$(cat "$work/c")" "$(cat "$work/d")" "$(cat "$work/e")"
+printf "| 16 M points (--lod spt) | %d | 0 | %.1f | %s dB | %s |\n" "$(cat "$work/a")" "$(cat "$work/b")" "$pts_psnr" "$pts_holes"
+printf "| 2 triangles (--lod spt --hybrid) | %d | %d | %.1f | %s dB | %s |\n" "$(cat "$work/c")" "$(cat "$work/d")" "$(cat "$work/e")" "$hyb_psnr" "$hyb_holes"
 awk -v a="$(cat "$work/b")" -v b="$(cat "$work/e")" 'BEGIN { printf "\nhybrid / points: %.2f (target <= 0.5)\n", b / a }'

@@ -44,6 +44,7 @@ HybridLod build_hybrid_lod(const SequentialPointTree& tree, const PointSet& leav
   }
   HybridLod h;
   h.triangle_px_per_epsilon = options.triangle_px_per_epsilon;
+  h.view_sphere = tree.view_sphere;
   h.positions = leaves.positions;
   h.normals = leaves.normals;
   if (tree.has_colors) h.colors = leaves.colors;

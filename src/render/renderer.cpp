@@ -84,16 +84,10 @@ Renderer::ModelState& Renderer::state_for(const RenderModel& model, ThreadPool& 
 void Renderer::render(std::span<const SceneInstance> scene, const Camera& camera,
                       const RenderSettings& settings, const FrameSettings& fs, ThreadPool& pool,
                       Frame& frame) {
-  const bool several = scene.size() > 1 ||
-                       (scene.size() == 1 && !scene[0].transform.is_identity());
   if (fs.rasterizer == Rasterizer::Reference) {
     if (fs.lod == LodScheme::Spt) {
       throw OptionError("--mode reference draws the mesh's triangles; it cannot be combined with "
                         "--lod spt");
-    }
-    if (several) {
-      throw OptionError("--mode reference draws one mesh as it is; give a single input without "
-                        "a transform");
     }
   }
   if (fs.hybrid) {
@@ -167,7 +161,7 @@ void Renderer::render(std::span<const SceneInstance> scene, const Camera& camera
   if (occlusion) {
     render_occluded(scene, camera, settings, fs, pool, frame);
   } else if (fs.rasterizer == Rasterizer::Reference) {
-    render_mesh_reference(*scene[0].model->mesh, camera, settings, frame);
+    render_mesh_reference(scene, camera, settings, frame);
   } else {
     const bool quality = fs.rasterizer == Rasterizer::Quality;
     render_detail::frame_pass(camera, settings, quality ? &fs.quality : nullptr,

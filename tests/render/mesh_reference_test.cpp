@@ -1,9 +1,12 @@
 // The reference triangle rasterizer against analytic pixel sets and exact ray casting.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <string>
 #include <limits>
 
+#include "pointillist/core/error.hpp"
 #include "pointillist/render/mesh_reference.hpp"
 #include "pointillist/scene/analytic.hpp"
 #include "render_test_util.hpp"
@@ -176,4 +179,55 @@ TEST(MeshReference, TessellatedSphereMatchesRayCastSilhouetteAndShading) {
   EXPECT_NEAR(c.r, 253, 3);
   EXPECT_EQ(c.r, c.g);
   EXPECT_EQ(c.g, c.b);
+}
+
+// A scene of two transformed instances of a mesh is drawn as the one mesh made of both,
+// transformed beforehand (the same triangles in the same order, so the same pixels).
+TEST(MeshReference, SceneInstancesAreTheirMeshesAtTheirTransforms) {
+  PointSet mesh;
+  mesh.positions = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0.5f}, {-1, 1, 0.2f}};
+  mesh.normals = {normalized(Vec3f{0.1f, 0, 1}), normalized(Vec3f{0, 0.2f, 1}),
+                  normalized(Vec3f{-0.1f, 0, 1}), normalized(Vec3f{0, -0.3f, 1})};
+  mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+  InstanceTransform a, b;
+  a.translate = {-0.8f, 0, -5};
+  b.translate = {0.9f, 0.2f, -6};
+  b.scale = 1.5f;
+  const float c = std::cos(0.4f), s = std::sin(0.4f);
+  b.rotation[0] = {c, 0, s};
+  b.rotation[1] = {0, 1, 0};
+  b.rotation[2] = {-s, 0, c};
+  const RenderModel model{.mesh = &mesh, .name = "quad"};
+  const SceneInstance scene[] = {{&model, a}, {&model, b}};
+  PointSet merged;
+  for (const InstanceTransform* t : {&a, &b}) {
+    const auto base = static_cast<std::uint32_t>(merged.positions.size());
+    for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
+      merged.positions.push_back(t->apply(mesh.positions[i]));
+      merged.normals.push_back(t->rotate(mesh.normals[i]));
+    }
+    for (const auto& tri : mesh.triangles) {
+      merged.triangles.push_back({base + tri[0], base + tri[1], base + tri[2]});
+    }
+  }
+  const Camera cam = axis_camera(96, 64);
+  Frame want, got;
+  render_mesh_reference(merged, cam, RenderSettings{}, want);
+  render_mesh_reference(scene, cam, RenderSettings{}, got);
+  int covered_pixels = 0;
+  for (int j = 0; j < 64; ++j) {
+    for (int i = 0; i < 96; ++i) covered_pixels += covered(want, i, j);
+  }
+  EXPECT_GT(covered_pixels, 500);
+  EXPECT_TRUE(std::equal(want.color.begin(), want.color.end(), got.color.begin()));
+  EXPECT_TRUE(std::equal(want.depth.begin(), want.depth.end(), got.depth.begin()));
+  // A model without a mesh is named.
+  const RenderModel cloud{.name = "cloud.ply"};
+  const SceneInstance bad[] = {{&model, a}, {&cloud, {}}};
+  try {
+    render_mesh_reference(bad, cam, RenderSettings{}, got);
+    FAIL() << "drew a model without a mesh";
+  } catch (const OptionError& e) {
+    EXPECT_NE(std::string(e.what()).find("cloud.ply"), std::string::npos);
+  }
 }

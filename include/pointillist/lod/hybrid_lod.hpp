@@ -74,6 +74,7 @@ struct HybridLod {
   std::vector<Vec3f> positions, normals;
   std::vector<Rgb8> colors;
   float triangle_px_per_epsilon = 4.0f;
+  Sphere view_sphere;  // the tree's: holds every vertex (one near plane for all the triangles)
   std::uint64_t suppressible_leaves = 0;    // leaves with s > 0 (give way to triangles when near)
   std::uint64_t suppressible_interior = 0;  // interior entries with s > 0
 

@@ -2,9 +2,12 @@
 // quality). Correct and simple rather than fast.
 #pragma once
 
+#include <span>
+
 #include "pointillist/core/camera.hpp"
 #include "pointillist/core/point_set.hpp"
 #include "pointillist/render/render.hpp"
+#include "pointillist/render/renderer.hpp"
 
 namespace pointillist {
 
@@ -24,6 +27,14 @@ namespace pointillist {
 // settings.threshold_px, shape and the culling flags are ignored. Throws OptionError for an
 // invalid camera or light; asserts that every triangle index is in range.
 void render_mesh_reference(const PointSet& mesh, const Camera& camera,
+                           const RenderSettings& settings, Frame& frame);
+
+// The same for a scene: every instance's model's mesh (RenderModel::mesh) drawn at its transform
+// (positions by InstanceTransform::apply, normals and face normals rotated) into one frame, in
+// instance order (a tie goes to the earlier triangle of the earlier instance); one near plane,
+// 1e-5 × the largest vertex depth of all instances. Throws OptionError naming a model without a
+// mesh.
+void render_mesh_reference(std::span<const SceneInstance> scene, const Camera& camera,
                            const RenderSettings& settings, Frame& frame);
 
 }  // namespace pointillist

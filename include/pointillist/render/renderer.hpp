@@ -140,8 +140,10 @@ class Renderer {
   // to back and only what the queries find visible is selected and drawn. A paged model draws
   // what is resident and requests the rest (load_requested, request_in_background).
   // frame.stats sums the instances. Throws OptionError for combinations that cannot be drawn
-  // (the message says what to drop): the reference rasterizer with SPT, with several or
-  // transformed instances, or without a mesh; SPT on a paged model; occlusion culling other
+  // (the message says what to drop): the reference rasterizer with SPT or on a model without a
+  // mesh (it draws every instance's mesh at its transform); SPT on a paged model; --hybrid
+  // without SPT, with another rasterizer or occlusion culling, or on a scene without
+  // triangles; occlusion culling other
   // than with the fast rasterizer on models held whole; invalid settings.
   void render(std::span<const SceneInstance> scene, const Camera& camera,
               const RenderSettings& settings, const FrameSettings& frame_settings,

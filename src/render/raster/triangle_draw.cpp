@@ -89,10 +89,19 @@ void project_block(const TriangleBatch& b, std::size_t begin, std::size_t end,
                    const CameraFrame& cam, Vec3f base_color, std::vector<ScreenTriangle>& out) {
   const HybridLod& lod = *b.lod;
   const bool colors = !lod.colors.empty();
+  // One near plane for all the model's triangles (1e-5 × the depth of its farthest point, as the
+  // mesh reference's), so that two triangles sharing an edge are clipped at the same points and
+  // leave no crack between them.
+  Sphere bounds = lod.view_sphere;
+  if (b.transform) {
+    bounds = {b.transform->apply(bounds.center), bounds.radius * b.transform->scale};
+  }
+  const float far = cam.depth(bounds.center) + bounds.radius;
+  if (!(far > 0.0f)) return;
+  const float near = 1e-5f * far;
   for (std::size_t s = begin; s < end; ++s) {
     const auto& tri = lod.triangles[b.selected[s]];
     std::array<EyeVertex, 3> v;
-    float max_z = 0;
     for (int k = 0; k < 3; ++k) {
       Vec3f p = lod.positions[tri[k]], n = lod.normals[tri[k]];
       if (b.transform) {
@@ -105,11 +114,9 @@ void project_block(const TriangleBatch& b, std::size_t begin, std::size_t end,
         c = Vec3f{float(rgb.r), float(rgb.g), float(rgb.b)} * (1.0f / 255.0f);
       }
       v[k] = {eye_space(cam, p), n, c};
-      max_z = std::max(max_z, v[k].p.z);
     }
-    if (!(max_z > 0.0f)) continue;
     std::array<EyeVertex, 4> clipped;
-    const int count = clip_near(v, 1e-5f * max_z, clipped);
+    const int count = clip_near(v, near, clipped);
     if (count < 3) continue;
     const ScreenVertex s0 = project_vertex(cam, clipped[0]);
     for (int k = 1; k + 1 < count; ++k) {

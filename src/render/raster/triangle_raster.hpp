@@ -42,7 +42,10 @@ inline EyeVertex lerp(const EyeVertex& a, const EyeVertex& b, float t) {
           a.color + (b.color - a.color) * t};
 }
 
-// Sutherland–Hodgman against z >= near; returns the vertex count (0, 3 or 4).
+// Sutherland–Hodgman against z >= near; returns the vertex count (0, 3 or 4). A crossing edge is
+// always interpolated from its inside end to its outside end, so two triangles that share the
+// edge (traversing it in opposite directions) get the very same clipped point: no crack opens
+// between them.
 inline int clip_near(const std::array<EyeVertex, 3>& in, float near,
                      std::array<EyeVertex, 4>& out) {
   int n = 0;
@@ -51,7 +54,11 @@ inline int clip_near(const std::array<EyeVertex, 3>& in, float near,
     const EyeVertex& b = in[(i + 1) % 3];
     const bool a_in = a.p.z >= near, b_in = b.p.z >= near;
     if (a_in) out[n++] = a;
-    if (a_in != b_in) out[n++] = lerp(a, b, (near - a.p.z) / (b.p.z - a.p.z));
+    if (a_in != b_in) {
+      const EyeVertex& inside = a_in ? a : b;
+      const EyeVertex& outside = a_in ? b : a;
+      out[n++] = lerp(inside, outside, (near - inside.p.z) / (outside.p.z - inside.p.z));
+    }
   }
   return n;
 }

@@ -48,6 +48,10 @@ struct ViewConstants {
 // radius of the mesh's vertices) can fall up to a pixel short of the true silhouette, and the
 // splat, as in the pure SPT, covers it.
 constexpr float kSilhouetteCos = 0.05f;
+// Only splats at most this many error bounds (--epsilon pixels) across are kept so: the gap they
+// fill is under a pixel, and a large splat kept edge-on (a ground quad's corner seen from eye
+// height) would cover the sky. Squared.
+constexpr float kSilhouetteSplat2 = 32.0f * 32.0f;
 
 // Entry i of [begin, end) is selected (mask 1) iff error² ≤ r²ε² < parent_error² and it faces the
 // eye, (c − eye)·n ≤ facing_limit (mask 2: in its interval but facing away). Written without
@@ -84,7 +88,10 @@ void select_mask(const SequentialPointTree& t, std::uint32_t begin, std::uint32_
       const float far = std::sqrt(d2) + rho;
       const float far2 = v.ortho ? eps2 : far * far * eps2;
       const float facing = dx * nx[i] + dy * ny[i] + dz * nz[i];
-      const int kept = !(far2 < sup[i] * sup[i]) | (facing * facing < s2 * d2);
+      // Edge-on and small: at most kSilhouetteSplat error bounds across.
+      const int edge_on = (facing * facing < s2 * d2) &
+                          (diameter[i] * diameter[i] < kSilhouetteSplat2 * re2);
+      const int kept = !(far2 < sup[i] * sup[i]) | edge_on;
       const int in = (err[i] * err[i] <= re2) & (re2 < perr[i] * perr[i]) & kept;
       mask[i] = static_cast<std::uint8_t>(in + (in & (facing > facing_limit)));
     }
