@@ -95,7 +95,8 @@ int run_info(const InfoOptions& o) {
                 "pages, leaf trims in %s, memory-mapped%s\n",
                 v2->has_colors() ? "6" : "4", v2->page_count(),
                 v2->leaf_trim() == quant::LeafTrim::Sixteenths ? "sixteenths" : "eighths",
-                model.pages() ? ", too large to decode whole (rendered page by page)" : "");
+                v2->has_triangles() ? ", with the mesh's faces" : "");
+    std::printf("opened:      %s\n", model.paging_reason().c_str());
     if (t.nodes.empty()) {
       std::printf("points:      %llu (leaves)\n", static_cast<unsigned long long>(t.leaf_count));
       std::printf("nodes:       %llu (%.3f per point)\n", static_cast<unsigned long long>(records),

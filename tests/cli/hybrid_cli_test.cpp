@@ -46,6 +46,7 @@ TEST(HybridCli, ConvertedMeshKeepsItsFacesAndRendersHybrid) {
   ASSERT_EQ(run_cli("convert " + ply + " -o " + ptl).exit_code, 0);
   const auto info = run_cli("info " + ptl);
   EXPECT_THAT(info.output, HasSubstr("3042 triangles"));
+  EXPECT_THAT(info.output, HasSubstr("with the mesh's faces"));
   const auto stats = dir.file("stats.json"), png = dir.file("h.png");
   const auto r = run_cli("render " + ptl + " --lod spt --hybrid --distance 0.5 --size 160x120 -o " +
                          png + " --stats " + stats);
