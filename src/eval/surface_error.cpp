@@ -4,7 +4,6 @@
 // section 3.2.
 #include "pointillist/eval/surface_error.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -12,6 +11,7 @@
 #include <string>
 
 #include "pointillist/core/error.hpp"
+#include "pointillist/prep/normals.hpp"
 #include "pointillist/spatial/knn.hpp"
 #include "triangle_bvh.hpp"
 
@@ -127,35 +127,6 @@ class MeshReference final : public SurfaceReference::Impl {
   std::vector<std::array<std::uint32_t, 3>> triangles_;
   std::vector<double> cumulative_area_;
 };
-
-// The plane of `self` and its neighbours: their mean, and the covariance's least eigenvector.
-// Sums relative to `self` in double, so clouds far from the origin lose no precision.
-std::pair<Vec3f, Vec3f> pca_plane(std::span<const Vec3f> positions, std::size_t self,
-                                  std::span<const std::uint32_t> neighbours) {
-  const Vec3f origin = positions[self];
-  double s[3] = {0, 0, 0}, ss[6] = {0, 0, 0, 0, 0, 0};  // xx xy xz yy yz zz
-  for (const std::uint32_t i : neighbours) {
-    const Vec3f d = positions[i] - origin;
-    const double x = d.x, y = d.y, z = d.z;
-    s[0] += x, s[1] += y, s[2] += z;
-    ss[0] += x * x, ss[1] += x * y, ss[2] += x * z, ss[3] += y * y, ss[4] += y * z, ss[5] += z * z;
-  }
-  const double inv = 1.0 / double(neighbours.size() + 1);  // self adds d = 0
-  const double mx = s[0] * inv, my = s[1] * inv, mz = s[2] * inv;
-  const Vec3f mean = origin + Vec3f{float(mx), float(my), float(mz)};
-  Eigen::Matrix3d c;
-  c(0, 0) = ss[0] * inv - mx * mx;
-  c(0, 1) = c(1, 0) = ss[1] * inv - mx * my;
-  c(0, 2) = c(2, 0) = ss[2] * inv - mx * mz;
-  c(1, 1) = ss[3] * inv - my * my;
-  c(1, 2) = c(2, 1) = ss[4] * inv - my * mz;
-  c(2, 2) = ss[5] * inv - mz * mz;
-  if (!(c.trace() > 0.0) || !c.allFinite()) return {mean, {0, 0, 1}};  // all neighbours coincide
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-  solver.computeDirect(c, Eigen::ComputeEigenvectors);
-  const Eigen::Vector3d e = solver.eigenvectors().col(0);
-  return {mean, normalized(Vec3f{float(e.x()), float(e.y()), float(e.z())})};
-}
 
 class PointsReference final : public SurfaceReference::Impl {
  public:

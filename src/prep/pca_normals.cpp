@@ -10,16 +10,9 @@
 #include "ordered_cloud.hpp"
 
 namespace pointillist {
-namespace prep_detail {
-namespace {
 
-constexpr std::size_t kGrain = 8192;
-
-// Eigenvector of the smallest eigenvalue of the covariance of `self` and its neighbours.
-// Coordinates are taken relative to `self` and summed in double, so scans far from the origin
-// lose no precision.
-Vec3f pca_normal(std::span<const Vec3f> positions, std::size_t self,
-                 std::span<const std::uint32_t> neighbours) {
+PcaPlane pca_plane(std::span<const Vec3f> positions, std::size_t self,
+                   std::span<const std::uint32_t> neighbours) {
   const Vec3f origin = positions[self];
   double s[3] = {0, 0, 0};
   double ss[6] = {0, 0, 0, 0, 0, 0};  // xx xy xz yy yz zz
@@ -39,6 +32,7 @@ Vec3f pca_normal(std::span<const Vec3f> positions, std::size_t self,
   // The point itself adds d = 0: it counts in the mean but adds nothing to the sums.
   const double inv = 1.0 / double(neighbours.size() + 1);
   const double mx = s[0] * inv, my = s[1] * inv, mz = s[2] * inv;
+  const Vec3f mean = origin + Vec3f{float(mx), float(my), float(mz)};
   Eigen::Matrix3d c;
   c(0, 0) = ss[0] * inv - mx * mx;
   c(0, 1) = c(1, 0) = ss[1] * inv - mx * my;
@@ -46,15 +40,20 @@ Vec3f pca_normal(std::span<const Vec3f> positions, std::size_t self,
   c(1, 1) = ss[3] * inv - my * my;
   c(1, 2) = c(2, 1) = ss[4] * inv - my * mz;
   c(2, 2) = ss[5] * inv - mz * mz;
-  if (!(c.trace() > 0.0) || !c.allFinite()) return {0, 0, 1};  // all neighbours coincide
+  if (!(c.trace() > 0.0) || !c.allFinite()) return {mean, {0, 0, 1}};  // all neighbours coincide
   // Closed form (eigenvalues sorted increasing). In double its normals stay within 5e-8 rad of
   // Eigen's iterative solver on sampled spheres, tori and cubes (measured), far below the
   // sampling error of the normal itself, at a fraction of the cost.
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
   solver.computeDirect(c, Eigen::ComputeEigenvectors);
   const Eigen::Vector3d e = solver.eigenvectors().col(0);
-  return normalized(Vec3f{float(e.x()), float(e.y()), float(e.z())});
+  return {mean, normalized(Vec3f{float(e.x()), float(e.y()), float(e.z())})};
 }
+
+namespace prep_detail {
+namespace {
+
+constexpr std::size_t kGrain = 8192;
 
 }  // namespace
 
@@ -66,7 +65,7 @@ std::vector<Vec3f> pca_normals_ordered(const OrderedCloud& cloud, std::uint32_t 
   std::vector<Vec3f> normals(n);
   parallel_for(pool, n, kGrain, [&](std::size_t begin, std::size_t end) {
     for (std::size_t j = begin; j < end; ++j) {
-      normals[j] = pca_normal(cloud.positions, j, cloud.row(j).first(used));
+      normals[j] = pca_plane(cloud.positions, j, cloud.row(j).first(used)).normal;
     }
     phase.advance(end - begin);
   });

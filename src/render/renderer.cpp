@@ -215,9 +215,11 @@ SelectionStats Renderer::select(std::span<const SceneInstance> scene, const Came
     into.with_discs = with_discs;
     into.chunk_count = 0;
     SelectionStats selected;
+    // Hybrid lists drawn for this instance (state_for built them when the model has triangles).
+    const bool hybrid = fs.lod == LodScheme::Spt && fs.hybrid && state.hybrid &&
+                        !inst.model->triangles.empty();
     if (fs.lod == LodScheme::Spt) {
       SptSelectionStats spt;
-      const bool hybrid = fs.hybrid && state.hybrid && !inst.model->triangles.empty();
       select_splats_spt(*state.spt, cam, settings,
                         {.epsilon_px = fs.epsilon_px,
                          .chunk_culling = fs.spt_chunk_culling,
@@ -264,7 +266,7 @@ SelectionStats Renderer::select(std::span<const SceneInstance> scene, const Came
     for (std::size_t c = 0; c < into.chunk_count; ++c) {
       place_chunk(into.chunks[c], place, settings);
     }
-    if (fs.lod == LodScheme::Spt && fs.hybrid && state.hybrid && !inst.model->triangles.empty()) {
+    if (hybrid) {
       // Where splats and triangles of one surface overlap, the triangles show: each splat (a
       // disc flat at its centre's depth, which pokes half out of a curved or tilted surface) is
       // drawn one radius deeper. Surfaces farther apart than a splat radius keep their order.

@@ -23,6 +23,18 @@ std::vector<Vec3f> mesh_vertex_normals(std::span<const Vec3f> positions,
                                        std::span<const std::array<std::uint32_t, 3>> triangles,
                                        ThreadPool& pool);
 
+// The least-squares plane of positions[self] and its neighbours (indices into positions, self not
+// among them): their mean, and the unit eigenvector of the smallest eigenvalue of their covariance
+// ((0, 0, 1) when they all coincide). Coordinates are taken relative to positions[self] and
+// summed in double, so scans far from the origin lose no precision. What pca_normals computes per
+// point (its normal, before orientation); the surface-error metric's local planes of a cloud.
+struct PcaPlane {
+  Vec3f mean;
+  Vec3f normal;
+};
+PcaPlane pca_plane(std::span<const Vec3f> positions, std::size_t self,
+                   std::span<const std::uint32_t> neighbours);
+
 struct PcaNormalOptions {
   // Points in each covariance, the point itself included (so k - 1 neighbours), and the degree of
   // the orientation graph. More smooths noise but blurs sharp edges; fewer follows thin features.

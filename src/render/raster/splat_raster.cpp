@@ -42,10 +42,7 @@ using render_detail::store4;
 using render_detail::kEllipseStride;
 using render_detail::prepare_ellipses;
 
-inline std::uint32_t pack(Rgb8 c) {
-  return static_cast<std::uint32_t>(c.r) | static_cast<std::uint32_t>(c.g) << 8 |
-         static_cast<std::uint32_t>(c.b) << 16;
-}
+using render_detail::pack_rgb;
 
 // One band of the image: depths in the output buffer (full image, rows top to bottom) and packed
 // colors (0x00BBGGRR) in a band-sized buffer whose first row is the band's first row.
@@ -410,7 +407,7 @@ void clear_band(const Target& t, Rgb8 background) {
   const std::size_t w = static_cast<std::size_t>(t.width);
   const std::size_t rows = static_cast<std::size_t>(t.row_end - t.row_begin);
   const std::size_t first = static_cast<std::size_t>(t.row_begin) * w;
-  std::fill(t.color, t.color + rows * w, pack(background));
+  std::fill(t.color, t.color + rows * w, pack_rgb(background));
   std::fill(t.depth + first, t.depth + first + rows * w, std::numeric_limits<float>::infinity());
 }
 

@@ -6,6 +6,8 @@
 #include <limits>
 
 #include "pointillist/render/renderer.hpp"
+#include "raster/unpack_rgb.hpp"
+#include "select/subtree_selection.hpp"
 
 namespace pointillist::render_detail {
 namespace {
@@ -13,18 +15,6 @@ namespace {
 constexpr int kBandRows = 32;
 constexpr std::uint32_t kScreenBlock = 4096;  // selected triangles per projection task
 
-inline std::uint32_t pack(Rgb8 c) {
-  return static_cast<std::uint32_t>(c.r) | static_cast<std::uint32_t>(c.g) << 8 |
-         static_cast<std::uint32_t>(c.b) << 16;
-}
-
-bool sphere_outside(const CameraFrame& cam, const Sphere& s) {
-  if (dot(s.center - cam.eye, cam.forward) <= -s.radius) return true;
-  for (const Plane& p : cam.planes) {
-    if (p.distance(s.center) <= -s.radius) return true;
-  }
-  return false;
-}
 
 // Whether a triangle is dropped by backface culling: every corner's normal faces away from the
 // eye (as the splats are dropped), and so does its plane (oriented by the corners' normals), so
@@ -143,7 +133,7 @@ void select_triangles(const HybridLod& lod, const CameraFrame& camera,
   std::vector<std::uint32_t> visible;
   for (std::uint32_t g = 0; g < lod.groups.size(); ++g) {
     if (lod.groups[g].begin == lod.groups[g].end) continue;
-    if (settings.frustum_culling && sphere_outside(camera, lod.groups[g].bounds)) {
+    if (settings.frustum_culling && spt_chunk_outside(camera, lod.groups[g].bounds)) {
       ++stats.groups_culled;
       continue;
     }
@@ -213,7 +203,7 @@ std::uint64_t draw_triangles(std::span<const TriangleBatch> batches, const Camer
   const Shader shader(settings, cam);
   const auto test = [&](std::size_t idx, float z) { return z <= depth[idx]; };
   const auto write = [&](std::size_t idx, float z, Rgb8 c) {
-    if (z < depth[idx] || pack(c) < pack(color[idx])) {
+    if (z < depth[idx] || pack_rgb(c) < pack_rgb(color[idx])) {
       depth[idx] = z;
       color[idx] = c;
     }

@@ -1,4 +1,4 @@
-// Packed 0x00BBGGRR pixels (the fast rasterizer's colour buffer) to 3-byte RGB pixels.
+// Packed 0x00BBGGRR pixels (the fast rasterizer's colour buffer) from and to 3-byte RGB pixels.
 #pragma once
 
 #include <bit>
@@ -11,6 +11,13 @@
 #include "pointillist/core/math.hpp"
 
 namespace pointillist::render_detail {
+
+// 0x00BBGGRR: below 2^24, so signed and unsigned order agree (the fast rasterizer's tie rule
+// compares packed colours).
+inline std::uint32_t pack_rgb(Rgb8 c) {
+  return static_cast<std::uint32_t>(c.r) | static_cast<std::uint32_t>(c.g) << 8 |
+         static_cast<std::uint32_t>(c.b) << 16;
+}
 
 // n pixels from `in` to `dst`, four at a time (three little-endian words), with streaming
 // stores where SSE2 has them: the output is written once per frame and not read back here.
