@@ -130,6 +130,7 @@ struct GenerateOptions {
   // `render` would see the written .ply) on `background`.
   std::string reference_output;
   std::string reference_depth_output;  // with it: its depth (PFM, scene units; empty = none)
+  std::string reference_normals_output;  // with it: its normals (PNG, normal colours; empty = none)
   ViewOptions view;
   Rgb8 background{0, 0, 0};
   std::vector<std::string> warnings;  // options given that do not apply (printed by run_generate)
@@ -148,6 +149,8 @@ struct CompareOptions {
   // --labels --depth REF.pfm TEST.pfm --see-through-gap G: the SEE-THROUGH count.
   std::vector<std::string> depth_images;
   float see_through_gap = 0;
+  // --labels --normals REF.png TEST.png: the NORMAL ERROR (normal colours).
+  std::vector<std::string> normal_images;
 };
 int run_compare(const CompareOptions& options);
 

@@ -7,6 +7,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include "commands.hpp"
 #include "options.hpp"
@@ -22,8 +23,25 @@ namespace {
 
 using ull = unsigned long long;
 
+double percent(std::uint64_t a, std::uint64_t b) {
+  return b > 0 ? 100.0 * double(a) / double(b) : 0.0;
+}
+
 std::string labels_to_json(const LabelComparison& l, int tolerance) {
-  char buf[2048];
+  std::string normals = "null";
+  if (l.normals_compared) {
+    char n[512];
+    std::snprintf(n, sizeof n,
+                  "{\"band_pixels\": %llu, \"band_mean_deg\": %.4f, \"band_over_5deg\": %.6f, "
+                  "\"covered_pixels\": %llu, \"covered_mean_deg\": %.4f, "
+                  "\"covered_over_5deg\": %.6f}",
+                  ull(l.normal_band_count), l.normal_band_mean_deg,
+                  percent(l.normal_band_over, l.normal_band_count) / 100.0,
+                  ull(l.normal_covered_count), l.normal_covered_mean_deg,
+                  percent(l.normal_covered_over, l.normal_covered_count) / 100.0);
+    normals = n;
+  }
+  char buf[2560];
   std::snprintf(buf, sizeof buf,
                 ",\n"
                 "  \"labels\": {\n"
@@ -52,7 +70,8 @@ std::string labels_to_json(const LabelComparison& l, int tolerance) {
                 "    \"transition_width_mean_px\": %.6f,\n"
                 "    \"transition_width_max_px\": %.6f,\n"
                 "    \"see_through_pixels\": %s,\n"
-                "    \"psnr_band_db\": %s\n"
+                "    \"psnr_band_db\": %s,\n"
+                "    \"normal_error\": %s\n"
                 "  }",
                 tolerance, ull(l.covered_count), ull(l.interior_count), ull(l.boundary_count),
                 ull(l.hole_count), ull(l.far_background_count), ull(l.overshoot_count),
@@ -63,7 +82,8 @@ std::string labels_to_json(const LabelComparison& l, int tolerance) {
                 ull(l.unmatched_profile_count), l.displacement_mean_px, l.displacement_max_px,
                 l.transition_mean_px, l.transition_max_px,
                 l.depth_compared ? std::to_string(l.see_through_count).c_str() : "null",
-                std::isfinite(l.psnr_band_db) ? std::to_string(l.psnr_band_db).c_str() : "null");
+                std::isfinite(l.psnr_band_db) ? std::to_string(l.psnr_band_db).c_str() : "null",
+                normals.c_str());
   return buf;
 }
 
@@ -95,9 +115,6 @@ std::string comparison_to_json(const ImageComparison& c, int width, int height,
   return buf + labels + "\n}\n";
 }
 
-double percent(std::uint64_t a, std::uint64_t b) {
-  return b > 0 ? 100.0 * double(a) / double(b) : 0.0;
-}
 
 void print_labels(const LabelComparison& l, int tolerance) {
   std::printf("labels:         palette of generate --scene T*, tolerance %d levels; reference "
@@ -134,6 +151,14 @@ void print_labels(const LabelComparison& l, int tolerance) {
     std::printf("  PSNR in B_8:  inf dB (identical there)\n");
   } else {
     std::printf("  PSNR in B_8:  %.2f dB\n", l.psnr_band_db);
+  }
+  if (l.normals_compared) {
+    std::printf("  NORMAL ERROR: mean %.2f deg in B_8, %.3f%% over 5 deg (%llu px); all covered: "
+                "mean %.2f deg, %.3f%% over 5 deg (%llu px)\n",
+                l.normal_band_mean_deg, percent(l.normal_band_over, l.normal_band_count),
+                ull(l.normal_band_count), l.normal_covered_mean_deg,
+                percent(l.normal_covered_over, l.normal_covered_count),
+                ull(l.normal_covered_count));
   }
 }
 
@@ -184,6 +209,20 @@ int run_compare(const CompareOptions& o) {
       ref_depth = read_pfm(o.depth_images[0], reference.width, reference.height);
       test_depth = read_pfm(o.depth_images[1], reference.width, reference.height);
     }
+    ImageRgb8 ref_normals, test_normals;
+    if (!o.normal_images.empty()) {
+      ref_normals = read_png_rgb8(o.normal_images[0]);
+      test_normals = read_png_rgb8(o.normal_images[1]);
+      for (const auto& [path, image] : {std::pair{o.normal_images[0], &ref_normals},
+                                        std::pair{o.normal_images[1], &test_normals}}) {
+        if (image->width != reference.width || image->height != reference.height) {
+          throw Error(path + " is " + std::to_string(image->width) + "x" +
+                      std::to_string(image->height) + " but the label images are " +
+                      std::to_string(reference.width) + "x" + std::to_string(reference.height) +
+                      "; render the normal image with the same camera options");
+        }
+      }
+    }
     labels = compare_labels(ref_view, test_view,
                             {.palette = kLabelPalette,
                              .background = background,
@@ -191,7 +230,9 @@ int run_compare(const CompareOptions& o) {
                              .reference_name = o.reference,
                              .reference_depth = ref_depth.pixels,
                              .test_depth = test_depth.pixels,
-                             .see_through_gap = o.see_through_gap});
+                             .see_through_gap = o.see_through_gap,
+                             .reference_normals = ref_normals.pixels,
+                             .test_normals = test_normals.pixels});
   }
 
   if (!o.json_output.empty()) {
@@ -245,6 +286,11 @@ Command add_compare_command(CLI::App& app) {
                   "generate --reference-depth, render --depth D.pfm) for the SEE-THROUGH count")
       ->expected(2)
       ->check(CLI::ExistingFile);
+  cmd->add_option("--normals", o->normal_images,
+                  "With --labels: the normal images of the reference and the test (PNG: "
+                  "generate --reference-normals, render --normal-colors) for the NORMAL ERROR")
+      ->expected(2)
+      ->check(CLI::ExistingFile);
   cmd->add_option("--see-through-gap", o->see_through_gap,
                   "With --depth: how far (scene units) behind the reference a test pixel of "
                   "another surface must lie to count as see-through (the spec: 2 mean splat "
@@ -252,6 +298,10 @@ Command add_compare_command(CLI::App& app) {
   return {cmd, [o, background, cmd] {
             if (!o->depth_images.empty() && !o->labels) {
               throw OptionError("--depth applies with --labels (the SEE-THROUGH count)");
+            }
+            if (!o->normal_images.empty() && !o->labels) {
+              throw OptionError("--normals applies with --labels (the NORMAL ERROR in the "
+                                "label band)");
             }
             if (!o->depth_images.empty() && !(o->see_through_gap > 0)) {
               throw OptionError("--depth needs --see-through-gap G, a depth in scene units > 0 "

@@ -15,6 +15,7 @@
 #include "util.hpp"
 #include "pointillist/core/atomic_file.hpp"
 #include "pointillist/core/error.hpp"
+#include "pointillist/core/normal_color.hpp"
 #include "pointillist/io/ply.hpp"
 #include "pointillist/io/pfm.hpp"
 #include "pointillist/io/png.hpp"
@@ -35,16 +36,21 @@ namespace {
 struct Reference {
   std::vector<Rgb8> pixels;
   std::vector<float> depth;  // along the view direction, +inf where the ray misses
+  std::vector<Rgb8> normals; // encode_normal_color of the eye-space normal, background on misses
 };
 Reference reference_image(const GenerateOptions& o, const CsgScene& scene,
                           const PointSet& samples, std::span<const std::uint32_t> group) {
   const Camera camera = make_camera(o.view, view_sphere(samples.positions), samples.up);
   CsgImage image = ray_cast_csg_image(scene, camera);
-  std::vector<Rgb8> pixels(image.label.size(), o.background);
+  const CameraFrame eye = make_camera_frame(camera);
+  std::vector<Rgb8> pixels(image.label.size(), o.background), normals(pixels);
   for (std::size_t i = 0; i < pixels.size(); ++i) {
-    if (image.label[i] != kNoLabel) pixels[i] = kLabelPalette[group[image.label[i]] % 8];
+    if (image.label[i] == kNoLabel) continue;
+    pixels[i] = kLabelPalette[group[image.label[i]] % 8];
+    const Vec3f n = image.normal[i];
+    normals[i] = encode_normal_color({dot(n, eye.right), dot(n, eye.up), -dot(n, eye.forward)});
   }
-  return {std::move(pixels), std::move(image.depth)};
+  return {std::move(pixels), std::move(image.depth), std::move(normals)};
 }
 
 // A CSG test scene of the sharp-features spec: exact normals, a colour per face; J-mode samples
@@ -74,6 +80,9 @@ int generate_csg(const GenerateOptions& o) {
   if (!o.reference_depth_output.empty()) {
     write_pfm(o.reference_depth_output, o.view.width, o.view.height, reference.depth);
   }
+  if (!o.reference_normals_output.empty()) {
+    write_png_rgb8(o.reference_normals_output, o.view.width, o.view.height, reference.normals);
+  }
   if (!o.quiet) {
     char normals[96] = "exact normals";
     if (scene.normal_noise_degrees > 0 || scene.position_noise > 0) {
@@ -87,6 +96,10 @@ int generate_csg(const GenerateOptions& o) {
     if (!o.reference_output.empty()) {
       std::printf("exact label reference (ray cast, unlit, a colour per face) %dx%d -> %s\n",
                   o.view.width, o.view.height, o.reference_output.c_str());
+    }
+    if (!o.reference_normals_output.empty()) {
+      std::printf("exact normals (eye space, normal colours) -> %s\n",
+                  o.reference_normals_output.c_str());
     }
   }
   return 0;
@@ -132,7 +145,19 @@ int generate_occlusion_scene(const GenerateOptions& o) {
 void check_options(const GenerateOptions& o) {
   check_outputs({}, {{"-o", o.output},
                      {"--reference", o.reference_output},
-                     {"--reference-depth", o.reference_depth_output}});
+                     {"--reference-depth", o.reference_depth_output},
+                     {"--reference-normals", o.reference_normals_output}});
+  if (!o.reference_normals_output.empty()) {
+    if (o.reference_output.empty()) {
+      throw OptionError("--reference-normals writes the normals of the --reference image; give "
+                        "--reference R.png too");
+    }
+    if (lowercase_extension(o.reference_normals_output) != ".png") {
+      throw OptionError("--reference-normals " + o.reference_normals_output +
+                        ": the normal image is a PNG (render --normal-colors' encoding); give a "
+                        "path ending in .png");
+    }
+  }
   if (!o.reference_depth_output.empty()) {
     if (o.reference_output.empty()) {
       throw OptionError("--reference-depth writes the depth of the --reference image; give "
@@ -291,6 +316,10 @@ Command add_generate_command(CLI::App& app) {
   cmd->add_option("--reference-depth", o->reference_depth_output,
                   "With --reference: also its depth along the view direction, a PFM in scene "
                   "units (compare --labels --depth)")
+      ->group(kGroupOutput);
+  cmd->add_option("--reference-normals", o->reference_normals_output,
+                  "With --reference: also its exact normals as render --normal-colors draws "
+                  "them, a PNG (compare --labels --normals)")
       ->group(kGroupOutput);
   auto camera = std::make_shared<CameraText>();
   add_camera_options(cmd, o->view, *camera);

@@ -15,7 +15,7 @@ namespace {
 struct RenderText {
   CameraText camera;
   std::string background = "0,0,0", path, memory, read_per_frame;
-  bool unlit = false;
+  bool unlit = false, normal_colors = false;
   std::vector<std::string> edl;  // --edl [STRENGTH]
   bool no_chunk_culling = false;
   bool features = false, no_features = false;
@@ -51,6 +51,12 @@ void add_look(CLI::App* cmd, RenderOptions& o, RenderText& t) {
   cmd->add_flag("--unlit", t.unlit,
                 "Show each splat's own colour, unshaded (ambient 1, no diffuse or specular): "
                 "the face colours of generate --scene T*, for compare --labels")
+      ->group(kGroupLook);
+  cmd->add_flag("--normal-colors", t.normal_colors,
+                "Show each pixel's eye-space normal instead of shading it, as (R,G,B) = "
+                "255*(n+1)/2 (x right, y up, z toward the viewer): a normal map, for looking at "
+                "normals and for compare --normals")
+      ->excludes("--unlit")
       ->group(kGroupLook);
   add_edl_and_two_sided(cmd, o.settings, t.edl);
   add_enum<Reconstruction>(cmd, "--reconstruction", o.frame.quality.reconstruction,
@@ -311,6 +317,13 @@ Command add_render_command(CLI::App& app) {
             parse_camera_options(t->camera, o->view);
             o->settings.background = parse_rgb8(t->background, "--background");
             if (cmd->count("--edl") > 0) o->settings.edl_strength = parse_edl(t->edl);
+            if (t->normal_colors) {
+              if (o->settings.edl_strength > 0) {
+                throw OptionError("--normal-colors draws normals, which eye-dome lighting would "
+                                  "darken; leave out --edl");
+              }
+              o->settings.normal_colors = true;
+            }
             if (t->unlit) {
               o->settings.ambient = 1.0f;
               o->settings.diffuse = 0.0f;

@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "pointillist/core/error.hpp"
+#include "pointillist/core/normal_color.hpp"
 
 namespace pointillist {
 namespace {
@@ -231,6 +232,14 @@ void measure_profiles(const std::vector<std::uint8_t>& ref, const std::vector<st
 
 double ratio(std::uint64_t a, std::uint64_t b) { return b == 0 ? 0.0 : double(a) / double(b); }
 
+// The angle between two decoded normals in degrees; 90 when either is the zero vector (a colour
+// no unit normal encodes to).
+double angle_degrees(Vec3f a, Vec3f b) {
+  if (dot(a, a) == 0.0f || dot(b, b) == 0.0f) return 90.0;
+  const double c = std::clamp(static_cast<double>(dot(a, b)), -1.0, 1.0);
+  return std::acos(c) * (180.0 / 3.14159265358979323846);
+}
+
 }  // namespace
 
 std::vector<std::uint8_t> label_image(ImageRgb8View image, std::span<const Rgb8> palette,
@@ -297,6 +306,14 @@ LabelComparison compare_labels(ImageRgb8View reference, ImageRgb8View test,
                   "radii in the spec), not " + std::to_string(o.see_through_gap));
     }
   }
+  out.normals_compared = !o.reference_normals.empty() || !o.test_normals.empty();
+  if (out.normals_compared && (o.reference_normals.size() != reference.pixels.size() ||
+                               o.test_normals.size() != reference.pixels.size())) {
+    throw Error("label comparison: normal images of " + std::to_string(o.reference_normals.size()) +
+                " and " + std::to_string(o.test_normals.size()) + " pixels for " +
+                std::to_string(reference.pixels.size()) + "-pixel images; give both normal "
+                "images, of the colour images' size");
+  }
   const int w = reference.width, h = reference.height;
   const std::vector<std::uint8_t> ref = reference_label_image(reference, o, out.background);
   const std::vector<std::uint8_t> got = label_image(test, o.palette, out.background, o.tolerance);
@@ -312,6 +329,7 @@ LabelComparison compare_labels(ImageRgb8View reference, ImageRgb8View test,
   const Mask mix_band = dilate(g.boundary, w, h, o.mix_band_px);
   double band_squared = 0;
   std::uint64_t band_pixels = 0;
+  double band_degrees = 0, covered_degrees = 0;
   for (std::size_t i = 0; i < ref.size(); ++i) {
     const bool mixed = got[i] == kLabelMixed;
     if (!g.covered[i]) {
@@ -331,6 +349,15 @@ LabelComparison compare_labels(ImageRgb8View reference, ImageRgb8View test,
       const auto sq = [](int x) { return static_cast<double>(x * x); };
       band_squared += sq(a.r - b.r) + sq(a.g - b.g) + sq(a.b - b.b);
       ++band_pixels;
+    }
+    if (out.normals_compared && test_foreground[i]) {
+      const double degrees = angle_degrees(decode_normal_color(o.reference_normals[i]),
+                                           decode_normal_color(o.test_normals[i]));
+      const bool over = degrees > kNormalErrorDegrees;
+      ++out.normal_covered_count, covered_degrees += degrees, out.normal_covered_over += over;
+      if (mix_band[i]) {
+        ++out.normal_band_count, band_degrees += degrees, out.normal_band_over += over;
+      }
     }
     out.covered_error_count += error;
     out.wrong_count += error && got[i] < kLabelBackground;
@@ -357,6 +384,12 @@ LabelComparison compare_labels(ImageRgb8View reference, ImageRgb8View test,
                                 : 10.0 * std::log10(255.0 * 255.0 / mse);
   }
   out.ler_covered = ratio(out.covered_error_count, out.covered_count);
+  if (out.normal_band_count > 0) {
+    out.normal_band_mean_deg = band_degrees / static_cast<double>(out.normal_band_count);
+  }
+  if (out.normal_covered_count > 0) {
+    out.normal_covered_mean_deg = covered_degrees / static_cast<double>(out.normal_covered_count);
+  }
   out.mixed_per_boundary_px = ratio(out.mixed_band_count, out.boundary_count);
   measure_profiles(ref, got, g, test, o, out);
   return out;

@@ -13,6 +13,7 @@
 #include "pointillist/core/camera.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/core/math.hpp"
+#include "pointillist/core/normal_color.hpp"
 #include "pointillist/render/settings.hpp"
 #include "simd.hpp"
 
@@ -54,6 +55,10 @@ class Shader {
     specular_ = s.specular;
     base_ = s.base_color;
     two_sided_ = s.two_sided;
+    normal_colors_ = s.normal_colors;
+    right_ = cam.right;
+    up_ = cam.up;
+    back_ = -cam.forward;
     table_ = power_table(s.shininess);
     power_ = table_->data();
   }
@@ -72,6 +77,9 @@ class Shader {
   // n: unit normal, v: unit vector to the eye, both in world space; base: linear 0..1.
   Rgb8 shade(Vec3f n, Vec3f v, Vec3f base) const {
     if (two_sided_ && dot(n, v) < 0.0f) n = -n;  // seen from behind: lit as its front
+    if (normal_colors_) {
+      return encode_normal_color({dot(n, right_), dot(n, up_), dot(n, back_)});
+    }
     const float ndl = dot(n, light_);
     const float k = ambient_ + diffuse_ * std::max(0.0f, ndl);
     // h is zero only when the light is exactly behind the surface (then n·l ≤ 0: no highlight);
@@ -93,6 +101,14 @@ class Shader {
       const Float4 sign = select4(ndv < zero, splat4(-1.0f), one);
       for (Float4& c : n) c = c * sign;
     }
+    if (normal_colors_) {  // encode_normal_color of the eye-space normal, lane by lane
+      const Vec3f axes[3] = {right_, up_, back_};
+      for (int c = 0; c < 3; ++c) {
+        const Float4 e = n[0] * axes[c].x + n[1] * axes[c].y + n[2] * axes[c].z;
+        out[c] = to_int4(min4(one, max4(zero, 0.5f * e + 0.5f)) * 255.0f + 0.5f);
+      }
+      return;
+    }
     const Float4 ndl = n[0] * light_.x + n[1] * light_.y + n[2] * light_.z;
     const Float4 k = ambient_ + diffuse_ * max4(zero, ndl);
     const Float4 hx = v[0] + light_.x, hy = v[1] + light_.y, hz = v[2] + light_.z;
@@ -112,6 +128,8 @@ class Shader {
 
  private:
   Vec3f light_, base_;
+  Vec3f right_, up_, back_;  // the eye's axes in world space (normal colours)
+  bool normal_colors_ = false;
   float ambient_ = 0, diffuse_ = 0, specular_ = 0;
   bool two_sided_ = false;
   using PowerTable = std::array<float, kTableIntervals + 2>;

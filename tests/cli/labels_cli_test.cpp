@@ -3,6 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <string>
@@ -11,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/cli_run.hpp"
+#include "pointillist/core/normal_color.hpp"
 #include "pointillist/io/pfm.hpp"
 #include "pointillist/io/png.hpp"
 #include "testing/testing.hpp"
@@ -197,4 +199,113 @@ TEST(LabelsCli, DepthImagesGiveTheSeeThroughCount) {
   r = run_cli("render " + ply + " -q -o " + img + " --depth " + dir.file("d.tif"));
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_THAT(r.output, HasSubstr(".png or .pfm"));
+}
+
+TEST(LabelsCli, NormalImagesGiveTheNormalError) {
+  // The reference's normals are the ray cast's exact face normals. Seen at the cube's corner, the
+  // faces' discs with features carry their face's exact normal up to the crease (no error in
+  // B_8), in both modes; without features discs of one face reach over the crease and show
+  // their normal there (90° off), and the quality mode blends the faces' normals.
+  pointillist::testing::TempDir dir;
+  const std::string ply = dir.file("cube.ply"), ref = dir.file("ref.png"),
+                    ref_normals = dir.file("ref_n.png"), img = dir.file("t.png"),
+                    normals = dir.file("t_n.png");
+  const std::string camera = " --size 128x128 --eye 2,2.1,1.9 --target 1,1,1";
+  auto r = run_cli("generate --scene T1 --sampling r -q -o " + ply + " --reference " + ref +
+                   " --reference-normals " + ref_normals + camera);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  // The reference shows three faces, so three normal colours, and their decoded normals are
+  // the cube's: orthogonal to each other (within the encoding's 0.4° each).
+  const ImageRgb8 exact = read_png_rgb8(ref_normals);
+  const ImageRgb8 labels = read_png_rgb8(ref);
+  ASSERT_EQ(exact.pixels.size(), labels.pixels.size());
+  std::size_t covered = 0;
+  std::vector<Rgb8> colours;
+  for (std::size_t i = 0; i < exact.pixels.size(); ++i) {
+    if (labels.pixels[i] == Rgb8{0, 0, 0}) continue;
+    ++covered;
+    if (std::find(colours.begin(), colours.end(), exact.pixels[i]) == colours.end()) {
+      colours.push_back(exact.pixels[i]);
+    }
+  }
+  ASSERT_EQ(colours.size(), 3u);
+  for (int a = 0; a < 3; ++a) {
+    const Vec3f u = decode_normal_color(colours[a]), v = decode_normal_color(colours[(a + 1) % 3]);
+    EXPECT_NEAR(dot(u, v), 0.0f, 0.014f);  // sin(0.8°)
+    EXPECT_GT(u.z, 0.0f);                  // facing the eye
+  }
+  ASSERT_GT(covered, 5000u);
+  const auto metrics = [&](const std::string& mode, const std::string& features) {
+    auto rr = run_cli("render " + ply + " -q --mode " + mode + " --unlit " + features + " -o " +
+                      img + camera);
+    EXPECT_EQ(rr.exit_code, 0) << rr.output;
+    rr = run_cli("render " + ply + " -q --mode " + mode + " --normal-colors " + features +
+                 " -o " + normals + camera);
+    EXPECT_EQ(rr.exit_code, 0) << rr.output;
+    rr = run_cli("compare " + ref + " " + img + " --labels --json - --normals " + ref_normals +
+                 " " + normals);
+    EXPECT_EQ(rr.exit_code, 0) << rr.output;
+    return nlohmann::json::parse(rr.output)["labels"]["normal_error"];
+  };
+  for (const std::string mode : {"fast", "quality"}) {
+    const auto with = metrics(mode, "--features");
+    EXPECT_GT(with["band_pixels"].get<int>(), 1000) << mode;
+    EXPECT_LT(with["band_mean_deg"].get<double>(), 0.5) << mode;
+    EXPECT_LT(with["band_over_5deg"].get<double>(), 0.002) << mode;
+    const auto without = metrics(mode, "--no-features");
+    EXPECT_GT(without["band_mean_deg"].get<double>(), 5.0) << mode;
+    EXPECT_GT(without["band_over_5deg"].get<double>(), 0.1) << mode;
+  }
+  // Both normal images are needed, of the label images' size, and only with --labels.
+  EXPECT_TRUE(label_metrics(ref, img)["normal_error"].is_null());
+  r = run_cli("compare " + ref + " " + img + " --normals " + ref_normals + " " + normals);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("--normals applies with --labels"));
+  r = run_cli("render " + ply + " -q --normal-colors -o " + dir.file("small.png") +
+              " --size 64x64");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = run_cli("compare " + ref + " " + img + " --labels --normals " + ref_normals + " " +
+              dir.file("small.png"));
+  EXPECT_NE(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("64x64 but the label images are 128x128"));
+  r = run_cli("generate --scene T1 -q -o " + ply + " --reference-normals " + ref_normals);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("give --reference R.png too"));
+  r = run_cli("generate --scene T1 -q -o " + ply + " --reference " + ref +
+              " --reference-normals " + dir.file("n.pfm"));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("ending in .png"));
+  r = run_cli("render " + ply + " -q --normal-colors --edl -o " + img);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("leave out --edl"));
+}
+
+TEST(LabelsCli, SmoothSphereNormalsMatchTheExactOnes) {
+  // T13, the smooth control: the quality mode's blended normals follow the exact sphere within
+  // a fraction of a degree everywhere (exact sample normals, jittered samples); the fast mode's
+  // flat discs each show their centre's normal, off by up to the angle a disc subtends.
+  pointillist::testing::TempDir dir;
+  const std::string ply = dir.file("s.ply"), ref = dir.file("ref.png"),
+                    ref_normals = dir.file("ref_n.png"), img = dir.file("t.png"),
+                    normals = dir.file("t_n.png");
+  const std::string camera = " --size 128x128 --view 30,20";
+  auto r = run_cli("generate --scene T13 -q -o " + ply + " --reference " + ref +
+                   " --reference-normals " + ref_normals + camera);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::vector<double> mean;
+  for (const std::string mode : {"quality", "fast"}) {
+    r = run_cli("render " + ply + " -q --unlit --mode " + mode + " -o " + img + camera);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    r = run_cli("render " + ply + " -q --normal-colors --mode " + mode + " -o " + normals + camera);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    r = run_cli("compare " + ref + " " + img + " --labels --json - --normals " + ref_normals +
+                " " + normals);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const auto n = nlohmann::json::parse(r.output)["labels"]["normal_error"];
+    EXPECT_GT(n["covered_pixels"].get<int>(), 8000) << mode;
+    mean.push_back(n["covered_mean_deg"].get<double>());
+  }
+  EXPECT_LT(mean[0], 0.6);
+  EXPECT_GT(mean[1], 2 * mean[0]);
+  EXPECT_LT(mean[1], 5.0);
 }

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "pointillist/core/error.hpp"
+#include "pointillist/core/normal_color.hpp"
 #include "pointillist/eval/label_metrics.hpp"
 
 using namespace pointillist;
@@ -301,4 +302,55 @@ TEST(LabelMetrics, PsnrInsideTheEightPixelBand) {
   EXPECT_TRUE(std::isinf(compare(ref, ref).psnr_band_db));
   const Image one = two_labels(kHi);  // a single label: no boundary
   EXPECT_TRUE(std::isnan(compare(one, one).psnr_band_db));
+}
+
+TEST(LabelMetrics, NormalErrorMeasuresAnglesInTheBandOverCoveredPixels) {
+  // Reference normals: label 0's face faces the eye, label 1's is turned 60° about y. The test
+  // has the same labels; its normals equal the reference's except a column of label 0 in B_8
+  // turned 10° about x (over the 5° threshold) and a column far from the boundary turned 3°.
+  const Image ref = two_labels(32);
+  Image ref_n, test_n;
+  const double rad = 3.14159265358979323846 / 180.0;
+  const auto about_x = [&](double deg) {
+    return encode_normal_color({0, static_cast<float>(std::sin(deg * rad)),
+                                static_cast<float>(std::cos(deg * rad))});
+  };
+  const Rgb8 face0 = about_x(0);
+  const Rgb8 face1 = encode_normal_color(
+      {static_cast<float>(std::sin(60 * rad)), 0, static_cast<float>(std::cos(60 * rad))});
+  for (int y = kLo; y < kHi; ++y) {
+    for (int x = kLo; x < kHi; ++x) {
+      ref_n.at(x, y) = test_n.at(x, y) = x < 32 ? face0 : face1;
+    }
+    test_n.at(28, y) = about_x(10);  // column 28: 4 px from the boundary, in B_8
+    test_n.at(12, y) = about_x(3);   // column 12: 20 px away, outside B_8
+  }
+  LabelCompareOptions o{.palette = kPalette};
+  o.reference_normals = ref_n.pixels;
+  o.test_normals = test_n.pixels;
+  const LabelComparison c = compare_labels(ref.view(), ref.view(), o);
+  ASSERT_TRUE(c.normals_compared);
+  // B_8: columns 23..40 (8 either side of the boundary columns 31 and 32), 48 rows.
+  EXPECT_EQ(c.normal_band_count, 18u * 48u);
+  EXPECT_EQ(c.normal_band_over, 48u);
+  EXPECT_NEAR(c.normal_band_mean_deg, 10.0 * 48 / (18.0 * 48), 0.03);
+  EXPECT_EQ(c.normal_covered_count, 48u * 48u);
+  EXPECT_EQ(c.normal_covered_over, 48u);
+  EXPECT_NEAR(c.normal_covered_mean_deg, (10.0 + 3.0) * 48 / (48.0 * 48), 0.02);
+
+  // A hole is HOLE's, not a normal error: the test's empty pixels are left out.
+  Image holed = ref;
+  holed.at(30, 30) = kBlack;
+  const LabelComparison h = compare_labels(ref.view(), holed.view(), o);
+  EXPECT_EQ(h.hole_count, 1u);
+  EXPECT_EQ(h.normal_band_count, 18u * 48u - 1);
+
+  // Both images or neither, of the colour images' size.
+  LabelCompareOptions one = o;
+  one.test_normals = {};
+  EXPECT_THROW(compare_labels(ref.view(), ref.view(), one), Error);
+  const std::vector<Rgb8> small(10);
+  one.test_normals = small;
+  EXPECT_THROW(compare_labels(ref.view(), ref.view(), one), Error);
+  EXPECT_FALSE(compare(ref, ref).normals_compared);
 }

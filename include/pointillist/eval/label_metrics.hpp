@@ -61,8 +61,15 @@
 //               see_through_gap (the spec's 2 mean splat radii): the render shows a farther
 //               surface there. The spec counts them into HOLE; they are reported apart.
 //
-// Left out: normal error and the weight of a second label (MIX's 2 % threshold) need the
-// renderer's debug output. The
+//   NORMAL ERROR (with normal images of both, LabelCompareOptions::reference_normals/
+//               test_normals, in the encoding of core/normal_color.hpp: `generate
+//               --reference-normals`, `render --normal-colors`): the angle between the decoded
+//               reference and test normals at the covered pixels of B_8 that the test covers
+//               (holes are HOLE's), mean and share above kNormalErrorDegrees (5°); also over
+//               all covered pixels. 8-bit encoding: each normal is within 0.4° of the true one.
+//
+// Left out: the weight of a second label (MIX's 2 % threshold) needs the renderer's debug
+// output. The
 // tolerance decides which blends show: one whose second colour carries weight w moves some
 // channel by w·d levels, d the largest channel difference of the two colours, so it is MIXED
 // when w·d > tolerance + 0.5.
@@ -100,7 +107,12 @@ struct LabelCompareOptions {
   // or NaN for none), both given or neither, and the depth gap that counts (> 0, scene units).
   std::span<const float> reference_depth, test_depth;
   float see_through_gap = 0;
+  // NORMAL ERROR: the normal images (normal colours, row-major), both given or neither.
+  std::span<const Rgb8> reference_normals, test_normals;
 };
+
+// The spec's threshold of the NORMAL ERROR's share (§4.5).
+constexpr double kNormalErrorDegrees = 5.0;
 
 // Codes of label_image: palette indices are 0 … palette.size() − 1.
 constexpr std::uint8_t kLabelBackground = 254;
@@ -134,6 +146,13 @@ struct LabelComparison {
   double psnr_band_db = std::numeric_limits<double>::quiet_NaN();
   bool depth_compared = false;            // depth images were given
   std::uint64_t see_through_count = 0;    // SEE-THROUGH (0 without depth)
+  bool normals_compared = false;          // normal images were given
+  // NORMAL ERROR in B_8 (covered by both) and over every pixel covered by both: pixels measured,
+  // mean angle (degrees; 0 when none) and pixels above kNormalErrorDegrees.
+  std::uint64_t normal_band_count = 0, normal_band_over = 0;
+  double normal_band_mean_deg = 0;
+  std::uint64_t normal_covered_count = 0, normal_covered_over = 0;
+  double normal_covered_mean_deg = 0;
 };
 
 // The label of every pixel of `image` (row-major): a palette index, kLabelBackground or
@@ -152,7 +171,8 @@ std::vector<std::uint8_t> reference_label_image(ImageRgb8View reference,
 // differ or are empty, the options are out of range (palette, tolerance, band widths, profile
 // length), the palette colours are not told apart at this tolerance (naming the two entries),
 // the reference holds a colour that is not background or a palette colour (naming the pixel), or
-// the depth images are given alone, at another size, or without a positive gap.
+// the depth images are given alone, at another size, or without a positive gap, or the normal
+// images alone or at another size.
 LabelComparison compare_labels(ImageRgb8View reference, ImageRgb8View test,
                                const LabelCompareOptions& options);
 

@@ -47,6 +47,12 @@ struct RenderSettings {
   // splats), and a surface seen from behind is lit as if its normal faced the eye (partial scans
   // seen from behind, clouds with unoriented normals).
   bool two_sided = false;
+  // Normal colours instead of shading: every surface shows its eye-space normal n (x right, y up,
+  // z toward the viewer; after the two-sided flip) as (R, G, B) = round(255·(n + 1)/2) per
+  // component, the blended normal in quality mode, the splat's normal in fast mode. Decoding
+  // 2·c/255 − 1 and normalising recovers n to within 0.4° (8-bit rounding). For looking at
+  // normals and for the normal error of `compare --normals`. Not with eye-dome lighting.
+  bool normal_colors = false;
   // Eye-dome lighting after rasterization (eye_dome.hpp): 0 = off; 1 is Potree's default.
   float edl_strength = 0.0f;
 
