@@ -22,8 +22,9 @@
 # OVERSHOOT, LER in B_4 and over the covered pixels (%), MIX (interior mixed pixels, and mixed pixels in B_8 per reference boundary pixel),
 # edge displacement mean/max (px), transition width mean/max (px) ("-" when no profile has both
 # faces in the test; the note counts the profiles that lack one), whole-image PSNR and PSNR in
-# B_8 (dB; "inf" also when the band is empty), the
-# render's wall time and its raster time from --stats (ms). A combination that fails prints its
+# B_8 (dB; "inf" also when the band is empty), the normal error in B_8 (mean angle in degrees
+# against the exact normals, and the share of pixels over 5°, %; from a second render of the view
+# with --normal-colors), the render's wall time and its raster time from --stats (ms). A combination that fails prints its
 # error in the row's note and the run goes on. Needs jq, awk and coreutils only.
 set -euo pipefail
 
@@ -96,9 +97,9 @@ now_ms() { echo $(( $(date +%s%N) / 1000000 )); }
 oneline() { tr '\n\t' '  ' <"$1" | sed 's/  */ /g; s/^ //; s/ $//' | cut -c1-160; }
 
 rows=$work/rows.tsv
-header="scene\tsamp\tview\tvariant\tHOLE\tSEE\tOVERSHOOT\tLER_B4%\tLER_cov%\tMIX\tMIX/bpx\tdisp_mean\tdisp_max\ttw_mean\ttw_max\tPSNR\tPSNR_B8\twall_ms\traster_ms\tnote"
+header="scene\tsamp\tview\tvariant\tHOLE\tSEE\tOVERSHOOT\tLER_B4%\tLER_cov%\tMIX\tMIX/bpx\tdisp_mean\tdisp_max\ttw_mean\ttw_max\tPSNR\tPSNR_B8\tNERR_B8\tN>5deg%\twall_ms\traster_ms\tnote"
 printf '%b\n' "$header" >"$rows"
-blank="\t\t\t\t\t\t\t\t\t\t\t\t\t"  # the 13 metric columns, empty
+blank="\t\t\t\t\t\t\t\t\t\t\t\t\t\t\t"  # the 15 metric columns, empty
 total=0
 for scene in $scenes; do
   for mode in $modes; do
@@ -108,8 +109,9 @@ for scene in $scenes; do
       ply=$work/${scene}_${mode}.ply
       ref=$work/${tag}_ref.png
       ref_depth=$work/${tag}_ref.pfm
+      ref_normals=$work/${tag}_ref_n.png
       if ! "$bin" generate -q --scene "$scene" --sampling "$mode" -o "$ply" --reference "$ref" \
-          --reference-depth "$ref_depth" --size "${size}x${size}" "${cam[@]}" 2>"$work/err"; then
+          --reference-depth "$ref_depth" --reference-normals "$ref_normals" --size "${size}x${size}" "${cam[@]}" 2>"$work/err"; then
         printf '%s\t%s\t%s\t%s%b\t\t\tgenerate failed: %s\n' "$scene" "$mode" "$view" "-" "$blank" \
           "$(oneline "$work/err")" >>"$rows"
         continue
@@ -134,8 +136,16 @@ for scene in $scenes; do
         raster=$(jq -r '.ms.raster // empty' "$work/stats.json" 2>/dev/null || true)
         note=""
         [[ -s $work/err ]] && note="stderr: $(oneline "$work/err")"
+        # The same view again as a normal map, for the NORMAL ERROR (not timed).
+        if ! "$bin" render -q "$ply" -o "$work/test_n.png" --size "${size}x${size}" "${cam[@]}" \
+            --mode "$rmode" --normal-colors "${fl[@]}" 2>"$work/err"; then
+          printf '%s\t%s\t%s\t%s%b\t%s\t%s\tnormal render failed: %s\n' "$scene" "$mode" "$view" \
+            "$name" "$blank" "$wall" "$raster" "$(oneline "$work/err")" >>"$rows"
+          continue
+        fi
         if ! "$bin" compare "$ref" "$img" --labels --json "$work/cmp.json" --depth "$ref_depth" \
-            "$work/test.pfm" --see-through-gap "$gap" >/dev/null 2>"$work/err"; then
+            "$work/test.pfm" --see-through-gap "$gap" --normals "$ref_normals" "$work/test_n.png" \
+            >/dev/null 2>"$work/err"; then
           printf '%s\t%s\t%s\t%s%b\t%s\t%s\tcompare failed: %s\n' "$scene" "$mode" "$view" "$name" \
             "$blank" "$wall" "$raster" "$(oneline "$work/err")" >>"$rows"
           continue
@@ -155,6 +165,8 @@ for scene in $scenes; do
              ($l.transition_width_mean_px | n), ($l.transition_width_max_px | n) end),
            (if .psnr_db == null then "inf" else (.psnr_db | n) end),
            (if $l.psnr_band_db == null then "inf" else ($l.psnr_band_db | n) end),
+           (if ($l.normal_error.band_pixels // 0) == 0 then "-", "-" else
+             ($l.normal_error.band_mean_deg | n), ($l.normal_error.band_over_5deg * 100 | n) end),
            $wall, $raster,
            ([(if ($l.unmatched_profiles // 0) > 0 then "\($l.unmatched_profiles) of \($l.profiles + $l.unmatched_profiles) profiles lack a face in the test" else empty end),
              (if $note != "" then $note else empty end)] | join("; "))
@@ -170,8 +182,8 @@ awk -F'\t' -v OFS='\t' '
     for (i = 5; i < NF; i++) {
       if ($i !~ /^-?[0-9.]+(e[-+]?[0-9]+)?$/) continue
       if (i == 8 || i == 9 || i == 11) $i = sprintf("%.3f", $i)
-      else if (i == 12 || i == 14 || i == 16 || i == 17) $i = sprintf("%.2f", $i)
-      else if (i == 13 || i == 19) $i = sprintf("%.1f", $i)
+      else if (i == 12 || i == 14 || i == 16 || i == 17 || i == 18 || i == 19) $i = sprintf("%.2f", $i)
+      else if (i == 13 || i == 21) $i = sprintf("%.1f", $i)
     }
   }
   { print }' "$rows" >"$rows.fmt" && mv "$rows.fmt" "$rows"
