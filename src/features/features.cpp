@@ -191,10 +191,13 @@ FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec
       }
       if (classified && sharp) {
         shapes[i] = fit_shape(centers[i], normals[i], around, around_normals);
-        // The residual less what the model's quantization alone leaves (noise_floor).
+        // The residual less what the model's quantization alone leaves (noise_floor); none
+        // when it is what the second-order fit alone leaves on exact data (kFitNoiseFloor).
         const float residual = fit_residual(centers[i], normals[i], shapes[i], around);
         const float floor = options.noise_floor * drawn[i];
-        noise[i] = std::sqrt(std::max(0.0f, residual * residual - floor * floor));
+        noise[i] = residual < kFitNoiseFloor * drawn[i]
+                       ? 0.0f
+                       : std::sqrt(std::max(0.0f, residual * residual - floor * floor));
       }
     }
   });

@@ -89,7 +89,8 @@ float sag_shift(const Disc& s, const Disc& partner, bool keep_positive) {
 // close-up in quality mode). Measured on T14-2 and T14-5, both sampling modes, overview and
 // close-up, with the renderer's fill of clipped pinholes: 0.75 left 6 hole pixels (T14-2), 1.0
 // none, 1.5 none but 1.7 times the label errors in the crease band, the price of a convex
-// crease's overhang, which is in view. 0 on exact data (the fit residual is 0 to second order).
+// crease's overhang, which is in view. Nearly 0 on exact data: the fit residual is 0 to second
+// order, and what higher orders leave is below kFitNoiseFloor.
 constexpr float kNoiseMargin = 1.0f;
 float noise_shift(float own_noise, float partner_noise) {
   return kNoiseMargin * std::sqrt(own_noise * own_noise + partner_noise * partner_noise);
