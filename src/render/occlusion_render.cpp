@@ -131,6 +131,41 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
   }
   const bool features = fs.features && any_features;
   const bool with_discs = features || quality;
+  // Sharp features in quality mode: how far behind a sure occluder the bound of a pixel's front
+  // surface may lie (quality_occluders.hpp). The renderer refuses the lists and pages, whose
+  // drawn radii this does not bound.
+  quality_detail::FeatureOccluderBound feature_bound;
+  if (quality && features) {
+    const float disc = fs.quality.radius_scale * std::max(1.0f, fs.splat_scale);
+    feature_bound.active = true;
+    feature_bound.width_per_radius =
+        disc * (fs.quality.reconstruction == Reconstruction::ZRange
+                    ? 2.0f + fs.quality.z_range_margin
+                    : fs.quality.z_threshold);
+    std::vector<std::pair<const RenderModel*, float>> leaf_radii;
+    for (const SceneInstance& inst : scene) {
+      auto it = std::find_if(leaf_radii.begin(), leaf_radii.end(),
+                             [&](const auto& e) { return e.first == inst.model; });
+      if (it == leaf_radii.end()) {
+        float largest = 0;
+        for (const SphereNode& n : inst.model->tree.nodes) {
+          if (n.child_count == 0) largest = std::max(largest, n.radius);
+        }
+        leaf_radii.emplace_back(inst.model, largest);
+        it = leaf_radii.end() - 1;
+      }
+      feature_bound.leaf_radius =
+          std::max(feature_bound.leaf_radius, it->second * inst.transform.scale);
+    }
+    const float t = settings.threshold_px, f = cam.focal_px;
+    if (cam.ortho) {
+      feature_bound.inner_radius = t / (2.0f * f);
+    } else {
+      feature_bound.radius_per_depth = 2.0f * f > t * disc
+                                           ? t / (2.0f * f - t * disc)
+                                           : std::numeric_limits<float>::infinity();
+    }
+  }
   {
     std::uint32_t id_base = 0;
     for (std::size_t i = 0; i < scene.size(); ++i) {
@@ -477,7 +512,8 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
       // The quality setup of the new chunks, and their occluders unless no query follows.
       dirty = quality_detail::draw_quality_occluders(stream, first, stream.chunk_count, cam,
                                                      settings, fs.quality, pool, quality_scratch_,
-                                                     c.occluders, frame.depth, !last);
+                                                     c.occluders, frame.depth, !last,
+                                                     feature_bound);
     } else {
       for (const SoftwareQueries::Rect& r : rects) {
         if (r.x1 > r.x0 && r.y1 > r.y0) {

@@ -138,16 +138,22 @@ void Renderer::render(std::span<const SceneInstance> scene, const Camera& camera
                        : quality && fs.quality.opacity < 1.0f
                            ? "--opacity below 1 (what shows through is not hidden)"
                            : nullptr;
+    // With sharp features the quality occluders bound the drawn radii by the QSplat rule
+    // (quality_occluders.hpp): not the Sequential Point Tree's lists, nor pages drawn coarser
+    // while they load.
     for (const SceneInstance& inst : scene) {
-      if (!drop && quality && fs.features && model_features(*inst.model)) {
-        drop = "sharp features with --mode quality (add --no-features)";
+      if (!drop && quality && fs.features && model_features(*inst.model) &&
+          (fs.lod == LodScheme::Spt || inst.model->pages || options_.page_all)) {
+        drop = fs.lod == LodScheme::Spt
+                   ? "--lod spt with sharp features in --mode quality (or add --no-features)"
+                   : "paging of models with sharp features in --mode quality (add --no-features)";
       }
     }
     if (drop) {
       throw OptionError(std::string("occlusion culling (--occlusion ") +
                         name(fs.occlusion.method) +
                         ") works with the fast mode, and the quality mode of opaque surfaces "
-                        "without sharp features; drop " +
+                        "(with sharp features: models held whole, --lod qsplat); drop " +
                         drop + ", or --occlusion");
     }
   }

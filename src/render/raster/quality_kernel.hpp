@@ -134,8 +134,8 @@ struct StreamPiece {
 
 // rasterize_quality over splats of `stream` taken piece by piece in the order of `pieces`
 // instead of in stream order, with every chunk's setup already in `scratch` (prepare_chunk with
-// quality_setup(camera, settings, quality, stream.has_colors, pool.thread_count()), no sharp
-// features). The image is rasterize_quality's on a stream holding the pieces' splats in that
+// quality_setup(camera, settings, quality, stream.has_colors, pool.thread_count()) and the
+// stream's has_features). The image is rasterize_quality's on a stream holding the pieces' splats in that
 // order.
 void rasterize_quality_pieces(const SplatStream& stream, std::span<const StreamPiece> pieces,
                               const CameraFrame& camera, const RenderSettings& settings,

@@ -4,6 +4,7 @@
 #include "raster/quality_occluders.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <limits>
 
@@ -21,6 +22,12 @@ using render_detail::select4;
 // rasterizer's lane arithmetic may round differently from this scalar loop right at the edge.
 constexpr float kOccluderCoverMargin = 1e-3f;
 
+// hi + W_max(hi) (FeatureOccluderBound), with slack for the float arithmetic of the setup.
+float feature_bound(const FeatureOccluderBound& f, float hi) {
+  const float r = std::max({f.leaf_radius, f.inner_radius, f.radius_per_depth * hi});
+  return hi + f.width_per_radius * r * (1.0f + 1e-4f) + std::fabs(hi) * 1e-6f;
+}
+
 }  // namespace
 
 SoftwareQueries::Rect draw_quality_occluders(const SplatStream& stream, std::size_t first,
@@ -28,7 +35,8 @@ SoftwareQueries::Rect draw_quality_occluders(const SplatStream& stream, std::siz
                                              const RenderSettings& settings,
                                              const QualitySettings& quality, ThreadPool& pool,
                                              QualityScratch& prepared, OccluderScratch& scratch,
-                                             std::span<float> bound, bool occluders) {
+                                             std::span<float> bound, bool occluders,
+                                             const FeatureOccluderBound& features) {
   const int width = camera.width, height = camera.height;
   SoftwareQueries::Rect out{width, height, 0, 0};
   if (last <= first || width <= 0 || height <= 0) return out;
@@ -39,11 +47,13 @@ SoftwareQueries::Rect draw_quality_occluders(const SplatStream& stream, std::siz
   fit_chunks(prepared, last);
   const std::size_t chunks = last - first;
   pool.run(chunks, [&](std::size_t c) {
-    prepare_chunk(stream.chunks[first + c], setup, false, prepared.chunk_splats[first + c],
+    prepare_chunk(stream.chunks[first + c], setup, stream.has_features,
+                  prepared.chunk_splats[first + c],
                   prepared.chunk_bins[first + c], prepared.chunk_planes[first + c]);
   });
 
   if (!occluders) return out;
+  assert(!stream.has_features || features.active);
   const std::size_t bands = static_cast<std::size_t>(setup.band_count);
   scratch.band_rects.assign(bands, out);
   const float half_w = 0.5f * static_cast<float>(width);
@@ -62,11 +72,14 @@ SoftwareQueries::Rect draw_quality_occluders(const SplatStream& stream, std::siz
       const std::size_t base = bands + 1;
       for (std::uint32_t k = bins[band]; k < bins[band + 1]; ++k) {
         const float* s = &prepared.chunk_splats[c][kStride * bins[base + k]];
+        // With features a clipped splat may lose any pixel: it is no occluder.
+        if (stream.has_features && (float_to_bits(s[kClipCode]) & 31u) != 0) continue;
         const int i0 = static_cast<int>(s[kI0]), i1 = static_cast<int>(s[kI1]);
         const int j0 = std::max(static_cast<int>(s[kJ0]), row0);
         const int j1 = std::min(static_cast<int>(s[kJ1]), row1 - 1);
         // The largest bound of the splat's fragments (ZThreshold: depth ≤ the disc's deepest).
-        const float u_bound = z_range ? s[kBound] : s[kDepthHi] + s[kBound];
+        float u_bound = z_range ? s[kBound] : s[kDepthHi] + s[kBound];
+        if (stream.has_features) u_bound = feature_bound(features, s[kDepthHi]);
         const float nx = s[kNx], ny = s[kNy], nz = s[kNz], nc = s[kNc];
         const float cx = s[kCx], cy = s[kCy], cz = s[kCz], inv_r2 = s[kInvR2];
         const Float4 lane{0.0f, 1.0f, 2.0f, 3.0f};

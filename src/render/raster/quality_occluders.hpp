@@ -21,17 +21,36 @@
 
 namespace pointillist::quality_detail {
 
+// With sharp features the quality rasterizer blends, at each pixel, only the surface of its
+// front fragment F (the nearest unclipped one) and bounds the blend by F's own bound, so a sure
+// fragment g no longer bounds B by g's bound: F, maybe drawn later, may reach further. But F is
+// no deeper than g (depth_F ≤ depth_g ≤ g's deepest, hi_g), and F's bound lies at most
+// W_F = width_per_radius · r_F behind its depth (r_F its node's radius): ZRange, the disc's
+// depth interval (≤ 2 drawn radii) plus the margin; ZThreshold, ε drawn radii. r_F is at most
+// the largest leaf radius of the scene, or, for an inner node the QSplat traversal draws at
+// depth z, threshold·z/(2f − threshold·disc) (perspective; orthographic: threshold/(2f)). So
+// B ≤ hi_g + W_max(hi_g) wherever an unclipped splat surely covers the pixel, and a node whose
+// nearest key lies behind that everywhere can neither be the front nor blend in.
+struct FeatureOccluderBound {
+  bool active = false;
+  float width_per_radius = 0;  // W_F over r_F (drawn radii per node radius times the rule's)
+  float leaf_radius = 0;       // the largest leaf radius of any instance, eye units
+  float radius_per_depth = 0;  // perspective: an inner node drawn at depth z has r ≤ this·z
+  float inner_radius = 0;      // orthographic: an inner node drawn has r ≤ this
+};
+
 // Work buffers of the occluder pass, kept across batches and frames.
 struct OccluderScratch {
   std::vector<SoftwareQueries::Rect> band_rects;
 };
 
 // Lowers `bound` (eye depth per pixel, rows top to bottom, the camera's size; +∞ where nothing
-// was drawn) with the splats of chunks [first, last) of `stream` (opaque surfaces, no sharp
-// features): at every pixel where rasterize_quality is certain to give a splat a fragment (its
+// was drawn) with the splats of chunks [first, last) of `stream` (opaque surfaces): at every pixel where rasterize_quality is certain to give a splat a fragment (its
 // kernel argument within 1 − 1e-3 of the disc or low-pass edge), to the largest bound that
 // fragment can have (ZRange: the splat's widened interval's end; ZThreshold: its deepest depth
-// plus ε·R). The smallest bound of a pixel's fragments is then never above `bound`. The chunks'
+// plus ε·R). The smallest bound of a pixel's fragments is then never above `bound`. A stream
+// with sharp features needs `features` active: then only splats without clip planes lower the
+// bound, to their deepest depth plus features' W_max there. The chunks'
 // setup is left in `prepared` as rasterize_quality_pieces expects it (quality_kernel.hpp).
 // Returns the rectangle of pixels lowered, [x0, x1) × [y0, y1) (empty when none). Without
 // `occluders` (nothing will test them), only the setup is made.
@@ -40,7 +59,8 @@ SoftwareQueries::Rect draw_quality_occluders(const SplatStream& stream, std::siz
                                              const RenderSettings& settings,
                                              const QualitySettings& quality, ThreadPool& pool,
                                              QualityScratch& prepared, OccluderScratch& scratch,
-                                             std::span<float> bound, bool occluders = true);
+                                             std::span<float> bound, bool occluders = true,
+                                             const FeatureOccluderBound& features = {});
 
 // The footprint a query must assume of a node's splats in quality mode: every disc lies within
 // the node's sphere grown by radius_scale (and the splat scale), covers the low-pass disc, and

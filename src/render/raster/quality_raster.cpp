@@ -435,7 +435,7 @@ void rasterize_quality_pieces(const SplatStream& stream, std::span<const StreamP
                               const QualitySettings& quality, ThreadPool& pool,
                               QualityScratch& scratch, std::span<Rgb8> color,
                               std::span<float> depth) {
-  assert(!stream.has_features && scratch.chunk_splats.size() >= stream.chunk_count);
+  assert(scratch.chunk_splats.size() >= stream.chunk_count);
   rasterize(stream, &pieces, camera, settings, quality, pool, scratch, color, depth);
 }
 
