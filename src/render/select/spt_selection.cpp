@@ -91,7 +91,7 @@ void select_mask(const SequentialPointTree& t, std::uint32_t begin, std::uint32_
       // Edge-on and small: at most kSilhouetteSplat error bounds across.
       const int edge_on = (facing * facing < s2 * d2) &
                           (diameter[i] * diameter[i] < kSilhouetteSplat2 * re2);
-      const int kept = !(far2 < sup[i] * sup[i]) | edge_on;
+      const int kept = static_cast<int>(!(far2 < sup[i] * sup[i])) | edge_on;
       const int in = (err[i] * err[i] <= re2) & (re2 < perr[i] * perr[i]) & kept;
       mask[i] = static_cast<std::uint8_t>(in + (in & (facing > facing_limit)));
     }
