@@ -36,6 +36,7 @@ Json occlusion_json(const OcclusionSettings& o, const OcclusionStats& s) {
           {"flushes", s.flushes},
           {"stalls", s.stalls},
           {"hiz_tiles_tested", s.tiles_tested},
+          {"paged_subtrees_culled", s.paged_subtrees_culled},
           {"ms_query", ms(s.ms_query)},
           {"ms_hiz", ms(s.ms_hiz)}};
 }

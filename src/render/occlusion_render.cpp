@@ -6,6 +6,7 @@
 // smaller colour), and only splats strictly behind what is drawn are skipped, so the image is
 // the same bits as without culling.
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -382,16 +383,41 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
   // A paged model's visible instance: its selection (which requests the pages it needs) moved
   // behind the stream's chunks; in the fast mode each chunk's pixel rectangle goes to `rects`,
   // in the quality mode each chunk is a piece of leaf n.
+  const QueryFootprint footprint =
+      quality ? quality_detail::quality_query_footprint(fs.quality, fs.splat_scale)
+              : QueryFootprint{std::max(1.0f, fs.splat_scale)};
+  // Inside a visible paged model, each subtree in another page is tested against what is drawn
+  // so far (the pyramid of the batches before this one: a subset of the frame's occluders), so
+  // a hidden page is neither drawn nor requested.
+  struct PagedTest {
+    const DepthPyramid* pyramid;
+    const CameraFrame* camera;
+    const InstanceTransform* transform;
+    const QueryFootprint* footprint;
+    std::atomic<std::uint64_t>* tested;
+  };
+  std::atomic<std::uint64_t> paged_tiles{0};
+  const auto paged_hidden = [](const void* context, Vec3f center, float radius) {
+    const PagedTest& t = *static_cast<const PagedTest*>(context);
+    std::uint64_t tested = 0;
+    const QueryBound bound{t.transform->apply(center), radius * t.transform->scale};
+    const bool visible = bound_may_be_visible(*t.pyramid, *t.camera, bound, *t.footprint, tested);
+    *t.tested += tested;
+    return !visible;
+  };
   const auto select_paged = [&](std::uint32_t n) {
     const std::uint32_t instance = c.meta[n].instance;
     ModelState& st = *states[instance];
     const bool page_features = features && st.pages->features();
     scratch_stream_.with_discs = with_discs;
+    const PagedTest test{&c.pyramid, &cam, &scene[instance].transform, &footprint, &paged_tiles};
+    const SubtreeOcclusion occlusion{paged_hidden, &test};
     const SelectionStats sel = st.paged->select(views[instance].cam, settings, pool,
-                                                scratch_stream_, true, page_features);
+                                                scratch_stream_, true, page_features, &occlusion);
     counters.visited += sel.nodes_visited;
     counters.culled_frustum += sel.culled_frustum;
     counters.culled_backface += sel.culled_backface;
+    ostats.paged_subtrees_culled += sel.culled_occluded;
     const ChunkPlacement place =
         placement(instance, scratch_stream_.has_colors, nullptr, page_features);
     for (std::size_t k = 0; k < scratch_stream_.chunk_count; ++k) {
@@ -492,13 +518,6 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
     paged_leaves.assign(split, order.end());
     order.erase(split, order.end());
     const std::size_t first = select_order();
-    for (const std::uint32_t n : paged_leaves) {
-      view_of(c.meta[n].instance);
-      instance_drawn[c.meta[n].instance] = 1;
-      select_paged(n);
-    }
-    const auto t1 = Clock::now();
-    SoftwareQueries::Rect dirty{cam.width, cam.height, 0, 0};
     if (quality) {
       // Where each leaf's splats are, for the quality pass.
       for (std::size_t g = 0; g < groups.size(); ++g) {
@@ -509,30 +528,61 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
           begin = end;
         }
       }
-      // The quality setup of the new chunks, and their occluders unless no query follows.
-      dirty = quality_detail::draw_quality_occluders(stream, first, stream.chunk_count, cam,
-                                                     settings, fs.quality, pool, quality_scratch_,
-                                                     c.occluders, frame.depth, !last,
-                                                     feature_bound);
-    } else {
-      for (const SoftwareQueries::Rect& r : rects) {
-        if (r.x1 > r.x0 && r.y1 > r.y0) {
-          dirty.x0 = std::min(dirty.x0, r.x0);
-          dirty.y0 = std::min(dirty.y0, r.y0);
-          dirty.x1 = std::max(dirty.x1, r.x1);
-          dirty.y1 = std::max(dirty.y1, r.y1);
-        }
-      }
-      draw_splats(stream, first, stream.chunk_count, cam, settings, pool, frame.scratch,
-                  frame.depth);
     }
-    ms_select += std::chrono::duration<double, std::milli>(t1 - t0).count();
+    ms_select += std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    SoftwareQueries::Rect dirty{cam.width, cam.height, 0, 0};
+    const auto grow = [](SoftwareQueries::Rect& into, const SoftwareQueries::Rect& r) {
+      if (r.x1 <= r.x0 || r.y1 <= r.y0) return;
+      into.x0 = std::min(into.x0, r.x0);
+      into.y0 = std::min(into.y0, r.y0);
+      into.x1 = std::max(into.x1, r.x1);
+      into.y1 = std::max(into.y1, r.y1);
+    };
+    // Draws the chunks from `drawn_to` on (quality: their setup and, with `occluders`, their
+    // occluders; fast: the splats) and returns the pixels they may have changed.
+    std::size_t drawn_to = first, rects_to = 0;
+    const auto draw_new = [&](bool occluders) {
+      SoftwareQueries::Rect d{cam.width, cam.height, 0, 0};
+      if (quality) {
+        d = quality_detail::draw_quality_occluders(stream, drawn_to, stream.chunk_count, cam,
+                                                   settings, fs.quality, pool, quality_scratch_,
+                                                   c.occluders, frame.depth, occluders,
+                                                   feature_bound);
+      } else {
+        for (; rects_to < rects.size(); ++rects_to) grow(d, rects[rects_to]);
+        draw_splats(stream, drawn_to, stream.chunk_count, cam, settings, pool, frame.scratch,
+                    frame.depth);
+      }
+      drawn_to = stream.chunk_count;
+      return d;
+    };
+    if (!paged_leaves.empty()) {
+      // Paged models select on the pool themselves, one after the other, near to far, each
+      // after what the batch drew before it, so that their pages are tested against it.
+      std::sort(paged_leaves.begin(), paged_leaves.end(), [&](std::uint32_t a, std::uint32_t b) {
+        const float da = length(c.h.nodes[a].bound.center - cam.eye) - c.h.nodes[a].bound.radius;
+        const float db = length(c.h.nodes[b].bound.center - cam.eye) - c.h.nodes[b].bound.radius;
+        return da < db || (da == db && a < b);
+      });
+      for (const std::uint32_t n : paged_leaves) {
+        const auto ts = Clock::now();
+        const SoftwareQueries::Rect d = draw_new(true);
+        grow(dirty, d);
+        if (d.x1 > d.x0 && d.y1 > d.y0) c.pyramid.refresh(d.x0, d.y0, d.x1, d.y1);
+        const auto tp = Clock::now();
+        ms_raster += std::chrono::duration<double, std::milli>(tp - ts).count();
+        view_of(c.meta[n].instance);
+        instance_drawn[c.meta[n].instance] = 1;
+        select_paged(n);
+        ms_select += std::chrono::duration<double, std::milli>(Clock::now() - tp).count();
+      }
+    }
+    // The rest, and their occluders unless no query follows.
+    const auto t1 = Clock::now();
+    grow(dirty, draw_new(!last));
     ms_raster += std::chrono::duration<double, std::milli>(Clock::now() - t1).count();
     return dirty;
   };
-  const QueryFootprint footprint =
-      quality ? quality_detail::quality_query_footprint(fs.quality, fs.splat_scale)
-              : QueryFootprint{std::max(1.0f, fs.splat_scale)};
   SoftwareQueries queries(c.pyramid, cam, footprint, os.query_latency, draw, ostats);
   cull_frame(c.h, callbacks, os, queries, c.state, ostats);
   if (quality) {
@@ -571,6 +621,7 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
   fill_stats(frame, selection, cam, pool.thread_count(), start, start, done);
   frame.stats.ms_select = ms_select;
   frame.stats.ms_raster = ms_raster;
+  ostats.tiles_tested += paged_tiles;
   frame.stats.occlusion = ostats;
   if (features) {
     RenderStats& s = frame.stats;

@@ -69,6 +69,9 @@ struct OcclusionStats {
   std::uint64_t flushes = 0;           // render-queue flushes that drew something
   std::uint64_t stalls = 0;            // results asked before they were available
   std::uint64_t tiles_tested = 0;      // pyramid tiles and pixels tested by queries
+  // Paged models: subtrees in other pages found hidden while a visible instance selected its
+  // splats (neither drawn nor requested).
+  std::uint64_t paged_subtrees_culled = 0;
   double ms_query = 0, ms_hiz = 0;     // answering queries; refreshing the pyramid
 };
 

@@ -53,10 +53,13 @@ class PagedRenderer {
   // `same_frame`, the selection adds to the last one's requests (another instance of the model
   // in the same frame) instead of starting a frame. With `features` (a source whose pages carry
   // them), each chunk also gets its splats' surface ids (the model's own) and clip planes
-  // (model space); the stream's has_features is the caller's to set.
+  // (model space); the stream's has_features is the caller's to set. With `occlusion`, a node
+  // whose children are in another page is first tested, and when hidden its subtree is neither
+  // drawn nor requested (occlusion culling inside a paged model; SelectionStats::
+  // culled_occluded counts them).
   SelectionStats select(const CameraFrame& camera, const RenderSettings& settings,
                         ThreadPool& pool, SplatStream& stream, bool same_frame = false,
-                        bool features = false);
+                        bool features = false, const SubtreeOcclusion* occlusion = nullptr);
 
   // Starts a frame whose selections all pass same_frame (occlusion culling selects a model's
   // instances only when they are visible): drops the last frame's page requests, so a model

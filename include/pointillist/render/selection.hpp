@@ -18,6 +18,17 @@ struct SelectionStats {
                                       // nodes dropped for being behind (or a hair in front of) it
   std::uint64_t culled_backface = 0;  // subtrees whose normal cone faces away, and drawn nodes
                                       // dropped for facing away
+  std::uint64_t culled_occluded = 0;  // subtrees an occlusion test found hidden (paged models
+                                      // under occlusion culling: PagedRenderer::select)
+};
+
+// An occlusion test a paged selection asks before it opens a node whose children lie in
+// another page (PagedRenderer::select): hidden(context, centre, radius), the node's sphere in
+// model space, is true only when nothing of the subtree can show. Called from several
+// selection tasks at once.
+struct SubtreeOcclusion {
+  bool (*hidden)(const void* context, Vec3f center, float radius) = nullptr;
+  const void* context = nullptr;
 };
 
 // Walks `tree` depth first (Rusinkiewicz & Levoy 2000, section 3.2) and writes the splats to draw

@@ -204,7 +204,7 @@ void PagedRenderer::render_quality(const Camera& camera, const RenderSettings& s
 
 SelectionStats PagedRenderer::select(const CameraFrame& cam, const RenderSettings& settings,
                                     ThreadPool& pool, SplatStream& stream, bool same_frame,
-                                    bool features) {
+                                    bool features, const SubtreeOcclusion* occlusion) {
   if (!(settings.threshold_px > 0.0f) || !std::isfinite(settings.threshold_px)) {
     throw OptionError("splat size threshold " + std::to_string(settings.threshold_px) +
                       " px is invalid; give a positive number of pixels (1 draws every detail)");
@@ -215,7 +215,8 @@ SelectionStats PagedRenderer::select(const CameraFrame& cam, const RenderSetting
   stream.has_colors = with_colors;
   stream.chunk_count = 0;
   const Shader shader(settings, cam);
-  const ViewConstants v = make_view_constants(shader, cam, settings, stream.with_discs);
+  ViewConstants v = make_view_constants(shader, cam, settings, stream.with_discs);
+  v.occlusion = occlusion;
   Selection selection{
       v,
       static_cast<std::uint8_t>((settings.frustum_culling ? kTestFrustum : 0) |
@@ -240,7 +241,8 @@ SelectionStats PagedRenderer::select(const CameraFrame& cam, const RenderSetting
   for (std::size_t t = 0; t < stream.chunk_count; ++t) splats += stream.chunks[t].count;
   return {.splats = splats, .nodes_visited = counters.visited,
           .culled_frustum = counters.culled_frustum,
-          .culled_backface = counters.culled_backface};
+          .culled_backface = counters.culled_backface,
+          .culled_occluded = counters.culled_occluded};
 }
 
 void PagedRenderer::begin_frame() {
@@ -283,6 +285,7 @@ void PagedRenderer::select_pages(const Access& access, Selection& s, ThreadPool&
     s.counters.visited += out.counters.visited;
     s.counters.culled_frustum += out.counters.culled_frustum;
     s.counters.culled_backface += out.counters.culled_backface;
+    s.counters.culled_occluded += out.counters.culled_occluded;
     for (const std::uint32_t page : out.touched) cache_.mark_used(page);
     for (const PageRequest& r : out.requests) cache_.request(r);
   }

@@ -90,6 +90,13 @@ void walk_subtree(const Access& access, const typename Access::Item& start,
         if (decision != Decision::Refine) break;
         const ChildRef c = access.children(p, n);
         if constexpr (Access::kPaged) {
+          // Under occlusion culling a hidden subtree in another page is neither opened nor
+          // requested (nor drawn as a stand-in: its sphere holds the stand-in's splat too).
+          if (v.occlusion != nullptr && c.page != access.page(p) &&
+              v.occlusion->hidden(v.occlusion->context, n.center, n.radius)) {
+            ++counters.culled_occluded;
+            break;
+          }
           if (!c.resident) {
             emit(n, access.page(p), access.index(p), d, z, true);
             out.requests.push_back(
@@ -120,6 +127,7 @@ void walk_subtree(const Access& access, const typename Access::Item& start,
   out.counters.visited += counters.visited;
   out.counters.culled_frustum += counters.culled_frustum;
   out.counters.culled_backface += counters.culled_backface;
+  out.counters.culled_occluded += counters.culled_occluded;
 }
 
 // Selects the splats of the view `v` into `stream` (its chunks from 0). `tasks` holds each

@@ -11,6 +11,7 @@
 
 #include "pointillist/core/camera.hpp"
 #include "pointillist/lod/sphere_tree.hpp"
+#include "pointillist/render/selection.hpp"
 #include "pointillist/render/settings.hpp"
 #include "pointillist/render/splat_stream.hpp"
 #include "shading.hpp"
@@ -63,8 +64,9 @@ struct Pending {
 };
 
 struct Counters {
-  std::uint64_t visited = 0, culled_frustum = 0, culled_backface = 0;
+  std::uint64_t visited = 0, culled_frustum = 0, culled_backface = 0, culled_occluded = 0;
 };
+
 
 
 struct ViewConstants {
@@ -78,6 +80,8 @@ struct ViewConstants {
   std::array<Plane, 4> planes;
   bool with_discs;  // finish_chunk writes the discs (SplatStream::with_discs)
   bool cull_facing;  // splats facing away are dropped (not with two-sided lighting)
+  // Paged selection under occlusion culling: subtrees in other pages are tested first.
+  const SubtreeOcclusion* occlusion = nullptr;
 };
 
 enum class Decision { Cull, Draw, Refine };
