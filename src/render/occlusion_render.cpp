@@ -181,7 +181,7 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
     InstanceView& iv = views[i];
     if (!iv.ready) {
       iv.identity = scene[i].transform.is_identity();
-      iv.cam = iv.identity ? cam : make_camera_frame(model_camera(camera, scene[i].transform));
+      iv.cam = iv.identity ? cam : model_camera_frame(camera, cam, scene[i].transform);
       iv.shader.emplace(settings, iv.cam);
       iv.v = make_view_constants(*iv.shader, iv.cam, settings, with_discs);
       iv.ready = true;

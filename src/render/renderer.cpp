@@ -216,7 +216,7 @@ SelectionStats Renderer::select(std::span<const SceneInstance> scene, const Came
     if (first_use) last_frame_.push_back(&state);
     const bool identity = inst.transform.is_identity();
     const CameraFrame cam =
-        identity ? world : make_camera_frame(model_camera(camera, inst.transform));
+        identity ? world : model_camera_frame(camera, world, inst.transform);
     SplatStream& into = i == 0 ? stream : scratch_stream_;
     into.with_discs = with_discs;
     into.chunk_count = 0;

@@ -35,6 +35,34 @@ inline Camera model_camera(const Camera& world, const InstanceTransform& t) {
   return c;
 }
 
+// The camera frame in model space. As make_camera_frame builds it from model_camera, except
+// where that cannot work although the world frame did: an eye so far away that, scaled into a
+// small instance's space, the view vector's length overflows (a path fuzzer's camera at 1e19).
+// There the world frame's axes and planes are carried over instead (same projection).
+inline CameraFrame model_camera_frame(const Camera& camera, const CameraFrame& world,
+                                      const InstanceTransform& t) {
+  const Camera c = model_camera(camera, t);
+  const Vec3f view = c.target - c.eye;
+  const float len = length(view);
+  if (len > 0.0f && std::isfinite(len) && is_finite(view) &&
+      length(cross(view / len, c.up)) > 1e-6f * length(c.up)) {
+    return make_camera_frame(c);
+  }
+  CameraFrame f = world;
+  const float inv_scale = 1.0f / t.scale;
+  f.eye = t.rotate_back(world.eye - t.translate) * inv_scale;
+  f.right = t.rotate_back(world.right);
+  f.up = t.rotate_back(world.up);
+  f.forward = t.rotate_back(world.forward);
+  if (world.ortho) f.focal_px = world.focal_px * t.scale;  // pixels per model unit
+  for (std::size_t k = 0; k < f.planes.size(); ++k) {
+    // n·(translate + R·p·s) + d >= 0  <=>  (Rᵀn)·p + (d + n·translate)/s >= 0
+    const Plane& w = world.planes[k];
+    f.planes[k] = {t.rotate_back(w.normal), (w.d + dot(w.normal, t.translate)) * inv_scale};
+  }
+  return f;
+}
+
 // Moves a chunk selected in model space into the world: discs, and depth (model depth × scale).
 inline void to_world(const InstanceTransform& t, SplatChunk& chunk, bool with_discs) {
   for (std::size_t i = 0; i < chunk.count; ++i) {

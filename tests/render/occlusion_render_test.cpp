@@ -433,6 +433,33 @@ TEST(OcclusionRender, HiddenPagesOfAVisibleModelAreNeitherDrawnNorLoaded) {
   }
 }
 
+TEST(OcclusionRender, AFarEyeOverSmallInstancesRendersAsInTheWorld) {
+  // The path fuzzer's camera (fuzz/findings): an eye 1.3e19 away is a valid world camera, but
+  // scaled into a 0.4-sized ball's space the view vector's length overflowed a float and the
+  // model-space frame was refused as "up parallel to the view". Every method renders it, the
+  // same image, and the balls a far eye sees as less than a pixel leave no trace.
+  const TestScene scene(false);
+  ThreadPool pool(2);
+  Camera far = path_camera(0, 2);
+  far.eye = {3.0f, 1.0f, 1.3333333e19f};
+  far.target = {-1.0f, 0.5f, -2.0f};
+  std::vector<Image> shots;
+  for (OcclusionMethod m : {OcclusionMethod::None, OcclusionMethod::StopAndWait,
+                            OcclusionMethod::ChcPlusPlus}) {
+    FrameSettings fs;
+    fs.occlusion.method = m;
+    Renderer renderer;
+    Frame frame;
+    ASSERT_NO_THROW(renderer.render(scene.instances, far, {}, fs, pool, frame)) << name(m);
+    shots.push_back({std::vector<Rgb8>(frame.color.begin(), frame.color.end()),
+                     std::vector<float>(frame.depth.begin(), frame.depth.end()),
+                     frame.stats.splats, frame.stats.occlusion});
+  }
+  EXPECT_TRUE(same_bits(shots[1], shots[0]));
+  EXPECT_TRUE(same_bits(shots[2], shots[0]));
+  EXPECT_LE(shots[0].splats, scene.instances.size());
+}
+
 TEST(OcclusionRender, AnEmptySceneIsTheBackground) {
   ThreadPool pool(2);
   Renderer renderer;
