@@ -47,8 +47,7 @@ Reference reference_image(const GenerateOptions& o, const CsgScene& scene,
   for (std::size_t i = 0; i < pixels.size(); ++i) {
     if (image.label[i] == kNoLabel) continue;
     pixels[i] = kLabelPalette[group[image.label[i]] % 8];
-    const Vec3f n = image.normal[i];
-    normals[i] = encode_normal_color({dot(n, eye.right), dot(n, eye.up), -dot(n, eye.forward)});
+    normals[i] = encode_normal_color(eye.eye_direction(image.normal[i]));
   }
   return {std::move(pixels), std::move(image.depth), std::move(normals)};
 }

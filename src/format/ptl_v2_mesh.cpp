@@ -31,12 +31,6 @@ void put_varint(std::vector<std::uint8_t>& out, std::int64_t delta) {
   out.push_back(static_cast<std::uint8_t>(v));
 }
 
-void put_u64(std::vector<std::uint8_t>& out, std::uint64_t v) {
-  const std::size_t at = out.size();
-  out.resize(at + 8);
-  store_u64(out.data() + at, v);
-}
-
 [[noreturn]] void fail(const std::string& path, std::uint64_t byte, const std::string& what) {
   throw FormatError(path + ": byte " + std::to_string(byte) + ": mesh faces: " + what +
                     "; the file is damaged (convert the mesh again, or render without --hybrid)");

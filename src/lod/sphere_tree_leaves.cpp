@@ -1,4 +1,5 @@
-// The leaves of a bounding-sphere hierarchy as a point set.
+// The leaves of a bounding-sphere hierarchy as a point set, and their largest radius.
+#include <algorithm>
 #include "pointillist/lod/sphere_tree.hpp"
 
 #include <string>
@@ -6,6 +7,14 @@
 #include "pointillist/core/error.hpp"
 
 namespace pointillist {
+
+float largest_leaf_radius(const SphereTreeView& tree) {
+  float largest = 0;
+  for (const SphereNode& n : tree.nodes) {
+    if (n.child_count == 0) largest = std::max(largest, n.radius);
+  }
+  return largest;
+}
 
 PointSet sphere_tree_leaves(const SphereTreeView& tree) {
   PointSet p;

@@ -137,35 +137,14 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
   // drawn radii this does not bound.
   quality_detail::FeatureOccluderBound feature_bound;
   if (quality && features) {
-    const float disc = fs.quality.radius_scale * std::max(1.0f, fs.splat_scale);
-    feature_bound.active = true;
-    feature_bound.width_per_radius =
-        disc * (fs.quality.reconstruction == Reconstruction::ZRange
-                    ? 2.0f + fs.quality.z_range_margin
-                    : fs.quality.z_threshold);
-    std::vector<std::pair<const RenderModel*, float>> leaf_radii;
-    for (const SceneInstance& inst : scene) {
-      auto it = std::find_if(leaf_radii.begin(), leaf_radii.end(),
-                             [&](const auto& e) { return e.first == inst.model; });
-      if (it == leaf_radii.end()) {
-        float largest = 0;
-        for (const SphereNode& n : inst.model->tree.nodes) {
-          if (n.child_count == 0) largest = std::max(largest, n.radius);
-        }
-        leaf_radii.emplace_back(inst.model, largest);
-        it = leaf_radii.end() - 1;
-      }
-      feature_bound.leaf_radius =
-          std::max(feature_bound.leaf_radius, it->second * inst.transform.scale);
+    float leaf_radius = 0;
+    for (std::uint32_t i = 0; i < scene.size(); ++i) {
+      ModelState& st = *states[i];
+      if (!st.largest_leaf) st.largest_leaf = largest_leaf_radius(st.model->tree);
+      leaf_radius = std::max(leaf_radius, *st.largest_leaf * scene[i].transform.scale);
     }
-    const float t = settings.threshold_px, f = cam.focal_px;
-    if (cam.ortho) {
-      feature_bound.inner_radius = t / (2.0f * f);
-    } else {
-      feature_bound.radius_per_depth = 2.0f * f > t * disc
-                                           ? t / (2.0f * f - t * disc)
-                                           : std::numeric_limits<float>::infinity();
-    }
+    feature_bound = quality_detail::feature_occluder_bound(fs.quality, fs.splat_scale,
+                                                           settings.threshold_px, cam, leaf_radius);
   }
   {
     std::uint32_t id_base = 0;
@@ -389,29 +368,15 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
   // Inside a visible paged model, each subtree in another page is tested against what is drawn
   // so far (the pyramid of the batches before this one: a subset of the frame's occluders), so
   // a hidden page is neither drawn nor requested.
-  struct PagedTest {
-    const DepthPyramid* pyramid;
-    const CameraFrame* camera;
-    const InstanceTransform* transform;
-    const QueryFootprint* footprint;
-    std::atomic<std::uint64_t>* tested;
-  };
   std::atomic<std::uint64_t> paged_tiles{0};
-  const auto paged_hidden = [](const void* context, Vec3f center, float radius) {
-    const PagedTest& t = *static_cast<const PagedTest*>(context);
-    std::uint64_t tested = 0;
-    const QueryBound bound{t.transform->apply(center), radius * t.transform->scale};
-    const bool visible = bound_may_be_visible(*t.pyramid, *t.camera, bound, *t.footprint, tested);
-    *t.tested += tested;
-    return !visible;
-  };
   const auto select_paged = [&](std::uint32_t n) {
     const std::uint32_t instance = c.meta[n].instance;
     ModelState& st = *states[instance];
     const bool page_features = features && st.pages->features();
     scratch_stream_.with_discs = with_discs;
-    const PagedTest test{&c.pyramid, &cam, &scene[instance].transform, &footprint, &paged_tiles};
-    const SubtreeOcclusion occlusion{paged_hidden, &test};
+    const InstancePyramidTest test{&c.pyramid, &cam, &scene[instance].transform, &footprint,
+                                   &paged_tiles};
+    const SubtreeOcclusion occlusion = test.occlusion();
     const SelectionStats sel = st.paged->select(views[instance].cam, settings, pool,
                                                 scratch_stream_, true, page_features, &occlusion);
     counters.visited += sel.nodes_visited;
@@ -531,13 +496,6 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
     }
     ms_select += std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
     SoftwareQueries::Rect dirty{cam.width, cam.height, 0, 0};
-    const auto grow = [](SoftwareQueries::Rect& into, const SoftwareQueries::Rect& r) {
-      if (r.x1 <= r.x0 || r.y1 <= r.y0) return;
-      into.x0 = std::min(into.x0, r.x0);
-      into.y0 = std::min(into.y0, r.y0);
-      into.x1 = std::max(into.x1, r.x1);
-      into.y1 = std::max(into.y1, r.y1);
-    };
     // Draws the chunks from `drawn_to` on (quality: their setup and, with `occluders`, their
     // occluders; fast: the splats) and returns the pixels they may have changed.
     std::size_t drawn_to = first, rects_to = 0;
@@ -549,7 +507,7 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
                                                    c.occluders, frame.depth, occluders,
                                                    feature_bound);
       } else {
-        for (; rects_to < rects.size(); ++rects_to) grow(d, rects[rects_to]);
+        for (; rects_to < rects.size(); ++rects_to) d.add(rects[rects_to]);
         draw_splats(stream, drawn_to, stream.chunk_count, cam, settings, pool, frame.scratch,
                     frame.depth);
       }
@@ -567,8 +525,8 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
       for (const std::uint32_t n : paged_leaves) {
         const auto ts = Clock::now();
         const SoftwareQueries::Rect d = draw_new(true);
-        grow(dirty, d);
-        if (d.x1 > d.x0 && d.y1 > d.y0) c.pyramid.refresh(d.x0, d.y0, d.x1, d.y1);
+        dirty.add(d);
+        if (!d.empty()) c.pyramid.refresh(d.x0, d.y0, d.x1, d.y1);
         const auto tp = Clock::now();
         ms_raster += std::chrono::duration<double, std::milli>(tp - ts).count();
         view_of(c.meta[n].instance);
@@ -579,7 +537,7 @@ void Renderer::render_occluded(std::span<const SceneInstance> scene, const Camer
     }
     // The rest, and their occluders unless no query follows.
     const auto t1 = Clock::now();
-    grow(dirty, draw_new(!last));
+    dirty.add(draw_new(!last));
     ms_raster += std::chrono::duration<double, std::milli>(Clock::now() - t1).count();
     return dirty;
   };

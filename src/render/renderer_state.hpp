@@ -3,6 +3,7 @@
 #pragma once
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <functional>
 #include <memory>
@@ -62,6 +63,27 @@ inline CameraFrame model_camera_frame(const Camera& camera, const CameraFrame& w
   }
   return f;
 }
+
+// Occlusion culling inside a paged instance (PagedRenderer::select): a subtree, its sphere in
+// model space, is hidden when its world bound cannot show over `pyramid` (bound_may_be_visible).
+// Adds the tiles tested to `tested`; safe from several selection tasks at once.
+struct InstancePyramidTest {
+  const DepthPyramid* pyramid;
+  const CameraFrame* camera;
+  const InstanceTransform* transform;
+  const QueryFootprint* footprint;
+  std::atomic<std::uint64_t>* tested;
+
+  static bool hidden(const void* context, Vec3f center, float radius) {
+    const InstancePyramidTest& t = *static_cast<const InstancePyramidTest*>(context);
+    std::uint64_t tiles = 0;
+    const QueryBound bound{t.transform->apply(center), radius * t.transform->scale};
+    const bool visible = bound_may_be_visible(*t.pyramid, *t.camera, bound, *t.footprint, tiles);
+    *t.tested += tiles;
+    return !visible;
+  }
+  SubtreeOcclusion occlusion() const { return {&hidden, this}; }
+};
 
 // Moves a chunk selected in model space into the world: discs, and depth (model depth × scale).
 inline void to_world(const InstanceTransform& t, SplatChunk& chunk, bool with_discs) {
@@ -226,6 +248,7 @@ struct Renderer::ModelState {
   std::uint64_t model_bytes = 0;  // storage bytes of a paged model (open + every page)
   std::optional<render_detail::ModelCullTree> cull_tree;      // occlusion culling (QSplat)
   std::optional<render_detail::ModelCullTree> spt_cull_tree;  // occlusion culling (SPT)
+  std::optional<float> largest_leaf;  // largest_leaf_radius of the model's tree, once needed
 };
 
 

@@ -19,10 +19,6 @@
 
 namespace pointillist::render_detail {
 
-// Eye-space coordinates of a world direction: x right, y up, z toward the viewer.
-inline Vec3f to_eye(const CameraFrame& cam, Vec3f world_dir) {
-  return {dot(world_dir, cam.right), dot(world_dir, cam.up), -dot(world_dir, cam.forward)};
-}
 
 // round(255·c) for c clamped to [0, 1]; NaN gives 0. (std::max(0, c) is maxss: no branch.)
 inline std::uint8_t to_unorm8(float c) {

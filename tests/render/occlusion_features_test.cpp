@@ -11,9 +11,11 @@
 #include "render/features_render_support.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/pipeline/scene.hpp"
+#include "render_test_util.hpp"
 
 using namespace pointillist;
 using namespace features_test;
+using pointillist::render_test::same_bits;
 
 
 namespace {
@@ -71,12 +73,6 @@ std::vector<Shot> render_path(const FeatureScene& scene, const FrameSettings& fs
                    frame.stats.splats});
   }
   return out;
-}
-
-bool same_bits(const Shot& a, const Shot& b) {
-  return a.color.size() == b.color.size() && a.depth.size() == b.depth.size() &&
-         std::memcmp(a.color.data(), b.color.data(), a.color.size() * sizeof(Rgb8)) == 0 &&
-         std::memcmp(a.depth.data(), b.depth.data(), a.depth.size() * sizeof(float)) == 0;
 }
 
 }  // namespace

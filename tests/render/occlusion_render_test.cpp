@@ -117,12 +117,6 @@ std::vector<Image> render_path(const TestScene& scene, const RenderSettings& set
   return out;
 }
 
-bool same_bits(const Image& a, const Image& b) {
-  return a.color.size() == b.color.size() && a.depth.size() == b.depth.size() &&
-         std::memcmp(a.color.data(), b.color.data(), a.color.size() * sizeof(Rgb8)) == 0 &&
-         std::memcmp(a.depth.data(), b.depth.data(), a.depth.size() * sizeof(float)) == 0;
-}
-
 }  // namespace
 
 TEST(OcclusionRender, EveryMethodGivesTheImageOfNoCullingForEveryKernelThreadsAndLatency) {

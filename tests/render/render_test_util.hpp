@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <vector>
 
 #include "pointillist/core/camera.hpp"
@@ -103,6 +104,14 @@ inline std::vector<std::uint32_t> stream_nodes(const SplatStream& s) {
 
 inline bool covered(const Frame& f, int i, int j) {
   return std::isfinite(f.depth[static_cast<std::size_t>(j) * f.width + i]);
+}
+
+// Whether two captured frames (anything with `color` and `depth` vectors) are the same bits.
+template <class Shot>
+bool same_bits(const Shot& a, const Shot& b) {
+  return a.color.size() == b.color.size() && a.depth.size() == b.depth.size() &&
+         std::memcmp(a.color.data(), b.color.data(), a.color.size() * sizeof(a.color[0])) == 0 &&
+         std::memcmp(a.depth.data(), b.depth.data(), a.depth.size() * sizeof(a.depth[0])) == 0;
 }
 
 }  // namespace pointillist::render_test

@@ -70,6 +70,10 @@ struct CameraFrame {
   // What eye-space x and y are multiplied by, with focal_px, to give pixels at depth z: 1/z in
   // perspective, 1 orthographic.
   float projection(float z) const { return ortho ? 1.0f : 1.0f / z; }
+  // Eye-space coordinates of a world direction: x right, y up, z toward the viewer.
+  Vec3f eye_direction(Vec3f world_dir) const {
+    return {dot(world_dir, right), dot(world_dir, up), -dot(world_dir, forward)};
+  }
   // Unit vector from p towards the eye (the viewing rays' reverse).
   Vec3f to_eye(Vec3f p) const { return ortho ? -forward : normalized(eye - p); }
 };

@@ -109,6 +109,9 @@ bool sphere_tree_root_halves(std::uint64_t n);
 // more than 2^20.
 SphereTree build_top_tree(std::span<const SphereNode> roots, bool has_colors);
 
+// The largest radius of the hierarchy's leaves (0 without nodes).
+float largest_leaf_radius(const SphereTreeView& tree);
+
 // The leaves of a hierarchy as splats: positions = leaf centres, normals, radii and (when the
 // tree has them) colors, in node order. Lets another level-of-detail structure (e.g. a Sequential
 // Point Tree) be built from a model file that stores a sphere tree.

@@ -10,6 +10,7 @@
 // wall-clock time or the thread count.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <span>
@@ -159,8 +160,15 @@ class OcclusionQueries {
 // `draw` is told (`last`) that nothing will test what it draws.
 class SoftwareQueries final : public OcclusionQueries {
  public:
-  struct Rect {
+  struct Rect {  // pixels [x0, x1) × [y0, y1)
     int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+    bool empty() const { return x1 <= x0 || y1 <= y0; }
+    // Grows to hold `r` too (an empty `r` changes nothing).
+    void add(const Rect& r) {
+      if (r.empty()) return;
+      x0 = std::min(x0, r.x0), y0 = std::min(y0, r.y0);
+      x1 = std::max(x1, r.x1), y1 = std::max(y1, r.y1);
+    }
   };
   using Draw = std::function<Rect(std::span<const std::uint32_t> nodes, bool last)>;
   SoftwareQueries(DepthPyramid& pyramid, const CameraFrame& camera, QueryFootprint footprint,

@@ -121,14 +121,28 @@ SoftwareQueries::Rect draw_quality_occluders(const SplatStream& stream, std::siz
       }
     }
   });
-  for (const SoftwareQueries::Rect& r : scratch.band_rects) {
-    if (r.x1 <= r.x0 || r.y1 <= r.y0) continue;
-    out.x0 = std::min(out.x0, r.x0);
-    out.y0 = std::min(out.y0, r.y0);
-    out.x1 = std::max(out.x1, r.x1);
-    out.y1 = std::max(out.y1, r.y1);
-  }
+  for (const SoftwareQueries::Rect& r : scratch.band_rects) out.add(r);
   return out;
+}
+
+FeatureOccluderBound feature_occluder_bound(const QualitySettings& quality, float splat_scale,
+                                            float threshold_px, const CameraFrame& camera,
+                                            float leaf_radius) {
+  const float disc = quality.radius_scale * std::max(1.0f, splat_scale);
+  FeatureOccluderBound b;
+  b.active = true;
+  b.width_per_radius = disc * (quality.reconstruction == Reconstruction::ZRange
+                                   ? 2.0f + quality.z_range_margin
+                                   : quality.z_threshold);
+  b.leaf_radius = leaf_radius;
+  const float t = threshold_px, f = camera.focal_px;
+  if (camera.ortho) {
+    b.inner_radius = t / (2.0f * f);
+  } else {
+    b.radius_per_depth =
+        2.0f * f > t * disc ? t / (2.0f * f - t * disc) : std::numeric_limits<float>::infinity();
+  }
+  return b;
 }
 
 QueryFootprint quality_query_footprint(const QualitySettings& quality, float splat_scale) {

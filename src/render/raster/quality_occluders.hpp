@@ -39,6 +39,13 @@ struct FeatureOccluderBound {
   float inner_radius = 0;      // orthographic: an inner node drawn has r ≤ this
 };
 
+// The bound of a scene whose largest leaf radius (world units, instance scale included) is
+// `leaf_radius`, its inner nodes drawn by the QSplat traversal at `threshold_px` through
+// `camera`, with `quality`'s rule and disc scale and the splat scale.
+FeatureOccluderBound feature_occluder_bound(const QualitySettings& quality, float splat_scale,
+                                            float threshold_px, const CameraFrame& camera,
+                                            float leaf_radius);
+
 // Work buffers of the occluder pass, kept across batches and frames.
 struct OccluderScratch {
   std::vector<SoftwareQueries::Rect> band_rects;
