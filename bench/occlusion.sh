@@ -79,9 +79,10 @@ for p in wall:wall row:row field:field city:city-walk city:city-static city:city
   if [ "$path" = city-walk ]; then
     run "$scene" "$path" chc --occlusion chc
     run "$scene" "$path" stop-and-wait --occlusion stop-and-wait
-    for rule in batching multiqueries random tight; do
+    for rule in batching multiqueries split random tight; do
       run "$scene" "$path" "chc++-no-$rule" --occlusion chc++ --chc-off "$rule"
     done
+    run "$scene" "$path" chc++-fixed-requery --occlusion chc++ --chc-doublings 0
   fi
   if [ "$path" = city-turn ]; then
     run "$scene" "$path" chc++-no-random --occlusion chc++ --chc-off random

@@ -140,11 +140,18 @@ void add_occlusion(CLI::App* cmd, RenderOptions& o, RenderText& t) {
       ->default_val(5u)
       ->check(CLI::Range(0u, 100000u))
       ->group(kGroup);
+  cmd->add_option("--chc-doublings", oc.requery_doublings,
+                  "With --occlusion chc++: a visible leaf's re-query interval doubles after each "
+                  "query that finds it still visible, up to this many times (0: the paper's "
+                  "fixed interval)")
+      ->default_val(2u)
+      ->check(CLI::Range(0u, 16u))
+      ->group(kGroup);
   cmd->add_option("--chc-off", t.chc_off,
                   "With --occlusion chc++: switch rules off (to measure them): batching, "
-                  "multiqueries, random, tight")
+                  "multiqueries, split, random, tight")
       ->delimiter(',')
-      ->check(CLI::IsMember({"batching", "multiqueries", "random", "tight"}))
+      ->check(CLI::IsMember({"batching", "multiqueries", "split", "random", "tight"}))
       ->group(kGroup);
 }
 
@@ -227,11 +234,13 @@ std::vector<std::string> ignored_options(const CLI::App& cmd, const RenderOption
   const bool quality = o.frame.rasterizer == Rasterizer::Quality;
   if (o.frame.occlusion.method == OcclusionMethod::None) {
     for (const char* name : {"--query-latency", "--cull-leaf", "--chc-batch", "--chc-requery",
-                             "--chc-off"}) {
+                             "--chc-doublings", "--chc-off"}) {
       ignored(name, "it applies with --occlusion");
     }
   } else if (o.frame.occlusion.method != OcclusionMethod::ChcPlusPlus) {
-    for (const char* name : {"--chc-batch", "--chc-off"}) ignored(name, "it applies with --occlusion chc++");
+    for (const char* name : {"--chc-batch", "--chc-doublings", "--chc-off"}) {
+      ignored(name, "it applies with --occlusion chc++");
+    }
   }
   if (spt) ignored("--threshold", "it is the QSplat traversal's detail; --lod spt uses --epsilon");
   if (!spt) {
@@ -311,6 +320,7 @@ Command add_render_command(CLI::App& app) {
               OcclusionSettings& oc = o->frame.occlusion;
               (rule == "batching"       ? oc.batching
                : rule == "multiqueries" ? oc.multiqueries
+               : rule == "split"        ? oc.split_failed
                : rule == "random"       ? oc.randomized
                                         : oc.tight_bounds) = false;
             }

@@ -321,6 +321,7 @@ TEST(ChcRules, AFailedMultiqueryReissuesEachOfItsNodes) {
   Flat f(50);
   ScriptedQueries q;
   OcclusionSettings s = chcpp();
+  s.split_failed = false;  // the paper's rule
   for (int frame = 0; frame < 11; ++frame) f.frame(s, q);  // all hidden: i grows to 11
   q.visible = {5};
   const OcclusionStats st = f.frame(s, q);
@@ -338,6 +339,167 @@ TEST(ChcRules, AFailedMultiqueryReissuesEachOfItsNodes) {
   EXPECT_EQ(q.drawn, (std::vector<std::uint32_t>{5}));
 }
 
+TEST(ChcRules, AFailedMultiqueryOfLikelyHiddenNodesIsQueriedAgainInHalves) {
+  Flat f(50);
+  ScriptedQueries q;
+  OcclusionSettings s = chcpp();
+  for (int frame = 0; frame < 11; ++frame) f.frame(s, q);  // all hidden: i grows to 11
+  q.visible = {5};
+  const OcclusionStats st = f.frame(s, q);
+  // The first query holding node 5 is the failed group; every later query is a half of a
+  // failed one: the half holding 5 (which fails again) and its sibling (hidden), down to {5}.
+  std::size_t first = 0;
+  while (first < q.issued.size() &&
+         std::count(q.issued[first].nodes.begin(), q.issued[first].nodes.end(), 5u) == 0) {
+    ++first;
+  }
+  ASSERT_LT(first, q.issued.size());
+  std::vector<std::uint32_t> failed = q.issued[first].nodes;
+  ASSERT_GT(failed.size(), 2u);
+  // At pkeep ≈ 0.99 a failed group of four or more is halved; a group of three f fails is
+  // cheaper node by node (3·f queries against 2·f and then 2·(2f/3) for its failing pair).
+  std::vector<std::vector<std::uint32_t>> expected;
+  std::uint64_t failed_groups = 0;
+  while (failed.size() > 1) {
+    ++failed_groups;
+    if (failed.size() <= 3) {
+      for (std::uint32_t n : failed) expected.push_back({n});
+      break;
+    }
+    const std::size_t half = (failed.size() + 1) / 2;
+    std::vector<std::uint32_t> a(failed.begin(), failed.begin() + half);
+    std::vector<std::uint32_t> b(failed.begin() + half, failed.end());
+    expected.push_back(a);
+    expected.push_back(b);
+    failed = std::count(a.begin(), a.end(), 5u) ? a : b;
+  }
+  std::vector<std::vector<std::uint32_t>> later;
+  std::set<std::uint32_t> covered;
+  for (std::size_t k = 0; k < q.issued.size(); ++k) {
+    for (std::uint32_t n : q.issued[k].nodes) covered.insert(n);
+    if (k > first && q.issued[k].flushes_before >= q.issued[first].flushes_before) {
+      const auto& nodes = q.issued[k].nodes;
+      // Queries of the other first-round groups are not halves; skip them.
+      if (std::count(q.issued[first].nodes.begin(), q.issued[first].nodes.end(), nodes[0])) {
+        later.push_back(nodes);
+      }
+    }
+  }
+  EXPECT_EQ(later, expected);
+  EXPECT_EQ(st.multiquery_failed, failed_groups);
+  EXPECT_EQ(covered.size(), 50u);  // every node was in some query
+  EXPECT_EQ(q.drawn, (std::vector<std::uint32_t>{5}));
+  // Fewer queries than re-querying each node of the failed group.
+  EXPECT_LT(expected.size(), q.issued[first].nodes.size());
+}
+
+TEST(ChcCostModel, TheHalvingRulesCostIsTheExpectedNumberOfQueriesOfTheBestPlan) {
+  // Oracle: for every plan (each group of three or more in the halving tree either re-queries
+  // its nodes one by one or queries its halves when it fails), enumerate every outcome (each
+  // node stays hidden with its pkeep, independently), count the queries the plan makes, weight
+  // by the outcome's probability; the cost is the smallest expectation over the plans.
+  const auto best_plan = [](const std::vector<double>& keep) {
+    const std::size_t m = keep.size();
+    // The groups of three or more in the halving tree, in a fixed order.
+    std::vector<std::pair<std::size_t, std::size_t>> splittable;
+    std::vector<std::pair<std::size_t, std::size_t>> todo{{0, m}};
+    while (!todo.empty()) {
+      const auto [lo, hi] = todo.back();
+      todo.pop_back();
+      if (hi - lo < 3) continue;
+      splittable.push_back({lo, hi});
+      const std::size_t mid = lo + (hi - lo + 1) / 2;
+      todo.push_back({lo, mid});
+      todo.push_back({mid, hi});
+    }
+    double best = 1e300;
+    for (std::uint32_t plan = 0; plan < (1u << splittable.size()); ++plan) {
+      const auto halves = [&](std::size_t lo, std::size_t hi) {
+        for (std::size_t k = 0; k < splittable.size(); ++k) {
+          if (splittable[k] == std::pair{lo, hi}) return (plan >> k & 1) != 0;
+        }
+        return false;
+      };
+      double expected = 0;
+      for (std::uint32_t mask = 0; mask < (1u << m); ++mask) {  // bit set: turned visible
+        double p = 1;
+        for (std::size_t k = 0; k < m; ++k) p *= (mask >> k & 1) ? 1 - keep[k] : keep[k];
+        int queries = 0;
+        std::vector<std::pair<std::size_t, std::size_t>> q{{0, m}};
+        while (!q.empty()) {
+          const auto [lo, hi] = q.back();
+          q.pop_back();
+          ++queries;
+          bool visible = false;
+          for (std::size_t k = lo; k < hi; ++k) visible = visible || (mask >> k & 1);
+          if (!visible || hi - lo == 1) continue;
+          if (halves(lo, hi)) {
+            const std::size_t mid = lo + (hi - lo + 1) / 2;
+            q.push_back({lo, mid});
+            q.push_back({mid, hi});
+          } else {
+            for (std::size_t k = lo; k < hi; ++k) q.push_back({k, k + 1});
+          }
+        }
+        expected += p * queries;
+      }
+      best = std::min(best, expected);
+    }
+    return best;
+  };
+  std::uint64_t x = 7;
+  for (std::size_t m = 1; m <= 9; ++m) {
+    for (int trial = 0; trial < 3; ++trial) {
+      std::vector<double> keep(m);
+      for (double& k : keep) {
+        x = x * 6364136223846793005ull + 1442695040888963407ull;
+        k = (trial == 0 ? 0.3 : 0.9) + (trial == 0 ? 0.69 : 0.099) *
+                                           static_cast<double>(x >> 11) / 9007199254740992.0;
+      }
+      std::sort(keep.rbegin(), keep.rend());
+      EXPECT_NEAR(split_query_cost(keep), best_plan(keep), 1e-9) << m << " " << trial;
+    }
+  }
+  // Re-querying each node is one of the plans, so a group never costs more than the paper's
+  // C(M); likely-hidden groups are split, likely-visible ones are not; each group is the
+  // prefix of largest |M| / C(M).
+  for (const std::uint64_t i : {1u, 3u, 10u}) {
+    const std::vector<double> keep(50, keep_probability(i));
+    const std::span<const double> all(keep);
+    for (std::size_t size = 1; size <= 50; ++size) {
+      EXPECT_LE(split_query_cost(all.first(size)),
+                1.0 + (1.0 - std::pow(keep[0], double(size))) * double(size) + 1e-12);
+    }
+    const auto groups = multiquery_groups(keep, true);
+    for (std::size_t size = 1; size <= 50; ++size) {
+      EXPECT_GE(groups[0] / split_query_cost(all.first(groups[0])),
+                size / split_query_cost(all.first(size)) - 1e-12);
+    }
+  }
+  EXPECT_TRUE(split_failed_group(std::vector<double>(8, keep_probability(10))));
+  EXPECT_FALSE(split_failed_group(std::vector<double>(8, 0.3)));
+}
+
+TEST(ChcRules, AVisibleLeafsRequeryIntervalDoublesWhileItStaysVisible) {
+  Flat f(1);
+  ScriptedQueries q;
+  q.visible = {1};
+  OcclusionSettings s = chcpp();
+  s.requery_frames = 5;
+  s.requery_doublings = 2;
+  std::vector<std::uint64_t> queried;
+  for (std::uint64_t frame = 1; frame <= 70; ++frame) {
+    if (frame == 50) q.visible.clear();  // hidden from frame 50: found at its next query
+    f.frame(s, q);
+    if (!q.issued.empty()) queried.push_back(frame);
+  }
+  // Found visible at 1; re-queried n_av later (6), then at intervals 5, 10, 20, 20 (the cap,
+  // n_av · 2²); the query at 61 finds it hidden, and from then on it is queried every frame.
+  ASSERT_GE(queried.size(), 7u);
+  EXPECT_EQ(std::vector<std::uint64_t>(queried.begin(), queried.begin() + 7),
+            (std::vector<std::uint64_t>{1, 6, 11, 21, 41, 61, 62}));
+}
+
 TEST(ChcRules, VisibleLeavesAreRequeriedEveryNavFramesOrAfterARandomFirstOffset) {
   for (bool randomized : {false, true}) {
     std::set<std::uint64_t> first_offsets;
@@ -347,6 +509,7 @@ TEST(ChcRules, VisibleLeavesAreRequeriedEveryNavFramesOrAfterARandomFirstOffset)
       q.visible = {1};
       OcclusionSettings s = chcpp();
       s.requery_frames = 5;
+      s.requery_doublings = 0;  // the paper's fixed interval
       s.randomized = randomized;
       s.seed = seed;
       std::vector<std::uint64_t> queried;

@@ -47,8 +47,14 @@ struct OcclusionSettings {
   bool batching = true;      // R1: previously invisible nodes queried in batches of `batch`
   unsigned batch = 50;
   bool multiqueries = true;  // R4: batches grouped into multiqueries by the cost model
+  // R4, ours: a failed multiquery whose nodes are likely to stay hidden is queried again as its
+  // two halves (group testing) instead of node by node; the cost model counts that.
+  bool split_failed = true;
   bool randomized = true;    // R5: the first re-query of a node turned visible after r ∈ [0, n_av]
   unsigned requery_frames = 5;  // n_av: visible leaves are re-queried every n_av frames
+  // Ours: each re-query that finds a leaf still visible doubles its interval, up to
+  // n_av · 2^requery_doublings frames (0: every n_av frames, the paper's rule).
+  unsigned requery_doublings = 2;
   bool tight_bounds = true;  // R6: a node's query is its descendants' spheres, d_max levels down
   unsigned tight_depth = 3;  // d_max
   float tight_area_ratio = 1.4f;  // refinement stops when Σ r_child² > ratio · r²
@@ -203,8 +209,18 @@ double keep_probability(std::uint64_t frames_invisible);
 
 // R4's grouping of previously invisible nodes, given each one's pkeep already sorted in the
 // order they are grouped: the sizes of consecutive groups, each the longest prefix of what is
-// left along which V(M) = |M| / (1 + (1 − Π pkeep)·|M|) does not decrease.
-std::vector<std::size_t> multiquery_groups(std::span<const double> keep);
+// left along which V(M) = |M| / C(M) does not decrease, where C(M) = 1 + (1 − Π pkeep)·|M| is
+// the expected number of queries when a failed group re-queries each node (the paper's rule).
+// With `split`, a failed group may instead be queried again as its two halves (the first
+// ⌈|M|/2⌉ nodes and the rest), each half planned alike: C(M) is split_query_cost, and each
+// group is the prefix of largest V(M).
+std::vector<std::size_t> multiquery_groups(std::span<const double> keep, bool split = false);
+// The expected number of queries of a multiquery on nodes of these pkeep (in group order) under
+// its best plan for failure: re-query each node, or query both halves and plan each alike (a
+// query is made only when its parent group failed, so C = 1 + Σ over failed-group plans).
+double split_query_cost(std::span<const double> keep);
+// Whether that plan queries the halves of this group when it fails (else each node).
+bool split_failed_group(std::span<const double> keep);
 
 // The culling hierarchy a method traverses: nodes with a bounding sphere, children, and per frame
 // a classification from the caller (frustum, detail) and a distance for front-to-back order.
@@ -247,6 +263,7 @@ struct CullState {
     // persistence i = frame − hidden_since + 1; a node seen for the first time has i = 1).
     std::uint64_t hidden_since = 0;
     std::uint64_t next_query = 0;    // frame at which a visible leaf is queried again
+    std::uint8_t still_visible = 0;  // re-queries in a row that found the leaf visible
   };
   std::vector<Node> nodes;
   std::uint64_t frame = 0;

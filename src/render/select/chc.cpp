@@ -76,6 +76,7 @@ class Culler {
     QueryId id;
     std::vector<std::uint32_t> nodes;
     bool v_query;
+    std::vector<double> keep;  // a multiquery's pkeep per node (for the halving rule)
   };
 
   void push(std::uint32_t n) {
@@ -178,7 +179,7 @@ class Culler {
 
   void issue_single(std::uint32_t n, bool v_query) {
     if (v_query) ++stats_.v_queries;
-    pending_.push_back({issue(n), {n}, v_query});
+    pending_.push_back({issue(n), {n}, v_query, {}});
   }
 
   // R1 + R4: the batch of previously invisible nodes, grouped by their chance of staying hidden.
@@ -198,25 +199,29 @@ class Culler {
     keep_.clear();
     for (const auto& k : keyed_) keep_.push_back(k.first);
     std::size_t start = 0;
-    for (const std::size_t size : multiquery_groups(keep_)) {
-      if (size == 1) {
-        issue_single(keyed_[start].second, false);
-      } else {
-        Pending p{0, {}, false};
-        bounds_.clear();
-        for (std::size_t k = start; k < start + size; ++k) {
-          const std::uint32_t n = keyed_[k].second;
-          p.nodes.push_back(n);
-          add_bounds(n, bounds_);
-        }
-        ++stats_.queries_multi;
-        stats_.multiquery_nodes += size;
-        p.id = q_.issue(bounds_);
-        pending_.push_back(std::move(p));
-      }
+    group_.clear();
+    for (const auto& k : keyed_) group_.push_back(k.second);
+    for (const std::size_t size : multiquery_groups(keep_, s_.split_failed)) {
+      issue_group(std::span<const std::uint32_t>(group_).subspan(start, size),
+                  std::span<const double>(keep_).subspan(start, size));
       start += size;
     }
     i_queue_.clear();
+  }
+
+  // One query on previously invisible nodes: a single query, or a multiquery on several.
+  void issue_group(std::span<const std::uint32_t> nodes, std::span<const double> keep) {
+    if (nodes.size() == 1) {
+      issue_single(nodes[0], false);
+      return;
+    }
+    Pending p{0, {nodes.begin(), nodes.end()}, false, {keep.begin(), keep.end()}};
+    bounds_.clear();
+    for (const std::uint32_t n : nodes) add_bounds(n, bounds_);
+    ++stats_.queries_multi;
+    stats_.multiquery_nodes += nodes.size();
+    p.id = q_.issue(bounds_);
+    pending_.push_back(std::move(p));
   }
 
   void handle_front() {
@@ -230,8 +235,16 @@ class Culler {
       return;
     }
     if (p.nodes.size() > 1) {
-      ++stats_.multiquery_failed;  // one query per node
-      for (const std::uint32_t n : p.nodes) issue_single(n, false);
+      ++stats_.multiquery_failed;
+      if (s_.split_failed && split_failed_group(p.keep)) {  // its two halves
+        const std::span<const std::uint32_t> nodes(p.nodes);
+        const std::span<const double> keep(p.keep);
+        const std::size_t half = (nodes.size() + 1) / 2;
+        issue_group(nodes.first(half), keep.first(half));
+        issue_group(nodes.subspan(half), keep.subspan(half));
+      } else {  // one query per node
+        for (const std::uint32_t n : p.nodes) issue_single(n, false);
+      }
       return;
     }
     const std::uint32_t n = p.nodes[0];
@@ -241,8 +254,14 @@ class Culler {
       s.next_query = f_ + (s_.randomized && s_.method == OcclusionMethod::ChcPlusPlus
                                ? random_offset(s_.seed, n, f_, s_.requery_frames)
                                : s_.requery_frames);
+      s.still_visible = 0;
     } else {
-      s.next_query = f_ + s_.requery_frames;
+      const unsigned doublings =
+          s_.method == OcclusionMethod::ChcPlusPlus
+              ? std::min<unsigned>(s.still_visible, s_.requery_doublings)
+              : 0;
+      s.next_query = f_ + (static_cast<std::uint64_t>(s_.requery_frames) << doublings);
+      if (s.still_visible < 255) ++s.still_visible;
     }
     pull_up(n);
   }
@@ -263,6 +282,7 @@ class Culler {
   std::vector<QueryBound> bounds_;
   std::vector<std::pair<double, std::uint32_t>> keyed_;
   std::vector<double> keep_;
+  std::vector<std::uint32_t> group_;
 };
 
 }  // namespace

@@ -204,21 +204,62 @@ double keep_probability(std::uint64_t frames_invisible) {
   return 0.99 - 0.7 * std::exp(-static_cast<double>(frames_invisible));
 }
 
-std::vector<std::size_t> multiquery_groups(std::span<const double> keep) {
+namespace {
+
+double failure_probability(std::span<const double> keep) {
+  double product = 1.0;
+  for (const double p : keep) product *= p;
+  return 1.0 - product;
+}
+
+// Expected queries after the first of a group under its best plan (each query is made only when
+// its parent group failed, so the terms add up without conditioning): re-query each node, or
+// query both halves and plan each of them alike.
+double extra_queries(std::span<const double> keep) {
+  if (keep.size() < 2) return 0.0;
+  const double fail = failure_probability(keep);
+  const std::size_t half = (keep.size() + 1) / 2;
+  const double each = fail * static_cast<double>(keep.size());
+  const double halves =
+      2.0 * fail + extra_queries(keep.first(half)) + extra_queries(keep.subspan(half));
+  return std::min(each, halves);
+}
+
+}  // namespace
+
+double split_query_cost(std::span<const double> keep) { return 1.0 + extra_queries(keep); }
+
+bool split_failed_group(std::span<const double> keep) {
+  if (keep.size() < 3) return false;  // two singles either way
+  const std::size_t half = (keep.size() + 1) / 2;
+  return 2.0 + (extra_queries(keep.first(half)) + extra_queries(keep.subspan(half))) /
+                   failure_probability(keep) <
+         static_cast<double>(keep.size());
+}
+
+std::vector<std::size_t> multiquery_groups(std::span<const double> keep, bool split) {
   std::vector<std::size_t> groups;
   std::size_t start = 0;
   while (start < keep.size()) {
-    double product = keep[start];
-    const auto value = [](double size, double p) { return size / (1.0 + (1.0 - p) * size); };
-    double best = value(1.0, product);
     std::size_t m = 1;
-    while (start + m < keep.size()) {
-      const double p = product * keep[start + m];
-      const double v = value(static_cast<double>(m + 1), p);
-      if (v < best) break;
-      best = v;
-      product = p;
-      ++m;
+    if (split) {
+      double best = 1.0;  // V of one node
+      for (std::size_t size = 2; start + size <= keep.size(); ++size) {
+        const double v = static_cast<double>(size) / split_query_cost(keep.subspan(start, size));
+        if (v >= best) best = v, m = size;
+      }
+    } else {
+      double product = keep[start];
+      const auto value = [](double size, double p) { return size / (1.0 + (1.0 - p) * size); };
+      double best = value(1.0, product);
+      while (start + m < keep.size()) {
+        const double p = product * keep[start + m];
+        const double v = value(static_cast<double>(m + 1), p);
+        if (v < best) break;
+        best = v;
+        product = p;
+        ++m;
+      }
     }
     groups.push_back(m);
     start += m;
