@@ -10,6 +10,9 @@
 #   bash bench/occlusion.sh [--stride N] [--size WxH] [--markdown]
 #
 #   --stride N   render every Nth frame of each path (default 3; 1 = the spec's full paths)
+#   --no-economy skip the query economy on the full paths (spec §1.8 checks 4 and 5: the city
+#                walk, static view and turn at every frame, CHC against CHC++ and its own rules;
+#                about 4 minutes)
 #   --size WxH   image size (default 1280x720)
 #   POINTILLIST_BIN   the binary (default build/release/pointillist)
 #   POINTILLIST_MODELS  the model cache (default ~/.cache/pointillist/models; make models)
@@ -25,11 +28,13 @@ models="${POINTILLIST_MODELS:-${XDG_CACHE_HOME:-$HOME/.cache}/pointillist/models
 stride=3
 size=1280x720
 markdown=0
+economy=1
 while [ $# -gt 0 ]; do
   case $1 in
     --stride) stride=$2; shift 2 ;;
     --size) size=$2; shift 2 ;;
     --markdown) markdown=1; shift ;;
+    --no-economy) economy=0; shift ;;
     *) echo "bench/occlusion.sh: unknown option $1" >&2; exit 2 ;;
   esac
 done
@@ -139,3 +144,42 @@ else:
     for r in rows:
         print("\t".join(str(x) for x in r))
 EOF
+
+[ "$economy" = 1 ] || exit 0
+# Query economy on the full paths (every frame; only the statistics are kept).
+echo "== query economy (full paths)"
+econ="$work/economy.tsv"
+: > "$econ"
+for spec in "city-walk|chc|--occlusion chc" "city-walk|chc++|--occlusion chc++" \
+            "city-walk|chc++ without split|--occlusion chc++ --chc-off split" \
+            "city-walk|chc++ fixed re-query|--occlusion chc++ --chc-doublings 0" \
+            "city-static|chc|--occlusion chc" "city-static|chc++|--occlusion chc++" \
+            "city-turn|chc++|--occlusion chc++" \
+            "city-turn|chc++ without R5|--occlusion chc++ --chc-off random"; do
+  IFS='|' read -r path label args <<< "$spec"
+  out="$work/econ-$path-${label// /_}.json"
+  # shellcheck disable=SC2086
+  "$bin" render "$work/city/city.json" --path "$work/city/$path.path" --size "$size" \
+    -o "$work/econ.png" --stats "$out" --quiet $args
+  printf '%s\t%s\t%s\n' "$path" "$label" "$out" >> "$econ"
+done
+python3 - "$econ" <<'EOF2'
+import json, statistics as st, sys
+print("| path | method | frames | queries / frame (median) | single | multi | v | failed multi | culling nodes visited | queries / nodes visited | max v-queries | sd of ms |")
+print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+for line in open(sys.argv[1]):
+    path, label, f = line.rstrip("\n").split("\t")
+    frames = json.load(open(f))["frames"]
+    # Check 4 counts the static view after frame 10; the others skip the first frame.
+    body = frames[10:] if path == "city-static" else frames[1:]
+    o = [x["occlusion"] for x in body]
+    q = [x["queries_single"] + x["queries_multi"] + x["v_queries"] for x in o]
+    visited = st.median(x["culling_nodes_visited"] for x in o)
+    print(f"| {path} | {label} | {len(frames)} | {st.median(q):.0f} | "
+          f"{st.median(x['queries_single'] for x in o):.0f} | "
+          f"{st.median(x['queries_multi'] for x in o):.0f} | "
+          f"{st.median(x['v_queries'] for x in o):.0f} | "
+          f"{st.median(x['multiquery_failed'] for x in o):.0f} | {visited:.0f} | "
+          f"{st.median(q) / visited:.3f} | {max(x['v_queries'] for x in o)} | "
+          f"{st.pstdev(x['ms'] for x in body):.1f} |")
+EOF2

@@ -10,8 +10,8 @@ MergedInputs::MergedInputs(std::span<const std::string> paths, const std::string
     streams_.push_back(open_point_stream(path, {.columns = columns}));
     const PointStreamInfo& info = streams_.back()->info();
     if (info.is_mesh) {
-      throw Error(path + ": is a mesh; meshes are converted in one piece (give a larger "
-                         "--memory, or convert its vertices as points)");
+      throw Error(path + ": is a mesh, which chunks cannot read (convert_chunked turns meshes "
+                         "into points first); this is a bug");
     }
     count_ += info.point_count;
     normals_ = normals_ && info.has_normals;

@@ -39,6 +39,8 @@
 #include "chunked.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/format/ptl_v2.hpp"
+#include "pointillist/io/ply.hpp"
+#include "pointillist/io/point_file.hpp"
 #include "pointillist/io/point_stream.hpp"
 #include "pointillist/lod/sphere_tree.hpp"
 #include "pointillist/pipeline/chunk_jobs.hpp"
@@ -48,6 +50,44 @@ namespace pointillist::chunking {
 namespace {
 
 std::string relations_kind(int rank) { return "relations" + std::to_string(rank); }
+
+// A mesh's vertices as a point file in the work folder, with the normals and radii its faces
+// give (prepare_mesh_vertices): the chunks hold points only. The mesh is read whole, so it must
+// fit the budget at about kMeshBytesPerVertex; other inputs pass through.
+std::vector<std::string> meshes_as_points(std::span<const std::string> inputs,
+                                          const WorkFolder& folder, const ConvertOptions& o,
+                                          std::uint64_t budget, ThreadPool& pool,
+                                          Progress& progress, std::vector<std::string>& warnings) {
+  std::vector<std::string> out(inputs.begin(), inputs.end());
+  for (std::size_t k = 0; k < inputs.size(); ++k) {
+    const std::string& path = inputs[k];
+    {
+      const auto stream = open_point_stream(path, {.columns = o.columns});
+      if (!stream->info().is_mesh) continue;
+      const std::uint64_t need = stream->info().point_count * kMeshBytesPerVertex;
+      if (need > budget) {
+        throw Error(path + ": a mesh of " + std::to_string(stream->info().point_count) +
+                    " vertices needs about " + std::to_string(need / 1'000'000) +
+                    " MB to find its normals and radii from its faces, over the memory budget of " +
+                    std::to_string(budget / 1'000'000) + " MB; raise --memory (meshes are read "
+                    "whole; their points are then converted in chunks)");
+      }
+    }
+    if (o.keep_faces) {
+      warnings.push_back(path + ": its faces are not kept (a mesh converted in chunks keeps "
+                         "points; render --hybrid needs them: convert in one piece, with a "
+                         "larger --memory)");
+    }
+    progress.detail(path);
+    PointSet mesh = read_point_file(path, progress, {.columns = o.columns});
+    PrepareOptions prepare = o.prepare;
+    prepare.input_name = path;
+    prepare_mesh_vertices(mesh, pool, progress, prepare);
+    out[k] = folder.file("mesh" + std::to_string(k) + ".ply");
+    write_ply(out[k], mesh);
+  }
+  return out;
+}
 
 }  // namespace
 
@@ -72,14 +112,16 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
   std::uint64_t input_points = 0;
   step(jobs, [&] {
     if (!root) return;
-    in.emplace(inputs, o.columns);
+    folder.emplace(output);
+    const std::vector<std::string> sources =
+        meshes_as_points(inputs, *folder, o, budget, pool, outer_progress, result.warnings);
+    in.emplace(sources, o.columns);
     input_points = in->count();
     sh.colors = in->has_colors();
     overall.emplace(outer_progress, input_points,
                     o.prepare.drop_outliers ? kOutlierPassShare : 0.0);
     progress_ptr = &*overall;
     if (const auto warning = in->colour_warning()) result.warnings.push_back(*warning);
-    folder.emplace(output);
   });
   if (!root) folder.emplace(output, WorkFolder::kJoin);
   if (o.prepare.drop_outliers) {

@@ -178,4 +178,39 @@ void prepare_splats(PointSet& points, ThreadPool& pool, Progress& progress,
   phase.advance(n);
 }
 
+void prepare_mesh_vertices(PointSet& mesh, ThreadPool& pool, Progress& progress,
+                           const PrepareOptions& options) {
+  check_options(options);
+  const std::string& name = options.input_name;
+  check_points(mesh, name);
+  if (!mesh.is_mesh()) return;
+  if (options.drop_outliers) {
+    throw OptionError(name + " is a mesh: outlier removal applies to point clouds (a mesh's "
+                      "faces define its surface; drop the option)");
+  }
+  drop_unreferenced_vertices(mesh);
+  const NormalSource source = options.normals;
+  if (source == NormalSource::Keep && !mesh.has_normals()) {
+    throw Error("--normals keep: " + name +
+                " has no normals (no nx/ny/nz vertex properties); use --normals auto or pca");
+  }
+  {
+    ProgressPhase phase(progress, "normals", mesh.size());
+    if (source == NormalSource::Pca) {
+      mesh.normals.clear();
+    } else if (source == NormalSource::Mesh ||
+               (source == NormalSource::Auto && !mesh.has_normals())) {
+      mesh.normals = mesh_vertex_normals(mesh.positions, mesh.triangles, pool);
+    }
+    phase.advance(mesh.size());
+  }
+  if (!mesh.has_radii()) {
+    ProgressPhase phase(progress, "radii", mesh.size());
+    mesh.radii = mesh_radii(mesh.positions, mesh.triangles, 1.0f, pool);
+    phase.advance(mesh.size());
+  }
+  mesh.triangles.clear();
+  mesh.triangles.shrink_to_fit();
+}
+
 }  // namespace pointillist

@@ -320,6 +320,105 @@ TEST(ChunkedConvert, DropsTheOutliersTheConversionInOnePieceDrops) {
   }
 }
 
+// A torus as a triangle mesh of rows × columns vertices (a closed grid), with colours.
+PointSet torus_mesh(std::uint32_t rows, std::uint32_t columns) {
+  PointSet m;
+  for (std::uint32_t i = 0; i < rows; ++i) {
+    const float u = 2.0f * kPi * float(i) / float(rows);
+    for (std::uint32_t j = 0; j < columns; ++j) {
+      const float v = 2.0f * kPi * float(j) / float(columns);
+      const float r = 1.0f + 0.35f * std::cos(v);
+      m.positions.push_back({r * std::cos(u), 0.35f * std::sin(v), r * std::sin(u)});
+      m.colors.push_back({std::uint8_t(40 + i % 200), std::uint8_t(90 + j % 150), 160});
+    }
+  }
+  const auto at = [&](std::uint32_t i, std::uint32_t j) {
+    return (i % rows) * columns + (j % columns);
+  };
+  for (std::uint32_t i = 0; i < rows; ++i) {
+    for (std::uint32_t j = 0; j < columns; ++j) {
+      m.triangles.push_back({at(i, j), at(i, j + 1), at(i + 1, j)});
+      m.triangles.push_back({at(i + 1, j), at(i, j + 1), at(i + 1, j + 1)});
+    }
+  }
+  return m;
+}
+
+TEST(ChunkedConvert, AMeshInManySmallChunksGivesTheOnePieceModel) {
+  TempDir dir;
+  PointSet mesh = torus_mesh(240, 120);
+  mesh.positions.push_back({5, 5, 5});  // used by no face: dropped, as in one piece
+  mesh.colors.push_back({255, 0, 0});
+  const std::string input = dir.file("torus.ply");
+  write_ply(input, mesh);
+  const Converted c = convert_both(dir, input, {.chunk_points = 2000});
+  EXPECT_GE(c.parts_result.chunks, 8u);
+  EXPECT_EQ(c.parts_result.output_points, 240u * 120u);
+  ASSERT_EQ(c.parts.leaf_count, c.whole.leaf_count);
+  ASSERT_EQ(c.parts.nodes.size(), c.whole.nodes.size());
+  // Normals and radii come from the faces as in one piece (the normals normalized once more);
+  // the chunks are subtrees of the one-piece hierarchy.
+  double worst_deg = 0;
+  for (std::size_t i = 0; i < c.whole.nodes.size(); ++i) {
+    const SphereNode& a = c.whole.nodes[i];
+    const SphereNode& b = c.parts.nodes[i];
+    EXPECT_EQ(a.radius, b.radius) << i;
+    EXPECT_EQ(std::memcmp(&a.center, &b.center, sizeof a.center), 0) << i;
+    if (a.child_count == 0) {
+      worst_deg = std::max(worst_deg, std::acos(std::clamp(double(dot(a.normal, b.normal)),
+                                                           -1.0, 1.0)) * 180.0 / kPi);
+    }
+  }
+  EXPECT_LT(worst_deg, 1.0);
+  std::printf("[chunked mesh] %zu chunks, %zu of %zu nodes differ, worst leaf normal %.4f deg\n",
+              c.parts_result.chunks, differing_nodes(c), c.whole.nodes.size(), worst_deg);
+  ThreadPool pool(2);
+  for (const float az : {0.0f, 120.0f, 240.0f}) {
+    const Camera cam = orbit_camera(c.whole.view_sphere,
+                                    {.azimuth_deg = az, .elevation_deg = 25, .width = 400,
+                                     .height = 300});
+    Frame fa, fb;
+    render(c.whole.view(), cam, {}, pool, fa);
+    render(c.parts.view(), cam, {}, pool, fb);
+    EXPECT_GE(psnr_rgb({fa.width, fa.height, fa.color}, {fb.width, fb.height, fb.color}), 40.0)
+        << "azimuth " << az;
+    EXPECT_NEAR(double(fb.stats.splats), double(fa.stats.splats), 0.01 * double(fa.stats.splats));
+  }
+  // The faces are not kept, and the result says so.
+  ASSERT_FALSE(c.parts_result.warnings.empty());
+  EXPECT_NE(c.parts_result.warnings[0].find("faces are not kept"), std::string::npos);
+}
+
+TEST(ChunkedConvert, AMeshTooLargeOrBrokenStopsWithoutLeavingAnything) {
+  TempDir dir;
+  PointSet mesh = torus_mesh(60, 40);
+  const std::string input = dir.file("torus.ply");
+  write_ply(input, mesh);
+  ThreadPool pool(1);
+  const std::vector<std::string> inputs{input};
+  // A budget under what reading the mesh whole takes (about 64 bytes a vertex).
+  try {
+    convert(inputs, dir.file("a.ptl"), {.memory_budget = 60 * 40 * 30}, pool, Progress::none());
+    FAIL() << "a mesh over the budget was converted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("--memory"), std::string::npos) << e.what();
+  }
+  // A face naming a vertex that is not there (written by hand: write_ply refuses it).
+  {
+    std::ofstream f(input, std::ios::binary | std::ios::trunc);
+    f << "ply\nformat ascii 1.0\nelement vertex " << mesh.size()
+      << "\nproperty float x\nproperty float y\nproperty float z\nelement face "
+      << mesh.triangles.size() + 1 << "\nproperty list uchar int vertex_indices\nend_header\n";
+    for (const Vec3f& p : mesh.positions) f << p.x << " " << p.y << " " << p.z << "\n";
+    for (const auto& t : mesh.triangles) f << "3 " << t[0] << " " << t[1] << " " << t[2] << "\n";
+    f << "3 0 1 99999\n";
+  }
+  EXPECT_THROW(convert(inputs, dir.file("a.ptl"), {.chunk_points = 500}, pool, Progress::none()),
+               Error);
+  EXPECT_FALSE(std::filesystem::exists(dir.file("a.ptl")));
+  EXPECT_FALSE(std::filesystem::exists(dir.file("a.ptl.chunks")));
+}
+
 TEST(ChunkedConvert, SaysWhatItCannotDoYet) {
   TempDir dir;
   const std::string input = write_cloud(dir, 4000, "scene.ply");

@@ -64,4 +64,15 @@ struct PrepareOptions {
 void prepare_splats(PointSet& points, ThreadPool& pool, Progress& progress,
                     const PrepareOptions& options = {});
 
+// The part of prepare_splats that needs a mesh's faces, for a mesh converted in chunks (whose
+// chunks hold points only): checks the mesh and drops its unused vertices as prepare_splats
+// does, fills normals (the file's with Keep or Auto when it has them, the faces' with Mesh or
+// Auto; left empty with Pca, which the chunks compute) and radii (the file's when present, else
+// mesh_radii with scale 1: the chunks apply radius_scale), then drops the faces. The result,
+// prepared again by prepare_splats with the same options, has the normals and radii the mesh
+// would get in one piece (the normals up to a second normalization). Throws as prepare_splats
+// (OptionError for drop_outliers on a mesh).
+void prepare_mesh_vertices(PointSet& mesh, ThreadPool& pool, Progress& progress,
+                           const PrepareOptions& options = {});
+
 }  // namespace pointillist
