@@ -66,6 +66,22 @@ std::size_t differing_nodes(const Converted& c) {
   return differing;
 }
 
+// The renders at three views: at least 40 dB apart, splat counts within 1%.
+void expect_renders_alike(const Converted& c) {
+  ThreadPool pool(2);
+  for (const float az : {0.0f, 120.0f, 240.0f}) {
+    const Camera cam = orbit_camera(c.whole.view_sphere,
+                                    {.azimuth_deg = az, .elevation_deg = 25, .width = 400,
+                                     .height = 300});
+    Frame fa, fb;
+    render(c.whole.view(), cam, {}, pool, fa);
+    render(c.parts.view(), cam, {}, pool, fb);
+    EXPECT_GE(psnr_rgb({fa.width, fa.height, fa.color}, {fb.width, fb.height, fb.color}), 40.0)
+        << "azimuth " << az;
+    EXPECT_NEAR(double(fb.stats.splats), double(fa.stats.splats), 0.01 * double(fa.stats.splats));
+  }
+}
+
 TEST(ChunkedConvert, ManySmallChunksGiveTheOnePieceHierarchy) {
   TempDir dir;
   const std::string input = write_cloud(dir, 60000, "scene.ply");
@@ -97,19 +113,7 @@ TEST(ChunkedConvert, ManySmallChunksGiveTheOnePieceHierarchy) {
   // nodes, bit for bit.
   EXPECT_EQ(differing, 0u);
   EXPECT_EQ(normals_apart, 0u);
-  // The renders at three views.
-  ThreadPool pool(2);
-  for (const float az : {0.0f, 120.0f, 240.0f}) {
-    const Camera cam = orbit_camera(c.whole.view_sphere,
-                                    {.azimuth_deg = az, .elevation_deg = 25, .width = 400,
-                                     .height = 300});
-    Frame fa, fb;
-    render(c.whole.view(), cam, {}, pool, fa);
-    render(c.parts.view(), cam, {}, pool, fb);
-    EXPECT_GE(psnr_rgb({fa.width, fa.height, fa.color}, {fb.width, fb.height, fb.color}), 40.0)
-        << "azimuth " << az;
-    EXPECT_NEAR(double(fb.stats.splats), double(fa.stats.splats), 0.01 * double(fa.stats.splats));
-  }
+  expect_renders_alike(c);
 }
 
 // A budget too small for the plan's positions: the plan works from a file of them (radix
@@ -372,18 +376,7 @@ TEST(ChunkedConvert, AMeshInManySmallChunksGivesTheOnePieceModel) {
   EXPECT_LT(worst_deg, 1.0);
   std::printf("[chunked mesh] %zu chunks, %zu of %zu nodes differ, worst leaf normal %.4f deg\n",
               c.parts_result.chunks, differing_nodes(c), c.whole.nodes.size(), worst_deg);
-  ThreadPool pool(2);
-  for (const float az : {0.0f, 120.0f, 240.0f}) {
-    const Camera cam = orbit_camera(c.whole.view_sphere,
-                                    {.azimuth_deg = az, .elevation_deg = 25, .width = 400,
-                                     .height = 300});
-    Frame fa, fb;
-    render(c.whole.view(), cam, {}, pool, fa);
-    render(c.parts.view(), cam, {}, pool, fb);
-    EXPECT_GE(psnr_rgb({fa.width, fa.height, fa.color}, {fb.width, fb.height, fb.color}), 40.0)
-        << "azimuth " << az;
-    EXPECT_NEAR(double(fb.stats.splats), double(fa.stats.splats), 0.01 * double(fa.stats.splats));
-  }
+  expect_renders_alike(c);
   // The faces are not kept, and the result says so.
   ASSERT_FALSE(c.parts_result.warnings.empty());
   EXPECT_NE(c.parts_result.warnings[0].find("faces are not kept"), std::string::npos);
