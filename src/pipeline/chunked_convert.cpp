@@ -64,7 +64,10 @@ std::vector<std::string> meshes_as_points(std::span<const std::string> inputs,
     {
       const auto stream = open_point_stream(path, {.columns = o.columns});
       if (!stream->info().is_mesh) continue;
-      const std::uint64_t need = stream->info().point_count * kMeshBytesPerVertex;
+      // The arrays, and the file's bytes (mapped, or for gzip decompressed: deflate mostly
+      // shrinks a binary mesh to a quarter or more).
+      const std::uint64_t need = stream->info().point_count * kMeshBytesPerVertex +
+                                 stream->info().file_size * (path.ends_with(".gz") ? 4 : 1);
       if (need > budget) {
         throw Error(path + ": a mesh of " + std::to_string(stream->info().point_count) +
                     " vertices needs about " + std::to_string(need / 1'000'000) +

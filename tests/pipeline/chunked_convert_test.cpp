@@ -389,7 +389,7 @@ TEST(ChunkedConvert, AMeshTooLargeOrBrokenStopsWithoutLeavingAnything) {
   write_ply(input, mesh);
   ThreadPool pool(1);
   const std::vector<std::string> inputs{input};
-  // A budget under what reading the mesh whole takes (about 64 bytes a vertex).
+  // A budget under what reading the mesh whole takes (about 56 bytes a vertex and the file).
   try {
     convert(inputs, dir.file("a.ptl"), {.memory_budget = 60 * 40 * 30}, pool, Progress::none());
     FAIL() << "a mesh over the budget was converted";
