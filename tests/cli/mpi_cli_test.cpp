@@ -16,6 +16,7 @@
 #include "pointillist/pipeline/chunk_jobs.hpp"
 #include "pointillist/scene/analytic.hpp"
 #include "testing/testing.hpp"
+#include "testing/torus_mesh.hpp"
 
 namespace pointillist {
 namespace {
@@ -69,6 +70,26 @@ TEST(MpiConvert, TwoRanksWriteTheBytesOfOneProcess) {
   const std::string bytes_one = file_bytes(one), bytes_two = file_bytes(two);
   ASSERT_GT(bytes_one.size(), 1000u);
   EXPECT_TRUE(bytes_one == bytes_two) << "the files differ";
+  EXPECT_FALSE(std::filesystem::exists(two + ".chunks"));
+}
+
+TEST(MpiConvert, TwoRanksConvertAMeshToTheBytesOfOneProcess) {
+  // Rank 0 turns the mesh into points in the chunk folder; both ranks prepare chunks.
+  if (skip_without_mpi()) GTEST_SKIP() << "this build has no MPI, or mpirun is not installed";
+  TempDir dir;
+  const std::string mesh = dir.file("torus.ply");
+  write_ply(mesh, testing::torus_mesh(120, 60));
+  const std::string one = dir.file("one.ptl"), two = dir.file("two.ptl");
+  const CliResult a =
+      testing::run_cli("convert " + mesh + " -o " + one + " --chunk-points 1000 --threads 2");
+  ASSERT_EQ(a.exit_code, 0) << a.output;
+  const CliResult b = mpirun2("convert " + mesh + " -o " + two + " --chunk-points 1000 --threads 1");
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  EXPECT_THAT(b.output, HasSubstr("on 2 MPI ranks"));
+  EXPECT_THAT(b.output, HasSubstr("faces are not kept"));
+  const std::string bytes_one = file_bytes(one);
+  ASSERT_GT(bytes_one.size(), 1000u);
+  EXPECT_TRUE(bytes_one == file_bytes(two)) << "the files differ";
   EXPECT_FALSE(std::filesystem::exists(two + ".chunks"));
 }
 

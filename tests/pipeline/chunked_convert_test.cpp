@@ -20,11 +20,13 @@
 #include "io/io_test_support.hpp"
 #include "io/las_builder.hpp"
 #include "testing/testing.hpp"
+#include "testing/torus_mesh.hpp"
 
 namespace pointillist {
 namespace {
 
 using testing::TempDir;
+using testing::torus_mesh;
 
 // The demo scene (sphere, torus, cube) sampled without normals or radii, with smooth colours.
 std::string write_cloud(const TempDir& dir, std::size_t count, const std::string& name) {
@@ -322,30 +324,6 @@ TEST(ChunkedConvert, DropsTheOutliersTheConversionInOnePieceDrops) {
         << "azimuth " << az;
     EXPECT_NEAR(double(fb.stats.splats), double(fa.stats.splats), 0.01 * double(fa.stats.splats));
   }
-}
-
-// A torus as a triangle mesh of rows × columns vertices (a closed grid), with colours.
-PointSet torus_mesh(std::uint32_t rows, std::uint32_t columns) {
-  PointSet m;
-  for (std::uint32_t i = 0; i < rows; ++i) {
-    const float u = 2.0f * kPi * float(i) / float(rows);
-    for (std::uint32_t j = 0; j < columns; ++j) {
-      const float v = 2.0f * kPi * float(j) / float(columns);
-      const float r = 1.0f + 0.35f * std::cos(v);
-      m.positions.push_back({r * std::cos(u), 0.35f * std::sin(v), r * std::sin(u)});
-      m.colors.push_back({std::uint8_t(40 + i % 200), std::uint8_t(90 + j % 150), 160});
-    }
-  }
-  const auto at = [&](std::uint32_t i, std::uint32_t j) {
-    return (i % rows) * columns + (j % columns);
-  };
-  for (std::uint32_t i = 0; i < rows; ++i) {
-    for (std::uint32_t j = 0; j < columns; ++j) {
-      m.triangles.push_back({at(i, j), at(i, j + 1), at(i + 1, j)});
-      m.triangles.push_back({at(i + 1, j), at(i, j + 1), at(i + 1, j + 1)});
-    }
-  }
-  return m;
 }
 
 TEST(ChunkedConvert, AMeshInManySmallChunksGivesTheOnePieceModel) {
