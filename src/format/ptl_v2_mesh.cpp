@@ -14,6 +14,7 @@
 
 #include "ptl_v2_layout.hpp"
 #include "pointillist/core/error.hpp"
+#include "pointillist/core/thread_pool.hpp"
 
 namespace pointillist::ptl2 {
 namespace {
@@ -40,7 +41,8 @@ void put_varint(std::vector<std::uint8_t>& out, std::int64_t delta) {
 
 std::vector<std::uint8_t> encode_mesh(std::span<const SphereNode> nodes,
                                       std::span<const std::array<std::uint32_t, 3>> triangles,
-                                      std::span<const std::span<const std::uint32_t>> pages) {
+                                      std::span<const std::span<const std::uint32_t>> pages,
+                                      ThreadPool& pool) {
   // The page of every leaf.
   std::vector<std::uint32_t> leaf_of_node(nodes.size(), 0);
   std::uint32_t leaves = 0;
@@ -67,32 +69,40 @@ std::vector<std::uint8_t> encode_mesh(std::span<const SphereNode> nodes,
       keyed[next[page_of_leaf[triangles[t][0]]]++] = {triangles[t][0], t};
     }
   }
-  for (std::size_t p = 0; p < pages.size(); ++p) {
-    std::sort(keyed.begin() + page_begin[p], keyed.begin() + page_begin[p + 1]);
-  }
+  // Each page's block sorted and encoded on its own (the same bytes for any thread count).
+  std::vector<std::vector<std::uint8_t>> blocks(pages.size());
+  pool.run(pages.size(), [&](std::size_t p) {
+    const auto first = keyed.begin() + std::ptrdiff_t(page_begin[p]);
+    const auto last = keyed.begin() + std::ptrdiff_t(page_begin[p + 1]);
+    std::sort(first, last);
+    std::vector<std::uint8_t>& block = blocks[p];
+    block.reserve(6 * std::size_t(last - first));
+    std::int64_t previous = 0;
+    for (auto it = first; it != last; ++it) {
+      const auto& t = triangles[it->second];
+      const std::int64_t corner = t[0];
+      put_varint(block, corner - previous);
+      put_varint(block, std::int64_t{t[1]} - corner);
+      put_varint(block, std::int64_t{t[2]} - corner);
+      previous = corner;
+    }
+  });
 
+  std::uint64_t total = kMeshFixedBytes + kBlockEntry * (pages.size() + 1);
+  for (const auto& block : blocks) total += block.size();
   std::vector<std::uint8_t> out(kMeshFixedBytes + kBlockEntry * (pages.size() + 1), 0);
-  out.reserve(out.size() + 4 * triangles.size());
+  out.reserve(total);
   std::memcpy(out.data(), kMagic, 4);
   store_u32(out.data() + 4, kVersion);
   store_u64(out.data() + 8, leaves);
   store_u64(out.data() + 16, triangles.size());
   store_u64(out.data() + 24, pages.size());
-  std::size_t k = 0;
   for (std::uint32_t p = 0; p < pages.size(); ++p) {
-    const std::uint64_t begin = out.size();
-    std::uint64_t count = 0;
-    std::int64_t previous = 0;
-    for (; k < page_begin[p + 1]; ++k, ++count) {
-      const auto& t = triangles[keyed[k].second];
-      const std::int64_t first = t[0];
-      put_varint(out, first - previous);
-      put_varint(out, std::int64_t{t[1]} - first);
-      put_varint(out, std::int64_t{t[2]} - first);
-      previous = first;
-    }
-    store_u64(out.data() + kMeshFixedBytes + kBlockEntry * p, begin);
-    store_u64(out.data() + kMeshFixedBytes + kBlockEntry * p + 8, count);
+    store_u64(out.data() + kMeshFixedBytes + kBlockEntry * p, out.size());
+    store_u64(out.data() + kMeshFixedBytes + kBlockEntry * p + 8,
+              page_begin[p + 1] - page_begin[p]);
+    out.insert(out.end(), blocks[p].begin(), blocks[p].end());
+    std::vector<std::uint8_t>().swap(blocks[p]);
   }
   store_u64(out.data() + kMeshFixedBytes + kBlockEntry * pages.size(), out.size());
   store_u64(out.data() + 32, out.size());

@@ -12,6 +12,10 @@
 
 #include "pointillist/lod/sphere_tree.hpp"
 
+namespace pointillist {
+class ThreadPool;
+}
+
 namespace pointillist::ptl2 {
 
 // compat_flags bit 2: the header holds the offset of a mesh section (readers that do not know it
@@ -22,10 +26,12 @@ constexpr std::uint64_t kMeshFixedBytes = 40;
 
 // The section for `triangles` over the leaves of the tree `nodes` (leaf k = the k-th node
 // without children, in node order), written as pages whose node indices are `pages[p]`.
-// Asserts every index is below the leaf count.
+// Asserts every index is below the leaf count. The pages' blocks are encoded on `pool`; the
+// bytes do not depend on its thread count.
 std::vector<std::uint8_t> encode_mesh(std::span<const SphereNode> nodes,
                                       std::span<const std::array<std::uint32_t, 3>> triangles,
-                                      std::span<const std::span<const std::uint32_t>> pages);
+                                      std::span<const std::span<const std::uint32_t>> pages,
+                                      ThreadPool& pool);
 
 // The section's size from its fixed fields at `bytes` (the rest of the file from byte `at`).
 // Throws FormatError "<path>: byte <offset>: <what>" when they do not fit.

@@ -69,7 +69,7 @@ PtlV2WriteReport write_ptl_v2(const std::string& path, const SphereTree& tree,
         }
       }
     }
-    mesh_bytes = encode_mesh(nodes, options.triangles, page_nodes);
+    mesh_bytes = encode_mesh(nodes, options.triangles, page_nodes, pool);
   }
   HeaderFields fields;
   fields.colors = colors;

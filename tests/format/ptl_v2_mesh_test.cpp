@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <fstream>
+#include <iterator>
 #include <set>
 
 #include "format_test_support.hpp"
@@ -40,15 +42,16 @@ struct Written {
   std::vector<std::array<std::uint32_t, 3>> faces;  // over the leaves
 };
 
-Written write_mesh(const std::string& path, int n, std::uint32_t page_bytes) {
-  ThreadPool pool(2);
+Written write_mesh(const std::string& path, int n, std::uint32_t page_bytes,
+                   unsigned threads = 2) {
+  ThreadPool pool(threads);
   Written w;
   w.mesh = grid_mesh(n);
   prepare_splats(w.mesh, pool, Progress::none());
   std::vector<std::uint32_t> order;
   w.tree = build_sphere_tree(w.mesh, pool, Progress::none(), {}, &order);
   w.faces = leaf_triangles(w.tree.view(), order, w.mesh.triangles);
-  write_ptl_v2(path, w.tree, "mesh", {.page_bytes = page_bytes, .triangles = w.faces});
+  write_ptl_v2(path, w.tree, "mesh", {.page_bytes = page_bytes, .triangles = w.faces}, pool);
   return w;
 }
 
@@ -80,6 +83,20 @@ TEST(PtlV2Mesh, FacesComeBackOnTheSamePointsOverManyPages) {
   for (const auto& t : w.mesh.triangles) want.insert(corners(w.mesh.positions, t));
   for (const auto& t : faces) got.insert(corners(leaves.positions, t));
   EXPECT_EQ(got, want);
+}
+
+TEST(PtlV2Mesh, TheFileIsTheSameForAnyThreadCount) {
+  // The pages' face blocks are encoded in parallel.
+  pointillist::testing::TempDir dir;
+  write_mesh(dir.file("one.ptl"), 60, 1024, 1);
+  write_mesh(dir.file("two.ptl"), 60, 1024, 2);
+  const auto bytes = [](const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  };
+  const std::string one = bytes(dir.file("one.ptl"));
+  ASSERT_GT(one.size(), 1000u);
+  EXPECT_TRUE(one == bytes(dir.file("two.ptl")));
 }
 
 TEST(PtlV2Mesh, FilesWithoutFacesHaveNone) {
