@@ -54,23 +54,32 @@ std::string write_cloud(const TempDir& dir, std::size_t count) {
   return path;
 }
 
+// Converts `input` with `options` in one process (two threads) and under mpirun (one thread a
+// rank); expects both to succeed with the same bytes and no chunk folder left. Returns mpirun's
+// output.
+std::string expect_two_ranks_write_one_process_bytes(const TempDir& dir, const std::string& input,
+                                                     const std::string& options) {
+  const std::string one = dir.file("one.ptl"), two = dir.file("two.ptl");
+  const CliResult a =
+      testing::run_cli("convert " + input + " -o " + one + options + " --threads 2");
+  EXPECT_EQ(a.exit_code, 0) << a.output;
+  const CliResult b = mpirun2("convert " + input + " -o " + two + options + " --threads 1");
+  EXPECT_EQ(b.exit_code, 0) << b.output;
+  const std::string bytes_one = file_bytes(one);
+  EXPECT_GT(bytes_one.size(), 1000u);
+  EXPECT_TRUE(bytes_one == file_bytes(two)) << "the files differ";
+  EXPECT_FALSE(std::filesystem::exists(two + ".chunks"));
+  return b.output;
+}
+
 TEST(MpiConvert, TwoRanksWriteTheBytesOfOneProcess) {
   if (skip_without_mpi()) GTEST_SKIP() << "this build has no MPI, or mpirun is not installed";
   TempDir dir;
-  const std::string cloud = write_cloud(dir, 40000);
-  const std::string one = dir.file("one.ptl"), two = dir.file("two.ptl");
-  const CliResult a =
-      testing::run_cli("convert " + cloud + " -o " + one + " --chunk-points 2000 --threads 2");
-  ASSERT_EQ(a.exit_code, 0) << a.output;
-  const CliResult b = mpirun2("convert " + cloud + " -o " + two + " --chunk-points 2000 --threads 1");
-  ASSERT_EQ(b.exit_code, 0) << b.output;
+  const std::string output =
+      expect_two_ranks_write_one_process_bytes(dir, write_cloud(dir, 40000), " --chunk-points 2000");
   // Rank 0 speaks for the job: one summary.
-  EXPECT_THAT(b.output, HasSubstr("on 2 MPI ranks"));
-  EXPECT_EQ(b.output.find("converted"), b.output.rfind("converted")) << b.output;
-  const std::string bytes_one = file_bytes(one), bytes_two = file_bytes(two);
-  ASSERT_GT(bytes_one.size(), 1000u);
-  EXPECT_TRUE(bytes_one == bytes_two) << "the files differ";
-  EXPECT_FALSE(std::filesystem::exists(two + ".chunks"));
+  EXPECT_THAT(output, HasSubstr("on 2 MPI ranks"));
+  EXPECT_EQ(output.find("converted"), output.rfind("converted")) << output;
 }
 
 TEST(MpiConvert, TwoRanksConvertAMeshToTheBytesOfOneProcess) {
@@ -79,34 +88,19 @@ TEST(MpiConvert, TwoRanksConvertAMeshToTheBytesOfOneProcess) {
   TempDir dir;
   const std::string mesh = dir.file("torus.ply");
   write_ply(mesh, testing::torus_mesh(120, 60));
-  const std::string one = dir.file("one.ptl"), two = dir.file("two.ptl");
-  const CliResult a =
-      testing::run_cli("convert " + mesh + " -o " + one + " --chunk-points 1000 --threads 2");
-  ASSERT_EQ(a.exit_code, 0) << a.output;
-  const CliResult b = mpirun2("convert " + mesh + " -o " + two + " --chunk-points 1000 --threads 1");
-  ASSERT_EQ(b.exit_code, 0) << b.output;
-  EXPECT_THAT(b.output, HasSubstr("on 2 MPI ranks"));
-  EXPECT_THAT(b.output, HasSubstr("faces are not kept"));
-  const std::string bytes_one = file_bytes(one);
-  ASSERT_GT(bytes_one.size(), 1000u);
-  EXPECT_TRUE(bytes_one == file_bytes(two)) << "the files differ";
-  EXPECT_FALSE(std::filesystem::exists(two + ".chunks"));
+  const std::string output =
+      expect_two_ranks_write_one_process_bytes(dir, mesh, " --chunk-points 1000");
+  EXPECT_THAT(output, HasSubstr("on 2 MPI ranks"));
+  EXPECT_THAT(output, HasSubstr("faces are not kept"));
 }
 
 TEST(MpiConvert, TwoRanksDropTheOutliersOfOneProcess) {
   // The outlier pass runs on both ranks and rank 0 gathers their verdicts.
   if (skip_without_mpi()) GTEST_SKIP() << "this build has no MPI, or mpirun is not installed";
   TempDir dir;
-  const std::string cloud = write_cloud(dir, 30000);
-  const std::string one = dir.file("one.ptl"), two = dir.file("two.ptl");
-  const std::string options = " --chunk-points 2000 --drop-outliers --threads ";
-  const CliResult a = testing::run_cli("convert " + cloud + " -o " + one + options + "2");
-  ASSERT_EQ(a.exit_code, 0) << a.output;
-  const CliResult b = mpirun2("convert " + cloud + " -o " + two + options + "1");
-  ASSERT_EQ(b.exit_code, 0) << b.output;
-  EXPECT_THAT(b.output, HasSubstr("outliers of 30000 points"));
-  EXPECT_TRUE(file_bytes(one) == file_bytes(two)) << "the files differ";
-  EXPECT_FALSE(std::filesystem::exists(two + ".chunks"));
+  const std::string output = expect_two_ranks_write_one_process_bytes(
+      dir, write_cloud(dir, 30000), " --chunk-points 2000 --drop-outliers");
+  EXPECT_THAT(output, HasSubstr("outliers of 30000 points"));
 }
 
 TEST(MpiConvert, AFailingRankStopsEveryRankWithOneMessageAndLeavesNothing) {
