@@ -57,6 +57,11 @@ bool is_point_file_extension(const std::string& path) {
   return kind != Kind::Unknown && kind != Kind::Laz;
 }
 
+bool may_hold_faces(const std::string& path) {
+  const Kind kind = kind_of(path);
+  return kind == Kind::Ply || kind == Kind::Obj;
+}
+
 PointSet read_point_file(const std::string& path, Progress& progress,
                          const PointReadOptions& options) {
   switch (kind_of(path)) {

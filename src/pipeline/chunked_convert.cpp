@@ -61,6 +61,8 @@ std::vector<std::string> meshes_as_points(std::span<const std::string> inputs,
   std::vector<std::string> out(inputs.begin(), inputs.end());
   for (std::size_t k = 0; k < inputs.size(); ++k) {
     const std::string& path = inputs[k];
+    // Opening a LAS or text stream reads the whole file once; only PLY and OBJ hold faces.
+    if (!may_hold_faces(path)) continue;
     {
       const auto stream = open_point_stream(path, {.columns = o.columns});
       if (!stream->info().is_mesh) continue;

@@ -36,6 +36,9 @@ PointSet read_point_file(const std::string& path, Progress& progress = Progress:
 // True when read_point_file has a reader for `path`'s extension (.laz is false).
 bool is_point_file_extension(const std::string& path);
 
+// True when `path`'s format can hold faces (PLY and OBJ, plain or .gz): only these can be meshes.
+bool may_hold_faces(const std::string& path);
+
 // The supported extensions, for messages and help texts: ".ply, .ply.gz, .xyz, ...".
 std::string supported_point_file_extensions();
 
