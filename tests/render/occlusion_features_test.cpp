@@ -5,7 +5,6 @@
 // rules, thread counts and latencies; and culling must still skip what is hidden.
 #include <gtest/gtest.h>
 
-#include <cstring>
 #include <vector>
 
 #include "render/features_render_support.hpp"
@@ -15,7 +14,10 @@
 
 using namespace pointillist;
 using namespace features_test;
+using pointillist::render_test::capture;
 using pointillist::render_test::same_bits;
+using pointillist::render_test::Shot;
+using pointillist::render_test::StrafePath;
 
 
 namespace {
@@ -43,36 +45,14 @@ struct FeatureScene {
   }
 };
 
-Camera path_camera(int k, int frames) {
-  Camera c;
-  const float x = 3.0f * float(k) / float(frames - 1);
-  c.eye = {x, 1.2f, 9.0f};
-  c.target = {x, 0.5f, 0.0f};
-  c.fov_deg = 45.0f;
-  c.width = 200;
-  c.height = 150;
-  return c;
-}
-
-struct Shot {
-  std::vector<Rgb8> color;
-  std::vector<float> depth;
-  std::uint64_t splats = 0;
-};
+// Frame k of a strafe from x = 0 to x = 3.
+constexpr StrafePath kPath{.span = 3.0f, .eye_y = 1.2f, .target_y = 0.5f, .distance = 9.0f,
+                           .fov_deg = 45.0f, .width = 200, .height = 150};
+Camera path_camera(int k, int frames) { return kPath.camera(k, frames); }
 
 std::vector<Shot> render_path(const FeatureScene& scene, const FrameSettings& fs,
                               unsigned threads, int frames) {
-  ThreadPool pool(threads);
-  Renderer renderer;
-  Frame frame;
-  std::vector<Shot> out;
-  for (int k = 0; k < frames; ++k) {
-    renderer.render(scene.instances, path_camera(k, frames), unlit(), fs, pool, frame);
-    out.push_back({std::vector<Rgb8>(frame.color.begin(), frame.color.end()),
-                   std::vector<float>(frame.depth.begin(), frame.depth.end()),
-                   frame.stats.splats});
-  }
-  return out;
+  return render_test::render_path(scene.instances, kPath, unlit(), fs, threads, frames);
 }
 
 }  // namespace
@@ -132,10 +112,8 @@ TEST(OcclusionFeatures, SinglePointLeavesAreCulledWithTheSameImage) {
       c.occlusion.leaf_points = 1;
       c.occlusion.min_query_splats = 0;
       culled.render(scene.instances, path_camera(k, 3), unlit(), c, pool, b);
-      const Shot want{std::vector<Rgb8>(a.color.begin(), a.color.end()),
-                      std::vector<float>(a.depth.begin(), a.depth.end()), a.stats.splats};
-      const Shot got{std::vector<Rgb8>(b.color.begin(), b.color.end()),
-                     std::vector<float>(b.depth.begin(), b.depth.end()), b.stats.splats};
+      const Shot want = capture(a);
+      const Shot got = capture(b);
       EXPECT_TRUE(same_bits(got, want)) << "rule " << int(rule) << " frame " << k;
       EXPECT_LT(got.splats, want.splats) << "rule " << int(rule) << " frame " << k;
     }
@@ -238,8 +216,7 @@ TEST(OcclusionFeatures, AFrontSurfaceReachingFarBehindItsOccluderKeepsItsSplats)
       Renderer renderer;
       Frame frame;
       renderer.render(s, cam, unlit(), f, pool, frame);
-      return Shot{std::vector<Rgb8>(frame.color.begin(), frame.color.end()),
-                  std::vector<float>(frame.depth.begin(), frame.depth.end()), frame.stats.splats};
+      return capture(frame);
     };
     const Shot want = shot(scene, fs);
     ASSERT_FALSE(same_bits(want, shot(without_f, fs))) << "f does not show: no test";

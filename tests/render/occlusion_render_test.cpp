@@ -84,37 +84,15 @@ struct TestScene {
 };
 
 // Frame k of a strafe from x = 0 to x = 6 (eye and target together).
-Camera path_camera(int k, int frames) {
-  Camera c;
-  const float x = 6.0f * float(k) / float(frames - 1);
-  c.eye = {x, 1.5f, 9.0f};
-  c.target = {x, 1.5f, 0.0f};
-  c.fov_deg = 40.0f;
-  c.width = 160;
-  c.height = 120;
-  return c;
-}
+constexpr StrafePath kPath{.span = 6.0f, .eye_y = 1.5f, .target_y = 1.5f, .distance = 9.0f,
+                           .fov_deg = 40.0f, .width = 160, .height = 120};
+Camera path_camera(int k, int frames) { return kPath.camera(k, frames); }
 
-struct Image {
-  std::vector<Rgb8> color;
-  std::vector<float> depth;
-  std::uint64_t splats = 0;
-  OcclusionStats occlusion;
-};
+using Image = Shot;
 
 std::vector<Image> render_path(const TestScene& scene, const RenderSettings& settings,
                                const FrameSettings& fs, unsigned threads, int frames) {
-  ThreadPool pool(threads);
-  Renderer renderer;
-  Frame frame;
-  std::vector<Image> out;
-  for (int k = 0; k < frames; ++k) {
-    renderer.render(scene.instances, path_camera(k, frames), settings, fs, pool, frame);
-    out.push_back({std::vector<Rgb8>(frame.color.begin(), frame.color.end()),
-                   std::vector<float>(frame.depth.begin(), frame.depth.end()), frame.stats.splats,
-                   frame.stats.occlusion});
-  }
-  return out;
+  return render_test::render_path(scene.instances, kPath, settings, fs, threads, frames);
 }
 
 }  // namespace
@@ -336,19 +314,8 @@ TEST(OcclusionRender, HiddenPagedModelsLoadNoPages) {
   // drawing what was visible until its next query).
   const auto settle = [&](std::span<const SceneInstance> scene_instances, const FrameSettings& fs,
                           int more) {
-    Renderer renderer({.page_all = true});
-    Frame frame;
-    for (int k = 0; k < 60 && more >= 0; ++k) {
-      renderer.render(scene_instances, camera, {}, fs, pool, frame);
-      if (renderer.complete()) --more;
-      renderer.load_requested(pool);
-    }
-    EXPECT_TRUE(renderer.complete());
     Settled out;
-    out.image = {std::vector<Rgb8>(frame.color.begin(), frame.color.end()),
-                 std::vector<float>(frame.depth.begin(), frame.depth.end()), frame.stats.splats,
-                 frame.stats.occlusion};
-    out.pages_loaded = renderer.paging_stats().cache.pages_loaded;
+    out.image = settle_paged(scene_instances, camera, fs, more, pool, out.pages_loaded);
     return out;
   };
   for (Rasterizer mode : {Rasterizer::Fast, Rasterizer::Quality}) {
@@ -392,18 +359,7 @@ TEST(OcclusionRender, HiddenPagesOfAVisibleModelAreNeitherDrawnNorLoaded) {
       scene.instances[0], {&back, make_transform({3.0f, 0.0f, -3.0f}, {}, 1.0f)}};
   const Camera camera = path_camera(0, 4);
   const auto settle = [&](const FrameSettings& fs, int more, std::uint64_t& pages_loaded) {
-    Renderer renderer({.page_all = true});
-    Frame frame;
-    for (int k = 0; k < 80 && more >= 0; ++k) {
-      renderer.render(instances, camera, {}, fs, pool, frame);
-      if (renderer.complete()) --more;
-      renderer.load_requested(pool);
-    }
-    EXPECT_TRUE(renderer.complete());
-    pages_loaded = renderer.paging_stats().cache.pages_loaded;
-    return Image{std::vector<Rgb8>(frame.color.begin(), frame.color.end()),
-                 std::vector<float>(frame.depth.begin(), frame.depth.end()), frame.stats.splats,
-                 frame.stats.occlusion};
+    return settle_paged(instances, camera, fs, more, pool, pages_loaded);
   };
   for (Rasterizer mode : {Rasterizer::Fast, Rasterizer::Quality}) {
     FrameSettings none;
@@ -445,9 +401,7 @@ TEST(OcclusionRender, AFarEyeOverSmallInstancesRendersAsInTheWorld) {
     Renderer renderer;
     Frame frame;
     ASSERT_NO_THROW(renderer.render(scene.instances, far, {}, fs, pool, frame)) << name(m);
-    shots.push_back({std::vector<Rgb8>(frame.color.begin(), frame.color.end()),
-                     std::vector<float>(frame.depth.begin(), frame.depth.end()),
-                     frame.stats.splats, frame.stats.occlusion});
+    shots.push_back(capture(frame));
   }
   EXPECT_TRUE(same_bits(shots[1], shots[0]));
   EXPECT_TRUE(same_bits(shots[2], shots[0]));

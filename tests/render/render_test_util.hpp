@@ -4,11 +4,13 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <span>
 #include <vector>
 
 #include "pointillist/core/camera.hpp"
 #include "pointillist/lod/sphere_tree.hpp"
 #include "pointillist/render/render.hpp"
+#include "pointillist/render/renderer.hpp"
 #include "pointillist/scene/analytic.hpp"
 #include "test_trees.hpp"
 
@@ -112,6 +114,67 @@ bool same_bits(const Shot& a, const Shot& b) {
   return a.color.size() == b.color.size() && a.depth.size() == b.depth.size() &&
          std::memcmp(a.color.data(), b.color.data(), a.color.size() * sizeof(a.color[0])) == 0 &&
          std::memcmp(a.depth.data(), b.depth.data(), a.depth.size() * sizeof(a.depth[0])) == 0;
+}
+
+// A frame copied out of the renderer's Frame: colour, depth, splat count, occlusion counts.
+struct Shot {
+  std::vector<Rgb8> color;
+  std::vector<float> depth;
+  std::uint64_t splats = 0;
+  OcclusionStats occlusion;
+};
+inline Shot capture(const Frame& f) {
+  return {std::vector<Rgb8>(f.color.begin(), f.color.end()),
+          std::vector<float>(f.depth.begin(), f.depth.end()), f.stats.splats, f.stats.occlusion};
+}
+
+// A strafe along +x by `span`, eye and target moving together, looking down −z.
+struct StrafePath {
+  float span = 0, eye_y = 0, target_y = 0, distance = 0, fov_deg = 0;
+  int width = 0, height = 0;
+  // Frame k of `frames` (frames ≥ 2).
+  Camera camera(int k, int frames) const {
+    Camera c;
+    const float x = span * float(k) / float(frames - 1);
+    c.eye = {x, eye_y, distance};
+    c.target = {x, target_y, 0.0f};
+    c.fov_deg = fov_deg;
+    c.width = width;
+    c.height = height;
+    return c;
+  }
+};
+
+// `frames` frames of `path` rendered by one Renderer (visibility kept from frame to frame).
+inline std::vector<Shot> render_path(std::span<const SceneInstance> instances,
+                                     const StrafePath& path, const RenderSettings& settings,
+                                     const FrameSettings& fs, unsigned threads, int frames) {
+  ThreadPool pool(threads);
+  Renderer renderer;
+  Frame frame;
+  std::vector<Shot> out;
+  for (int k = 0; k < frames; ++k) {
+    renderer.render(instances, path.camera(k, frames), settings, fs, pool, frame);
+    out.push_back(capture(frame));
+  }
+  return out;
+}
+
+// Renders paged `instances` (every model paged) until every page the view needs is resident,
+// then `more` frames; returns the last frame and the pages loaded.
+inline Shot settle_paged(std::span<const SceneInstance> instances, const Camera& camera,
+                         const FrameSettings& fs, int more, ThreadPool& pool,
+                         std::uint64_t& pages_loaded) {
+  Renderer renderer({.page_all = true});
+  Frame frame;
+  for (int k = 0; k < 80 && more >= 0; ++k) {
+    renderer.render(instances, camera, {}, fs, pool, frame);
+    if (renderer.complete()) --more;
+    renderer.load_requested(pool);
+  }
+  EXPECT_TRUE(renderer.complete());
+  pages_loaded = renderer.paging_stats().cache.pages_loaded;
+  return capture(frame);
 }
 
 }  // namespace pointillist::render_test
