@@ -1,11 +1,12 @@
-// compute_features: the graph, then every splat's sharp edges, partners and planes in parallel
-// blocks (concatenated in splat order), then the surface ids.
+// compute_features and compute_feature_part: the graph, then every splat's sharp edges, partners
+// and planes in parallel blocks (concatenated in splat order), then the surfaces.
 #include <algorithm>
 #include <cstdio>
 #include <cmath>
 #include <string>
 
 #include "pointillist/core/error.hpp"
+#include "pointillist/features/feature_parts.hpp"
 #include "pointillist/features/features.hpp"
 #include "pointillist/features/neighbour_graph.hpp"
 #include "pointillist/features/rules.hpp"
@@ -26,71 +27,6 @@ struct Block {
   std::vector<ClipPlane> planes;
   FeatureStats stats;
 };
-
-void add(FeatureStats& to, const FeatureStats& from) {
-  to.sharp_edges += from.sharp_edges;
-  to.crossing_edges += from.crossing_edges;
-  to.antiparallel_edges += from.antiparallel_edges;
-  to.candidates += from.candidates;
-  to.clipped += from.clipped;
-  to.pass_through += from.pass_through;
-  to.undefined_4_15 += from.undefined_4_15;
-  to.nearest_rule += from.nearest_rule;
-  to.capped += from.capped;
-  for (std::size_t k = 0; k < to.plane_histogram.size(); ++k) {
-    to.plane_histogram[k] += from.plane_histogram[k];
-  }
-}
-
-// Breadth-first search over the continuous edges, seeded in increasing splat index (spec §1.8
-// [P]): ids are numbered in the order of each surface's smallest splat index.
-std::uint64_t segment(const NeighbourGraph& graph, std::span<const std::uint8_t> kinds,
-                      std::vector<std::uint32_t>& ids, std::uint64_t& large) {
-  const std::size_t n = graph.vertex_count();
-  constexpr std::uint32_t kNone = 0xffffffffu;
-  ids.assign(n, kNone);
-  std::vector<std::uint32_t> queue(n);
-  std::uint32_t next_id = 0;
-  large = 0;
-  const std::size_t large_size = std::max<std::size_t>(1, (n + 199) / 200);  // 0.5 %
-  for (std::size_t seed = 0; seed < n; ++seed) {
-    if (ids[seed] != kNone) continue;
-    std::size_t head = 0, tail = 0;
-    queue[tail++] = static_cast<std::uint32_t>(seed);
-    ids[seed] = next_id;
-    while (head < tail) {
-      const std::uint32_t s = queue[head++];
-      for (std::uint64_t e = graph.offsets[s]; e < graph.offsets[s + 1]; ++e) {
-        const std::uint32_t j = graph.neighbours[e];
-        if (ids[j] == kNone && kinds[e] == kContinuous) {
-          ids[j] = next_id;
-          queue[tail++] = j;
-        }
-      }
-    }
-    if (tail >= large_size) ++large;
-    ++next_id;
-  }
-  return next_id;
-}
-
-// The angle (radians) within which the normals of three quarters of the neighbour pairs agree,
-// over every 4th edge (the statistic needs no more); pairs facing apart, such as a thin part's
-// two sides, are not the surface's roughness.
-float normal_spread(const NeighbourGraph& graph, std::span<const Vec3f> normals) {
-  std::vector<float> dots;
-  dots.reserve(graph.neighbours.size() / 4 + 1);
-  for (std::size_t i = 0; i < graph.vertex_count(); ++i) {
-    for (std::uint64_t e = graph.offsets[i]; e < graph.offsets[i + 1]; e += 4) {
-      const float d = dot(normals[i], normals[graph.neighbours[e]]);
-      if (d > 0) dots.push_back(d);
-    }
-  }
-  if (dots.empty()) return 0;
-  const auto quartile = dots.begin() + static_cast<std::ptrdiff_t>(dots.size() / 4);
-  std::nth_element(dots.begin(), quartile, dots.end());
-  return std::acos(std::min(*quartile, 1.0f));
-}
 
 }  // namespace
 
@@ -135,19 +71,20 @@ std::string noisy_features_warning(const FeatureStats& s, const FeatureOptions& 
   return text;
 }
 
-FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec3f> normals,
-                             std::span<const float> radii, ThreadPool& pool,
-                             const FeatureOptions& options, Progress& progress) {
-  validate_feature_options(options);
-  const std::size_t n = centers.size();
-  FeatureData out;
-  out.options = options;
-  std::vector<float> drawn(n);
-  for (std::size_t i = 0; i < n; ++i) drawn[i] = radii[i] * options.radius_scale;
-  const NeighbourGraph graph = build_neighbour_graph(centers, drawn, pool, progress);
-  out.stats.splats = n;
-  out.stats.edges = graph.edge_count();
 
+namespace {
+
+// The part's own splats' features over `graph` (rows of own splats and of their neighbours
+// complete), with the threshold of `options` as given. `owned` empty: every splat is the part's.
+FeaturePart features_over_graph(const NeighbourGraph& graph, std::span<const Vec3f> centers,
+                                std::span<const Vec3f> normals, std::span<const float> drawn,
+                                std::span<const std::uint64_t> keys,
+                                std::span<const std::uint8_t> owned, const FeatureOptions& options,
+                                ThreadPool& pool, Progress& progress) {
+  const std::size_t n = centers.size();
+  const auto own = [&](std::size_t i) { return owned.empty() || owned[i] != 0; };
+  const auto key = [&](std::size_t i) { return keys.empty() ? std::uint64_t{i} : keys[i]; };
+  FeaturePart out;
   const bool reflex_rule =
       options.edge_test == EdgeTest::Side && options.clip_rule == ClipRule::Classified;
   constexpr std::size_t kBlock = 4096;
@@ -160,15 +97,7 @@ FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec
   std::vector<float> noise;
   const bool classified = options.clip_rule == ClipRule::Classified;
   if (classified) shapes.resize(n), noise.resize(n);
-  // The threshold raised above a rough scan's spread.
-  const float spread = normal_spread(graph, normals);
-  out.stats.spread_deg = spread * 180.0f / kPi;
-  const float raised = std::cos(std::min(kSpreadFactor * spread, kMaxRaisedAngle));
-  if (options.adapt_threshold && raised < out.options.sharp_threshold) {
-    out.options.sharp_threshold = raised;
-    out.stats.threshold_raised = true;
-  }
-  const float w_s = out.options.sharp_threshold;
+  const float w_s = options.sharp_threshold;
   pool.run(blocks.size(), [&](std::size_t b) {
     std::vector<Vec3f> around, around_normals;
     for (std::size_t i = b * kBlock, end = std::min(n, i + kBlock); i < end; ++i) {
@@ -210,12 +139,11 @@ FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec
     pool.run(blocks.size(), [&](std::size_t b) {
       Block& block = blocks[b];
       const std::size_t first = b * kBlock, end = std::min(n, first + kBlock);
-      block.modes.resize(end - first);
-      block.plane_counts.resize(end - first);
       std::vector<Vec3f> continuous;
       std::vector<std::size_t> crossing;  // into `sharp`
       std::vector<Disc> partners, through, sharp;
       for (std::size_t i = first; i < end; ++i) {
+        if (!own(i)) continue;
         const Disc s = disc(i);
         continuous.clear();
         crossing.clear();
@@ -230,7 +158,8 @@ FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec
           candidate = true;
           sharp.push_back(disc(j));
           const Crossing x = disc_crossing(s, sharp.back());
-          if (j > i) {
+          // Each sharp edge counted once over the whole set: at its end of lower key.
+          if (key(j) > key(i)) {
             ++block.stats.sharp_edges;
             block.stats.crossing_edges += x == Crossing::Cross;
             block.stats.antiparallel_edges += x == Crossing::Parallel;
@@ -273,8 +202,8 @@ FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec
         if (classified) keep_uncovered(s, clip, sharp, w_s);
         block.stats.undefined_4_15 += clip.undefined_4_15;
         block.stats.capped += clip.capped;
-        block.modes[i - first] = clip.mode;
-        block.plane_counts[i - first] = static_cast<std::uint32_t>(clip.planes.size());
+        block.modes.push_back(clip.mode);
+        block.plane_counts.push_back(static_cast<std::uint32_t>(clip.planes.size()));
         if (!clip.planes.empty()) {
           ++block.stats.clipped;
           ++block.stats.plane_histogram[clip.planes.size()];
@@ -286,18 +215,116 @@ FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec
     });
   }
 
-  out.clip_mode.reserve(n);
-  out.clip_offset.reserve(n + 1);
+  std::size_t owned_count = 0;
+  for (const Block& block : blocks) owned_count += block.modes.size();
+  out.clip_mode.reserve(owned_count);
+  out.clip_offset.reserve(owned_count + 1);
   out.clip_offset.push_back(0);
   for (const Block& block : blocks) {
-    add(out.stats, block.stats);
+    add_feature_counts(out.stats, block.stats);
     out.clip_mode.insert(out.clip_mode.end(), block.modes.begin(), block.modes.end());
     for (std::uint32_t count : block.plane_counts) {
       out.clip_offset.push_back(out.clip_offset.back() + count);
     }
     out.clip_planes.insert(out.clip_planes.end(), block.planes.begin(), block.planes.end());
   }
-  out.stats.segments = segment(graph, kinds, out.surface_id, out.stats.large_segments);
+  out.stats.splats = owned_count;
+
+  // Surfaces inside the part: breadth-first search over the continuous edges between own
+  // splats, seeded in increasing order (spec §1.8 [P]), so they are numbered in the order of
+  // their first splats; continuous edges to the halo become links.
+  constexpr std::uint32_t kNone = 0xffffffffu;
+  std::vector<std::uint32_t> label(n, kNone);
+  std::vector<std::uint32_t> queue(owned_count);
+  for (std::size_t seed = 0; seed < n; ++seed) {
+    if (!own(seed) || label[seed] != kNone) continue;
+    const auto id = static_cast<std::uint32_t>(out.component_first.size());
+    std::size_t head = 0, tail = 0;
+    queue[tail++] = static_cast<std::uint32_t>(seed);
+    label[seed] = id;
+    while (head < tail) {
+      const std::uint32_t s = queue[head++];
+      for (std::uint64_t e = graph.offsets[s]; e < graph.offsets[s + 1]; ++e) {
+        const std::uint32_t j = graph.neighbours[e];
+        if (label[j] == kNone && kinds[e] == kContinuous && own(j)) {
+          label[j] = id;
+          queue[tail++] = j;
+        }
+      }
+    }
+    out.component_first.push_back(key(seed));
+    out.component_size.push_back(tail);
+  }
+  out.component.reserve(owned_count);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!own(i)) continue;
+    out.component.push_back(label[i]);
+    out.row_entries += graph.offsets[i + 1] - graph.offsets[i];
+    for (std::uint64_t e = graph.offsets[i]; e < graph.offsets[i + 1]; ++e) {
+      const std::uint32_t j = graph.neighbours[e];
+      if (kinds[e] == kContinuous && !own(j)) out.links.push_back({label[i], key(i), key(j)});
+    }
+  }
+  return out;
+}
+
+std::vector<float> drawn_radii(std::span<const float> radii, const FeatureOptions& options) {
+  std::vector<float> drawn(radii.size());
+  for (std::size_t i = 0; i < radii.size(); ++i) drawn[i] = radii[i] * options.radius_scale;
+  return drawn;
+}
+
+void check_part(const FeaturePartInput& part) {
+  const std::size_t n = part.centers.size();
+  if (part.normals.size() != n || part.radii.size() != n || part.keys.size() != n ||
+      part.owned.size() != n) {
+    throw Error("sharp features of a part: " + std::to_string(n) + " centres but " +
+                std::to_string(part.normals.size()) + " normals, " +
+                std::to_string(part.radii.size()) + " radii, " + std::to_string(part.keys.size()) +
+                " keys and " + std::to_string(part.owned.size()) + " ownership flags");
+  }
+  for (std::size_t i = 1; i < n; ++i) {
+    if (!(part.keys[i - 1] < part.keys[i])) {
+      throw Error("sharp features of a part: splat " + std::to_string(i) + "'s key " +
+                  std::to_string(part.keys[i]) + " does not follow " +
+                  std::to_string(part.keys[i - 1]) + "; give the splats in the whole set's order");
+    }
+  }
+}
+
+}  // namespace
+
+FeaturePart compute_feature_part(const FeaturePartInput& part, const FeatureOptions& options,
+                                 ThreadPool& pool, Progress& progress) {
+  validate_feature_options(options);
+  check_part(part);
+  const std::vector<float> drawn = drawn_radii(part.radii, options);
+  const NeighbourGraph graph = build_neighbour_graph(part.centers, drawn, pool, progress);
+  return features_over_graph(graph, part.centers, part.normals, drawn, part.keys, part.owned,
+                             options, pool, progress);
+}
+
+FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec3f> normals,
+                             std::span<const float> radii, ThreadPool& pool,
+                             const FeatureOptions& options, Progress& progress) {
+  validate_feature_options(options);
+  const std::vector<float> drawn = drawn_radii(radii, options);
+  const NeighbourGraph graph = build_neighbour_graph(centers, drawn, pool, progress);
+  FeatureStats spread_stats;
+  const FeatureOptions decided =
+      adapt_sharp_threshold(options, normal_spread_histogram(graph, normals), spread_stats);
+  FeaturePart part =
+      features_over_graph(graph, centers, normals, drawn, {}, {}, decided, pool, progress);
+  const FeaturePart* const parts[] = {&part};
+  const FeatureJoin join = join_feature_parts(parts, centers.size());
+  FeatureData out;
+  out.options = decided;
+  out.stats = joined_feature_stats(parts, join, spread_stats);
+  out.surface_id = std::move(part.component);
+  for (std::uint32_t& id : out.surface_id) id = join.surface[0][id];
+  out.clip_mode = std::move(part.clip_mode);
+  out.clip_offset = std::move(part.clip_offset);
+  out.clip_planes = std::move(part.clip_planes);
   return out;
 }
 
