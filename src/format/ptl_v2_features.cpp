@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "pointillist/core/error.hpp"
+#include "pointillist/format/ptl_v2.hpp"
 #include "ptl_v2_layout.hpp"
 
 namespace pointillist::ptl2 {
@@ -127,45 +128,82 @@ ClipMode read_planes(Reader& r, std::uint64_t field, std::vector<ClipPlane>& pla
 
 }  // namespace
 
+namespace {
+
+PtlV2FeatureBlock feature_block(const TreeFeatures& f) {
+  // Surface ids of every node, as runs (a surface's nodes are mostly together).
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> runs;
+  PtlV2FeatureBlock block;
+  const std::size_t n = f.surface.size();
+  for (std::size_t k = 0; k < n; ++k) {
+    if (!runs.empty() && runs.back().first == f.surface[k]) {
+      ++runs.back().second;
+    } else {
+      runs.push_back({f.surface[k], 1});
+    }
+    block.clipped += !f.planes(k).empty();
+    block.planes += static_cast<std::uint32_t>(f.planes(k).size());
+  }
+  Writer w;
+  w.u32(static_cast<std::uint32_t>(runs.size()));
+  for (const auto& [id, length] : runs) w.u32(id), w.u32(length);
+  w.u32(block.clipped);
+  for (std::size_t k = 0; k < n; ++k) {
+    if (f.planes(k).empty()) continue;
+    w.u32(static_cast<std::uint32_t>(k));
+    write_planes(w, f, k);
+  }
+  block.bytes = std::move(w.out);
+  return block;
+}
+
+std::uint64_t feature_head_size(std::uint32_t page_count) {
+  return kFixedBytes + 8 + kBlockEntry * (std::uint64_t{page_count} + 1);
+}
+
+std::vector<std::uint8_t> feature_head(const TreeFeatures& summary, std::uint64_t leaf_count,
+                                       std::span<const PtlV2FeatureBlockEntry> blocks) {
+  Writer w;
+  write_fixed(w, summary, leaf_count);
+  w.u64(blocks.size());
+  // The block table: (offset, clipped nodes, planes) per page, then (end, 0, 0).
+  std::uint64_t at = feature_head_size(static_cast<std::uint32_t>(blocks.size()));
+  for (const PtlV2FeatureBlockEntry& b : blocks) {
+    w.u64(at), w.u32(b.clipped), w.u32(b.planes);
+    at += b.size;
+  }
+  w.u64(at), w.u32(0), w.u32(0);
+  return std::move(w.out);
+}
+
+}  // namespace
+
 std::vector<std::uint8_t> encode_features(std::span<const SphereNode> nodes,
                                           const TreeFeatures& f,
                                           std::span<const std::span<const std::uint32_t>> pages) {
-  Writer w;
   std::uint64_t leaves = 0;
   for (const SphereNode& n : nodes) leaves += n.child_count == 0;
-  write_fixed(w, f, leaves);
-  w.u64(pages.size());
-  // The block table: (offset, clipped nodes, planes) per page, then (end, 0, 0).
-  const std::size_t table = w.out.size();
-  for (std::size_t p = 0; p <= pages.size(); ++p) w.u64(0), w.u32(0), w.u32(0);
+  std::vector<PtlV2FeatureBlock> blocks(pages.size());
+  TreeFeatures page;
   for (std::size_t p = 0; p < pages.size(); ++p) {
-    const std::span<const std::uint32_t> page = pages[p];
-    // Surface ids of every node, as runs (a surface's nodes are mostly together).
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> runs;
-    std::uint32_t clipped = 0, planes = 0;
-    for (const std::uint32_t k : page) {
-      if (!runs.empty() && runs.back().first == f.surface[k]) {
-        ++runs.back().second;
-      } else {
-        runs.push_back({f.surface[k], 1});
-      }
-      clipped += !f.planes(k).empty();
-      planes += static_cast<std::uint32_t>(f.planes(k).size());
+    page.surface.clear();
+    page.clip_mode.clear();
+    page.clip_planes.clear();
+    page.clip_offset.assign(1, 0);
+    for (const std::uint32_t k : pages[p]) {
+      page.surface.push_back(f.surface[k]);
+      page.clip_mode.push_back(f.clip_mode[k]);
+      const auto planes = f.planes(k);
+      page.clip_planes.insert(page.clip_planes.end(), planes.begin(), planes.end());
+      page.clip_offset.push_back(static_cast<std::uint32_t>(page.clip_planes.size()));
     }
-    store_u64(&w.out[table + kBlockEntry * p], w.out.size());
-    store_u32(&w.out[table + kBlockEntry * p + 8], clipped);
-    store_u32(&w.out[table + kBlockEntry * p + 12], planes);
-    w.u32(static_cast<std::uint32_t>(runs.size()));
-    for (const auto& [id, length] : runs) w.u32(id), w.u32(length);
-    w.u32(clipped);
-    for (std::size_t j = 0; j < page.size(); ++j) {
-      if (f.planes(page[j]).empty()) continue;
-      w.u32(static_cast<std::uint32_t>(j));
-      write_planes(w, f, page[j]);
-    }
+    blocks[p] = feature_block(page);
   }
-  store_u64(&w.out[table + kBlockEntry * pages.size()], w.out.size());
-  return std::move(w.out);
+  std::vector<PtlV2FeatureBlockEntry> entries;
+  for (const PtlV2FeatureBlock& b : blocks) entries.push_back({b.bytes.size(), b.clipped, b.planes});
+  std::vector<std::uint8_t> out = feature_head(f, leaves, entries);
+  for (const PtlV2FeatureBlock& b : blocks) out.insert(out.end(), b.bytes.begin(), b.bytes.end());
+  return out;
 }
 
 FeatureSection decode_feature_header(std::string_view bytes, std::uint64_t at,
@@ -354,3 +392,21 @@ void decode_page_features(std::string_view bytes, std::uint64_t at,
 }
 
 }  // namespace pointillist::ptl2
+
+namespace pointillist {
+
+PtlV2FeatureBlock encode_ptl_v2_feature_block(const TreeFeatures& page) {
+  return ptl2::feature_block(page);
+}
+
+std::uint64_t ptl_v2_feature_head_size(std::uint32_t page_count) {
+  return ptl2::feature_head_size(page_count);
+}
+
+std::vector<std::uint8_t> encode_ptl_v2_feature_head(
+    const TreeFeatures& summary, std::uint64_t leaf_count,
+    std::span<const PtlV2FeatureBlockEntry> blocks) {
+  return ptl2::feature_head(summary, leaf_count, blocks);
+}
+
+}  // namespace pointillist

@@ -80,6 +80,8 @@ struct PtlV2PartWriter::State {
   std::uint32_t depth = 0;
   EncodeStats stats;
   std::optional<AtomicFile> file;
+  HeaderFields header;  // as finish_uncommitted wrote it
+  bool finished = false;
 };
 
 PtlV2PartWriter::PtlV2PartWriter(const std::string& path,
@@ -243,6 +245,39 @@ void PtlV2PartWriter::write_subtree(std::size_t k, const SphereTree& tree, Threa
 PtlV2WriteReport PtlV2PartWriter::finish(const Aabb& bounds, const Sphere& view_sphere,
                                          const std::array<double, 3>& origin, Vec3f up,
                                          const std::string& metadata) {
+  const PtlV2WriteReport report = finish_uncommitted(bounds, view_sphere, origin, up, metadata);
+  state_->file->commit();
+  return report;
+}
+
+const std::string& PtlV2PartWriter::temp_path() const { return state_->file->temp_path(); }
+
+void PtlV2PartWriter::write_at(std::uint64_t offset, const void* data, std::size_t size) {
+  state_->file->write_at(offset, data, size);
+}
+
+void PtlV2PartWriter::commit_with_features(
+    const std::string& metadata,
+    const std::function<std::uint64_t(std::uint64_t)>& write_section) {
+  State& st = *state_;
+  if (!st.finished) {
+    throw Error("cannot write " + st.path + ": its features come after finish_uncommitted");
+  }
+  HeaderFields f = st.header;
+  f.metadata_size = metadata.size();
+  f.features_offset = f.metadata_offset + metadata.size();
+  f.features_size = write_section(f.features_offset);
+  if (f.features_size == 0) f.features_offset = 0;
+  st.file->write_at(f.metadata_offset, metadata.data(), metadata.size());
+  const std::vector<std::uint8_t> head = header_and_table(f, st.table);
+  st.file->write_at(0, head.data(), head.size());
+  st.file->commit();
+}
+
+PtlV2WriteReport PtlV2PartWriter::finish_uncommitted(const Aabb& bounds,
+                                                     const Sphere& view_sphere,
+                                                     const std::array<double, 3>& origin,
+                                                     Vec3f up, const std::string& metadata) {
   State& st = *state_;
   for (std::size_t k = 0; k < st.written.size(); ++k) {
     if (!st.written[k]) {
@@ -284,7 +319,8 @@ PtlV2WriteReport PtlV2PartWriter::finish(const Aabb& bounds, const Sphere& view_
   page_bytes(top_page, {&header_root, 1}, {&one, 1}, st.top_codes.record, st.record_size, bytes);
   st.file->write_at(st.table[0].offset, bytes.data(), bytes.size());
   st.file->write_at(st.metadata_offset, metadata.data(), metadata.size());
-  st.file->commit();
+  st.header = f;
+  st.finished = true;
 
   PtlV2WriteReport report;
   report.file_size = st.metadata_offset + metadata.size();

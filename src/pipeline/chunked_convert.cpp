@@ -29,6 +29,7 @@
 #include <set>
 #include <sstream>
 
+#include "chunk_features.hpp"
 #include "chunk_files.hpp"
 #include "chunk_inputs.hpp"
 #include "chunk_messages.hpp"
@@ -100,10 +101,6 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
                               const ConvertOptions& o, const std::string& metadata_head,
                               std::uint64_t max_chunk_points, ThreadPool& pool,
                               Progress& outer_progress) {
-  if (o.features) {
-    throw OptionError("convert: --features are not available for chunked conversion yet (the "
-                      "input needs more than --memory); give a larger --memory");
-  }
   ChunkJobs& jobs = o.jobs ? *o.jobs : ChunkJobs::single();
   const bool root = jobs.rank() == 0;
   const std::uint64_t budget = o.memory_budget ? o.memory_budget : default_memory_budget();
@@ -124,7 +121,8 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
     input_points = in->count();
     sh.colors = in->has_colors();
     overall.emplace(outer_progress, input_points,
-                    o.prepare.drop_outliers ? kOutlierPassShare : 0.0);
+                    (o.prepare.drop_outliers ? kOutlierPassShare : 0.0) +
+                        (o.features ? kFeaturePassShare : 0.0));
     progress_ptr = &*overall;
     if (const auto warning = in->colour_warning()) result.warnings.push_back(*warning);
   });
@@ -365,7 +363,7 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
     if (!root) return;
     Aabb bounds;
     for (const Aabb& b : boxes) bounds.extend(b);
-    ProgressPhase phase(progress, "write", n);
+    std::optional<ProgressPhase> phase(std::in_place, progress, "write", n);
     PtlV2PartWriter writer(output, summaries, colors, v2);
     const Vec3f centre = bounds.center();
     // Subtrees are encoded and written in place a few at a time (as many as the chunks
@@ -383,13 +381,21 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
         far2[c] = std::max(far2[c], length_squared(p - centre));
       }
       writer.write_subtree(c, tree, chunk_pool);
-      phase.advance(plan.counts[c]);
+      phase->advance(plan.counts[c]);
     });
     const float view_radius = std::sqrt(*std::max_element(far2.begin(), far2.end()));
     std::ostringstream meta;
     meta << metadata_head;
     for (const std::string& comment : in->comments()) meta << "comment: " << comment << "\n";
-    writer.finish(bounds, {centre, view_radius}, in->origin(), in->up(), meta.str());
+    if (o.features) {
+      // Found on the written file's leaves, as the conversion in one piece finds them.
+      writer.finish_uncommitted(bounds, {centre, view_radius}, in->origin(), in->up(), meta.str());
+      phase.reset();
+      add_features_in_parts(writer, *folder, meta.str(), for_quantized_model(*o.features), pool,
+                            progress, result.warnings);
+    } else {
+      writer.finish(bounds, {centre, view_radius}, in->origin(), in->up(), meta.str());
+    }
   });
   result.output_points = 0;
   for (const std::uint64_t count : own_count) result.output_points += count;

@@ -127,21 +127,24 @@ ConvertResult convert(std::span<const std::string> inputs, const std::string& ou
     estimate += exact.back() ? *exact.back() : point_count_estimate(path);  // a bound
   }
   const bool to_v2 = ends_with(output, ".ptl") && o.ptl_version == 2;
-  const bool over = estimate > budget / chunking::kInCoreBytesPerPoint;
+  const std::uint64_t per_point =
+      o.features ? chunking::kFeatureBytesPerPoint : chunking::kInCoreBytesPerPoint;
+  const bool over = estimate > budget / per_point;
   const bool ranks = o.jobs != nullptr && o.jobs->size() > 1;
   if (to_v2 && (o.chunk_points != 0 || over || ranks)) {
+    std::uint64_t most = budget / chunking::kChunkBytesPerPoint / pool.thread_count();
+    // A part is found with its halo (up to as many points again) and the process around it.
+    if (o.features) most = std::min(most, budget / (3 * chunking::kFeatureBytesPerPoint));
     const std::uint64_t chunk_points =
         o.chunk_points ? o.chunk_points
-                       : std::clamp<std::uint64_t>(budget / chunking::kChunkBytesPerPoint /
-                                                       pool.thread_count(),
-                                                   1024, chunking::kMaxChunkPoints);
+                       : std::clamp<std::uint64_t>(most, 1024, chunking::kMaxChunkPoints);
     return chunking::convert_chunked(inputs, output, o, metadata_head(inputs, o), chunk_points,
                                      pool, progress);
   }
   if (over) {
     throw Error("convert: the inputs hold up to " + std::to_string(estimate) +
                 " points, which need about " +
-                gigabytes(estimate * chunking::kInCoreBytesPerPoint) +
+                gigabytes(estimate * per_point) +
                 " of memory in one piece, over the budget of " + gigabytes(budget) +
                 "; write a .ptl (converted in chunks within the budget), or raise --memory");
   }

@@ -161,11 +161,45 @@ class PtlV2PartWriter {
   PtlV2WriteReport finish(const Aabb& bounds, const Sphere& view_sphere,
                           const std::array<double, 3>& origin, Vec3f up,
                           const std::string& metadata);
+  // Sharp features are found on the written file, then added (the chunked conversion):
+  // finish_uncommitted writes what finish() writes but leaves the file at temp_path(), complete
+  // and readable (PtlV2File::open) without features; commit_with_features then writes `metadata`
+  // in place of the first, calls write_section(offset), which writes the features section from
+  // byte `offset` on (write_at) and returns its size, records both in the header and renames the
+  // file into place. Throws IoError when writing fails, Error when called out of turn.
+  PtlV2WriteReport finish_uncommitted(const Aabb& bounds, const Sphere& view_sphere,
+                                      const std::array<double, 3>& origin, Vec3f up,
+                                      const std::string& metadata);
+  const std::string& temp_path() const;
+  void write_at(std::uint64_t offset, const void* data, std::size_t size);
+  void commit_with_features(const std::string& metadata,
+                            const std::function<std::uint64_t(std::uint64_t)>& write_section);
 
  private:
   struct State;
   std::unique_ptr<State> state_;
 };
+
+// The sharp-features section written a page at a time (docs/ptl-format.md, "Sharp features"),
+// for files whose features are found part by part: each page's block from the features of its
+// records (`page`: per record in page order, surface id, clip mode and planes; options, stats and
+// surface count unused), then the head (fixed fields and block table, ptl_v2_feature_head_size
+// bytes) over the blocks' sizes and counts, from `summary`'s options, statistics and surface
+// count. The section is the head, then the blocks in page order.
+struct PtlV2FeatureBlock {
+  std::vector<std::uint8_t> bytes;
+  std::uint32_t clipped = 0, planes = 0;
+};
+PtlV2FeatureBlock encode_ptl_v2_feature_block(const TreeFeatures& page);
+std::uint64_t ptl_v2_feature_head_size(std::uint32_t page_count);
+// What the head needs of each block.
+struct PtlV2FeatureBlockEntry {
+  std::uint64_t size = 0;
+  std::uint32_t clipped = 0, planes = 0;
+};
+std::vector<std::uint8_t> encode_ptl_v2_feature_head(
+    const TreeFeatures& summary, std::uint64_t leaf_count,
+    std::span<const PtlV2FeatureBlockEntry> blocks);
 
 // A decoded page.
 struct PtlV2Page {
