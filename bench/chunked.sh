@@ -7,7 +7,7 @@
 # should not).
 #
 #   bash bench/chunked.sh [--bin PATH] [--work DIR] [--points N] [--memory SIZE[,SIZE...]]
-#                         [--no-whole] [--colors] [--mpi]
+#                         [--no-whole] [--colors] [--mpi] [--features]
 #
 #   --points N     points of the generated cloud (default 10000000). 100000000 takes about
 #                  25 s to generate (1.2 GB), minutes to convert, and 17 GB in one piece.
@@ -18,6 +18,8 @@
 #   --colors       the cloud has colours (generate --colors): 15 bytes a point
 #   --mpi          also run each budget under `mpirun -n 2 --oversubscribe` (one thread a rank)
 #                  and check that it writes the single process's file byte for byte
+#   --features     every conversion finds the sharp features too (convert --features; in chunks
+#                  part by part), and the renders that compare them draw them (--mode quality)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bin="${POINTILLIST_BIN:-build/release/pointillist}"
@@ -27,6 +29,8 @@ memory="1G,512M"
 whole=1
 colors=""
 mpi=0
+features=()
+render_mode=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --bin) bin="$2"; shift 2 ;;
@@ -36,6 +40,7 @@ while [ $# -gt 0 ]; do
     --no-whole) whole=0; shift ;;
     --colors) colors="--colors"; shift ;;
     --mpi) mpi=1; shift ;;
+    --features) features=(--features); render_mode=(--mode quality); shift ;;
     *) echo "chunked.sh: unknown option $1" >&2; exit 2 ;;
   esac
 done
@@ -59,14 +64,14 @@ run() {
                      mpirun -n 2 --oversubscribe) ;;
   esac
   /usr/bin/time -f "%e %U %S %M" -o "$work/$name.time" "${launcher[@]}" "$bin" convert "$cloud" \
-    -o "$out" "$@" > "$log"
+    -o "$out" "${features[@]}" "$@" > "$log"
   read -r wall user sys peak < "$work/$name.time"
   local chunks
   chunks=$(sed -n 's/^in \([0-9]*\) chunks.*/\1/p' "$log")
   echo "$name $wall $(echo "$user + $sys" | bc) $peak ${chunks:-0}"
 }
 
-echo "cloud: $points points ($cloud)"
+echo "cloud: $points points ($cloud)${features:+, with --features}"
 results=()
 if [ "$whole" = 1 ]; then results+=("$(run whole)"); fi
 IFS=',' read -ra budgets <<< "$memory"
@@ -94,11 +99,11 @@ done
 if [ "$whole" = 1 ]; then
   # Same model: the renders at one view are compared byte for byte (the files' page layouts
   # differ by design, the decoded hierarchies should not).
-  "$bin" render "$work/whole.ptl" -o "$work/whole.png" --view 30,20 -q
+  "$bin" render "$work/whole.ptl" -o "$work/whole.png" --view 30,20 "${render_mode[@]}" -q
   for r in "${results[@]:1}"; do
     read -r name _ <<< "$r"
     case "$name" in mpi-*) continue ;; esac
-    "$bin" render "$work/$name.ptl" -o "$work/$name.png" --view 30,20 -q
+    "$bin" render "$work/$name.ptl" -o "$work/$name.png" --view 30,20 "${render_mode[@]}" -q
     cmp -s "$work/whole.png" "$work/$name.png" \
       && echo "$name: renders the same image, byte for byte, as the one-piece file" \
       || echo "$name: renders a different image from the one-piece file"
