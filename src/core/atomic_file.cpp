@@ -183,6 +183,13 @@ void AtomicFile::flush() {
   used_ = 0;
 }
 
+void AtomicFile::sync() {
+  flush();
+  if (::fsync(fd_) != 0) {
+    throw IoError(errno_message("cannot write " + path_ + " (its temporary file " + temp_path_ + ")"));
+  }
+}
+
 void AtomicFile::commit() {
   flush();
   const int fd = fd_;

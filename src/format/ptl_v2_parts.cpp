@@ -252,6 +252,8 @@ PtlV2WriteReport PtlV2PartWriter::finish(const Aabb& bounds, const Sphere& view_
 
 const std::string& PtlV2PartWriter::temp_path() const { return state_->file->temp_path(); }
 
+void PtlV2PartWriter::sync() { state_->file->sync(); }
+
 void PtlV2PartWriter::write_at(std::uint64_t offset, const void* data, std::size_t size) {
   state_->file->write_at(offset, data, size);
 }

@@ -22,9 +22,12 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <optional>
 #include <sstream>
 
+#include "chunk_messages.hpp"
+#include "chunk_stages.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/features/feature_parts.hpp"
 #include "pointillist/features/neighbour_graph.hpp"
@@ -251,28 +254,58 @@ void load_part(const std::string& path, FeaturePart& f) {
 
 }  // namespace
 
-void add_features_in_parts(PtlV2PartWriter& writer, const WorkFolder& folder,
+void add_features_in_parts(ChunkJobs& jobs, PtlV2PartWriter* writer, const WorkFolder& folder,
                            const std::string& metadata, const FeatureOptions& options,
                            ThreadPool& pool, Progress& progress,
                            std::vector<std::string>& warnings) {
-  validate_feature_options(options);
+  const bool root = jobs.rank() == 0;
+  // Every rank reads the file rank 0 wrote (synced to disk first, for a shared file system).
+  std::string path;
+  {
+    MessageWriter w;
+    step(jobs, [&] {
+      validate_feature_options(options);
+      if (!root) return;
+      writer->sync();
+      const std::string& temp = writer->temp_path();
+      w.put_vector(std::vector<char>(temp.begin(), temp.end()));
+    });
+    jobs.broadcast(w.bytes());
+    MessageReader m(w.bytes());
+    const std::vector<char> chars = m.get_vector<char>();
+    path.assign(chars.begin(), chars.end());
+  }
   std::optional<TreeFeatures> summary;
   std::vector<PtlV2FeatureBlockEntry> entries;
   std::vector<std::uint64_t> block_at;
   const std::string blocks_path = folder.file("feature-blocks");
-  {
-    const auto file = PtlV2File::open(writer.temp_path());
-    const Pages pages(*file);
-    const std::size_t parts = pages.part_pages.size();
-    const float scale = options.radius_scale;
+  std::unique_ptr<PtlV2File> file;
+  std::optional<Pages> pages_holder;
+  std::size_t parts = 0;
+  std::vector<std::size_t> mine;  // this rank's parts
+  step(jobs, [&] {
+    file = PtlV2File::open(path);
+    pages_holder.emplace(*file);
+    parts = pages_holder->part_pages.size();
+    for (std::size_t k = std::size_t(jobs.rank()); k < parts; k += std::size_t(jobs.size())) {
+      mine.push_back(k);
+    }
+  });
+  const Pages& pages = *pages_holder;
+  const float scale = options.radius_scale;
+  // One phase for the passes: each leaf twice, then each page (rank 0's parts and the pages).
+  std::optional<ProgressPhase> phase(std::in_place, progress, "features",
+                                     2 * file->leaf_count() + file->page_count());
 
-    // One phase for the passes: each leaf twice, then each page.
-    ProgressPhase phase(progress, "features", 2 * file->leaf_count() + file->page_count());
-    // Pass 1: the spread, and the largest drawn radius.
-    SpreadHistogram spread;
-    float r_max = 0;
-    {
-      for (std::size_t k = 0; k < parts; ++k) {
+  // Pass 1: the spread, and the largest drawn radius; rank 0 decides the threshold.
+  SpreadHistogram spread;
+  float r_max = 0;
+  FeatureStats spread_stats;
+  FeatureOptions decided = options;
+  {
+    MessageWriter w;
+    step(jobs, [&] {
+      for (const std::size_t k : mine) {
         const PartSplats s = gather_part(pages, std::uint32_t(k), scale, [](float r) { return r; });
         if (s.own_count == 0) continue;
         r_max = std::max(r_max, s.r_own);
@@ -280,30 +313,93 @@ void add_features_in_parts(PtlV2PartWriter& writer, const WorkFolder& folder,
         for (float& r : drawn) r *= scale;
         const NeighbourGraph graph = build_neighbour_graph(s.centers, drawn, pool);
         spread.add(normal_spread_histogram(graph, s.normals, s.owned));
-        phase.advance(s.own_count);
+        phase->advance(s.own_count);
       }
-    }
-    FeatureStats spread_stats;
-    const FeatureOptions decided = adapt_sharp_threshold(options, spread, spread_stats);
+      w.put(r_max);
+      w.put_vector(spread.slot);
+      w.put_vector(spread.fine);
+    });
+    const std::vector<std::vector<char>> all = jobs.gather(w.bytes());
+    MessageWriter decision;
+    step(jobs, [&] {
+      if (!root) return;
+      for (std::size_t r = 1; r < all.size(); ++r) {
+        MessageReader m(all[r]);
+        r_max = std::max(r_max, m.get<float>());
+        SpreadHistogram theirs;
+        theirs.slot = m.get_vector<std::uint32_t>();
+        theirs.fine = m.get_vector<std::array<std::uint64_t, 256>>();
+        for (const std::uint32_t slot : theirs.slot) {
+          if (slot > theirs.fine.size()) throw Error("chunked conversion: a rank sent a bad histogram");
+        }
+        spread.add(theirs);
+      }
+      decided = adapt_sharp_threshold(options, spread, spread_stats);
+      decision.put(r_max);
+      decision.put(decided);
+      decision.put(spread_stats);
+    });
+    jobs.broadcast(decision.bytes());
+    MessageReader m(decision.bytes());
+    r_max = m.get<float>();
+    decided = m.get<FeatureOptions>();
+    spread_stats = m.get<FeatureStats>();
+  }
 
-    // Pass 2: each part's features, kept on disk; then the join.
-    std::vector<FeaturePart> found(parts);
-    std::vector<const FeaturePart*> listed;
-    std::vector<std::size_t> listed_part;
-    {
-      for (std::size_t k = 0; k < parts; ++k) {
+  // Pass 2: each part's features, kept on disk; rank 0 learns what the join needs.
+  std::vector<FeaturePart> found(parts);
+  std::vector<std::uint8_t> has(parts, 0);
+  {
+    MessageWriter w;
+    step(jobs, [&] {
+      for (const std::size_t k : mine) {
         const PartSplats s = gather_part(pages, std::uint32_t(k), scale,
                                          [&](float r) { return feature_halo_reach(r, r_max); });
         if (s.own_count == 0) continue;
-        found[k] = compute_feature_part(s.input(), decided, pool);
-        save_part(folder.file("features" + std::to_string(k)), found[k]);
+        FeaturePart f = compute_feature_part(s.input(), decided, pool);
+        save_part(folder.file("features" + std::to_string(k)), f);
+        w.put(std::uint64_t(k));
+        w.put_vector(f.component_first);
+        w.put_vector(f.component_size);
+        w.put_vector(f.links);
+        w.put(f.row_entries);
+        w.put(f.stats);
         // Only what the join needs stays in memory.
-        found[k].clip_mode = {}, found[k].clip_offset = {}, found[k].clip_planes = {};
-        found[k].component = {};
-        listed.push_back(&found[k]);
-        listed_part.push_back(k);
-        phase.advance(s.own_count);
+        f.clip_mode = {}, f.clip_offset = {}, f.clip_planes = {}, f.component = {};
+        found[k] = std::move(f);
+        has[k] = 1;
+        phase->advance(s.own_count);
       }
+    });
+    const std::vector<std::vector<char>> all = jobs.gather(w.bytes());
+    step(jobs, [&] {
+      if (!root) return;
+      for (std::size_t r = 1; r < all.size(); ++r) {
+        MessageReader m(all[r]);
+        while (!m.done()) {
+          const auto k = std::size_t(m.get<std::uint64_t>());
+          if (k >= parts) throw Error("chunked conversion: a rank sent a part out of range");
+          FeaturePart& f = found[k];
+          f.component_first = m.get_vector<std::uint64_t>();
+          f.component_size = m.get_vector<std::uint64_t>();
+          f.links = m.get_vector<FeatureLink>();
+          f.row_entries = m.get<std::uint64_t>();
+          f.stats = m.get<FeatureStats>();
+          has[k] = 1;
+        }
+      }
+    });
+  }
+  file.reset();
+  step(jobs, [&] {
+    if (!root) return;
+    file = PtlV2File::open(path);
+    std::vector<const FeaturePart*> listed;
+    std::vector<std::size_t> listed_part;
+    for (std::size_t k = 0; k < parts; ++k) {
+      if (!has[k]) continue;
+      listed.push_back(&found[k]);
+      listed_part.push_back(k);
     }
     const FeatureJoin join = join_feature_parts(listed, file->leaf_count());
     summary.emplace();
@@ -339,7 +435,7 @@ void add_features_in_parts(PtlV2PartWriter& writer, const WorkFolder& folder,
         }
         std::sort(own_keys.begin(), own_keys.end());
         if (own_keys.size() != results.component.size()) {
-          throw Error(writer.temp_path() + ": the sharp features of part " + std::to_string(k) +
+          throw Error(path + ": the sharp features of part " + std::to_string(k) +
                       " do not match its leaves");
         }
       }
@@ -404,43 +500,42 @@ void add_features_in_parts(PtlV2PartWriter& writer, const WorkFolder& folder,
         entries[p] = {block.bytes.size(), block.clipped, block.planes};
         block_at[p] = written;
         written += block.bytes.size();
-        phase.advance(1);
+        phase->advance(1);
       }
     };
     for (std::size_t k = 1; k < parts; ++k) encode_part(k);
     encode_part(0);
     blocks.flush();
     if (!blocks) throw IoError(blocks_path + ": cannot write sharp features there; is the disk full?");
-  }
+    blocks.close();
+    phase.reset();
 
-  std::ostringstream meta;
-  meta << metadata << "features: sharp threshold " << summary->options.sharp_threshold << ", "
-       << summary->stats.clipped << " clipped splats, " << summary->stats.segments
-       << " surfaces\n";
-  const std::string noisy = noisy_features_warning(summary->stats, summary->options);
-  if (!noisy.empty()) warnings.push_back("--features: " + noisy);
-  std::uint64_t leaves = 0;
-  {
-    const auto file = PtlV2File::open(writer.temp_path());
-    leaves = file->leaf_count();
-  }
-  writer.commit_with_features(meta.str(), [&](std::uint64_t offset) {
-    const std::vector<std::uint8_t> head = encode_ptl_v2_feature_head(*summary, leaves, entries);
-    writer.write_at(offset, head.data(), head.size());
-    std::uint64_t at = offset + head.size();
-    std::ifstream in(blocks_path, std::ios::binary);
-    std::vector<char> buffer;
-    for (std::size_t p = 0; p < entries.size(); ++p) {
-      buffer.resize(entries[p].size);
-      in.seekg(std::streamoff(block_at[p]));
-      in.read(buffer.data(), std::streamsize(buffer.size()));
-      if (!in) throw IoError(blocks_path + ": cannot read back the sharp features kept there");
-      writer.write_at(at, buffer.data(), buffer.size());
-      at += buffer.size();
-    }
-    return at - offset;
+    std::ostringstream meta;
+    meta << metadata << "features: sharp threshold " << summary->options.sharp_threshold << ", "
+         << summary->stats.clipped << " clipped splats, " << summary->stats.segments
+         << " surfaces\n";
+    const std::string noisy = noisy_features_warning(summary->stats, summary->options);
+    if (!noisy.empty()) warnings.push_back("--features: " + noisy);
+    const std::uint64_t leaves = file->leaf_count();
+    file.reset();
+    writer->commit_with_features(meta.str(), [&](std::uint64_t offset) {
+      const std::vector<std::uint8_t> head = encode_ptl_v2_feature_head(*summary, leaves, entries);
+      writer->write_at(offset, head.data(), head.size());
+      std::uint64_t at = offset + head.size();
+      std::ifstream in(blocks_path, std::ios::binary);
+      std::vector<char> buffer;
+      for (std::size_t p = 0; p < entries.size(); ++p) {
+        buffer.resize(entries[p].size);
+        in.seekg(std::streamoff(block_at[p]));
+        in.read(buffer.data(), std::streamsize(buffer.size()));
+        if (!in) throw IoError(blocks_path + ": cannot read back the sharp features kept there");
+        writer->write_at(at, buffer.data(), buffer.size());
+        at += buffer.size();
+      }
+      return at - offset;
+    });
+    std::filesystem::remove(blocks_path);
   });
-  std::filesystem::remove(blocks_path);
 }
 
 }  // namespace pointillist::chunking

@@ -358,13 +358,15 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
     });
   }
 
-  // 7. Write (rank 0).
+  // 7. Write (rank 0); with --features, the file stays unrenamed for step 8.
+  std::optional<PtlV2PartWriter> writer;
+  std::string metadata;
   step(jobs, [&] {
     if (!root) return;
     Aabb bounds;
     for (const Aabb& b : boxes) bounds.extend(b);
-    std::optional<ProgressPhase> phase(std::in_place, progress, "write", n);
-    PtlV2PartWriter writer(output, summaries, colors, v2);
+    ProgressPhase phase(progress, "write", n);
+    writer.emplace(output, summaries, colors, v2);
     const Vec3f centre = bounds.center();
     // Subtrees are encoded and written in place a few at a time (as many as the chunks
     // prepared at once).
@@ -380,23 +382,26 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
       for (const Vec3f& p : s.points.positions) {
         far2[c] = std::max(far2[c], length_squared(p - centre));
       }
-      writer.write_subtree(c, tree, chunk_pool);
-      phase->advance(plan.counts[c]);
+      writer->write_subtree(c, tree, chunk_pool);
+      phase.advance(plan.counts[c]);
     });
     const float view_radius = std::sqrt(*std::max_element(far2.begin(), far2.end()));
     std::ostringstream meta;
     meta << metadata_head;
     for (const std::string& comment : in->comments()) meta << "comment: " << comment << "\n";
+    metadata = meta.str();
     if (o.features) {
-      // Found on the written file's leaves, as the conversion in one piece finds them.
-      writer.finish_uncommitted(bounds, {centre, view_radius}, in->origin(), in->up(), meta.str());
-      phase.reset();
-      add_features_in_parts(writer, *folder, meta.str(), for_quantized_model(*o.features), pool,
-                            progress, result.warnings);
+      writer->finish_uncommitted(bounds, {centre, view_radius}, in->origin(), in->up(), metadata);
     } else {
-      writer.finish(bounds, {centre, view_radius}, in->origin(), in->up(), meta.str());
+      writer->finish(bounds, {centre, view_radius}, in->origin(), in->up(), metadata);
     }
   });
+  // 8. Sharp features, found on the written file's leaves as the conversion in one piece finds
+  // them, the parts shared among the ranks.
+  if (o.features) {
+    add_features_in_parts(jobs, root ? &*writer : nullptr, *folder, metadata,
+                          for_quantized_model(*o.features), pool, progress, result.warnings);
+  }
   result.output_points = 0;
   for (const std::uint64_t count : own_count) result.output_points += count;
   if (overall) result.phase_seconds = overall->phase_seconds();

@@ -103,6 +103,15 @@ TEST(MpiConvert, TwoRanksDropTheOutliersOfOneProcess) {
   EXPECT_THAT(output, HasSubstr("outliers of 30000 points"));
 }
 
+TEST(MpiConvert, TwoRanksFindTheSharpFeaturesOfOneProcess) {
+  // Both ranks find the features of their parts of the file rank 0 wrote; rank 0 joins them.
+  if (skip_without_mpi()) GTEST_SKIP() << "this build has no MPI, or mpirun is not installed";
+  TempDir dir;
+  const std::string output = expect_two_ranks_write_one_process_bytes(
+      dir, write_cloud(dir, 30000), " --chunk-points 2000 --features");
+  EXPECT_THAT(output, HasSubstr("features"));
+}
+
 TEST(MpiConvert, AFailingRankStopsEveryRankWithOneMessageAndLeavesNothing) {
   if (skip_without_mpi()) GTEST_SKIP() << "this build has no MPI, or mpirun is not installed";
   TempDir dir;

@@ -31,6 +31,10 @@ class AtomicFile {
   void write_at(std::uint64_t offset, const void* data, std::size_t size);
   // Flushes, closes and renames into place. Throws IoError.
   void commit();
+  // Flushes and asks the system to put the bytes written so far on disk (fsync), so that other
+  // processes, on other machines of a shared file system too, can read the temporary file.
+  // Throws IoError.
+  void sync();
 
   const std::string& temp_path() const { return temp_path_; }
 

@@ -171,6 +171,7 @@ class PtlV2PartWriter {
                                       const std::array<double, 3>& origin, Vec3f up,
                                       const std::string& metadata);
   const std::string& temp_path() const;
+  void sync();  // for other processes reading temp_path() (AtomicFile::sync)
   void write_at(std::uint64_t offset, const void* data, std::size_t size);
   void commit_with_features(const std::string& metadata,
                             const std::function<std::uint64_t(std::uint64_t)>& write_section);
