@@ -6,6 +6,9 @@
 #include <bit>
 #include <cmath>
 #include <numeric>
+#include <string>
+
+#include "pointillist/core/error.hpp"
 
 namespace pointillist {
 namespace {
@@ -113,7 +116,20 @@ void add_feature_counts(FeatureStats& to, const FeatureStats& from) {
   }
 }
 
-FeatureJoin join_feature_parts(std::span<const FeaturePart* const> parts, std::uint64_t splats) {
+void resolve_feature_links(std::uint32_t from, std::span<const FeatureLink> links,
+                           std::uint32_t to, std::span<const std::uint64_t> to_keys,
+                           std::span<const std::uint32_t> to_components,
+                           std::vector<std::pair<PartSurface, PartSurface>>& joined) {
+  for (const FeatureLink& l : links) {
+    const auto it = std::lower_bound(to_keys.begin(), to_keys.end(), l.other);
+    if (it == to_keys.end() || *it != l.other) continue;
+    const std::uint32_t c = to_components[std::size_t(it - to_keys.begin())];
+    joined.push_back({{from, l.component}, {to, c}});
+  }
+}
+
+FeatureJoin join_feature_parts(std::span<const FeaturePart* const> parts, std::uint64_t splats,
+                               std::span<const std::pair<PartSurface, PartSurface>> joined) {
   // Every part's surfaces numbered one after the other, then joined by a union-find.
   std::vector<std::size_t> base(parts.size() + 1, 0);
   for (std::size_t p = 0; p < parts.size(); ++p) {
@@ -126,24 +142,16 @@ FeatureJoin join_feature_parts(std::span<const FeaturePart* const> parts, std::u
     while (up[a] != a) a = up[a] = up[up[a]];
     return a;
   };
-  // A link and the one listed back by the other splat's part share their pair of keys.
-  struct End {
-    std::uint64_t low, high;
-    std::size_t surface;
-  };
-  std::vector<End> ends;
-  for (std::size_t p = 0; p < parts.size(); ++p) {
-    for (const FeatureLink& l : parts[p]->links) {
-      ends.push_back({std::min(l.own, l.other), std::max(l.own, l.other), base[p] + l.component});
+  const auto index = [&](const PartSurface& s) {
+    if (s.part >= parts.size() || s.component >= parts[s.part]->component_first.size()) {
+      throw Error("sharp features: a joined surface (part " + std::to_string(s.part) +
+                  ", surface " + std::to_string(s.component) + ") does not exist");
     }
-  }
-  std::sort(ends.begin(), ends.end(), [](const End& a, const End& b) {
-    return a.low != b.low ? a.low < b.low : a.high != b.high ? a.high < b.high : a.surface < b.surface;
-  });
-  for (std::size_t e = 1; e < ends.size(); ++e) {
-    if (ends[e].low != ends[e - 1].low || ends[e].high != ends[e - 1].high) continue;
-    const std::size_t a = find(ends[e].surface), b = find(ends[e - 1].surface);
-    if (a != b) up[std::max(a, b)] = std::min(a, b);
+    return base[s.part] + s.component;
+  };
+  for (const auto& [a, b] : joined) {
+    const std::size_t x = find(index(a)), y = find(index(b));
+    if (x != y) up[std::max(x, y)] = std::min(x, y);
   }
   // Each joined surface's first splat and size; ids in the order of first splats.
   constexpr std::uint64_t kUnset = ~std::uint64_t{0};

@@ -230,39 +230,42 @@ FeaturePart features_over_graph(const NeighbourGraph& graph, std::span<const Vec
   }
   out.stats.splats = owned_count;
 
-  // Surfaces inside the part: breadth-first search over the continuous edges between own
-  // splats, seeded in increasing order (spec §1.8 [P]), so they are numbered in the order of
-  // their first splats; continuous edges to the halo become links.
+  // Surfaces inside the part: breadth-first search over the continuous edges, seeded at the own
+  // splats in increasing order (spec §1.8 [P]), so they are numbered in the order of their first
+  // splats. The search goes through halo splats too (every edge between splats of the part is an
+  // edge of the whole set, so what it joins is joined; only edges to splats outside the part are
+  // missing): each halo splat it reaches becomes a link, which the join follows into the part
+  // that owns it.
   constexpr std::uint32_t kNone = 0xffffffffu;
   std::vector<std::uint32_t> label(n, kNone);
-  std::vector<std::uint32_t> queue(owned_count);
+  std::vector<std::uint32_t> queue(n);
   for (std::size_t seed = 0; seed < n; ++seed) {
     if (!own(seed) || label[seed] != kNone) continue;
     const auto id = static_cast<std::uint32_t>(out.component_first.size());
-    std::size_t head = 0, tail = 0;
+    std::size_t head = 0, tail = 0, owned_here = 0;
     queue[tail++] = static_cast<std::uint32_t>(seed);
     label[seed] = id;
     while (head < tail) {
       const std::uint32_t s = queue[head++];
+      owned_here += own(s);
       for (std::uint64_t e = graph.offsets[s]; e < graph.offsets[s + 1]; ++e) {
         const std::uint32_t j = graph.neighbours[e];
-        if (label[j] == kNone && kinds[e] == kContinuous && own(j)) {
+        if (label[j] == kNone && kinds[e] == kContinuous) {
           label[j] = id;
           queue[tail++] = j;
         }
       }
     }
     out.component_first.push_back(key(seed));
-    out.component_size.push_back(tail);
+    out.component_size.push_back(owned_here);
   }
   out.component.reserve(owned_count);
   for (std::size_t i = 0; i < n; ++i) {
-    if (!own(i)) continue;
-    out.component.push_back(label[i]);
-    out.row_entries += graph.offsets[i + 1] - graph.offsets[i];
-    for (std::uint64_t e = graph.offsets[i]; e < graph.offsets[i + 1]; ++e) {
-      const std::uint32_t j = graph.neighbours[e];
-      if (kinds[e] == kContinuous && !own(j)) out.links.push_back({label[i], key(i), key(j)});
+    if (own(i)) {
+      out.component.push_back(label[i]);
+      out.row_entries += graph.offsets[i + 1] - graph.offsets[i];
+    } else if (label[i] != kNone) {
+      out.links.push_back({label[i], key(i)});
     }
   }
   return out;
@@ -316,7 +319,7 @@ FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec
   FeaturePart part =
       features_over_graph(graph, centers, normals, drawn, {}, {}, decided, pool, progress);
   const FeaturePart* const parts[] = {&part};
-  const FeatureJoin join = join_feature_parts(parts, centers.size());
+  const FeatureJoin join = join_feature_parts(parts, centers.size(), {});
   FeatureData out;
   out.options = decided;
   out.stats = joined_feature_stats(parts, join, spread_stats);

@@ -127,6 +127,19 @@ void for_each_leaf(const Pages& pages, std::uint32_t p, const PtlV2Page& page, F
   }
 }
 
+// The keys of part `part`'s own leaves, ascending.
+std::vector<std::uint64_t> own_keys(const Pages& pages, std::uint32_t part) {
+  std::vector<std::uint64_t> keys;
+  PtlV2Page page;
+  for (const std::uint32_t p : pages.part_pages[part]) {
+    pages.file->decode_page(p, page);
+    for_each_leaf(pages, p, page,
+                  [&](std::uint32_t, std::uint64_t key, const SphereNode&) { keys.push_back(key); });
+  }
+  std::sort(keys.begin(), keys.end());
+  return keys;
+}
+
 float box_distance(const Aabb& box, Vec3f c) {
   float d2 = 0;
   for (int a = 0; a < 3; ++a) {
@@ -401,7 +414,41 @@ void add_features_in_parts(ChunkJobs& jobs, PtlV2PartWriter* writer, const WorkF
       listed.push_back(&found[k]);
       listed_part.push_back(k);
     }
-    const FeatureJoin join = join_feature_parts(listed, file->leaf_count());
+    // Each link goes to the part that owns its splat (the key's page rank names the page), where
+    // that splat's surface is looked up.
+    std::vector<std::uint32_t> page_of_rank(file->page_count());
+    for (std::uint32_t p = 0; p < file->page_count(); ++p) page_of_rank[pages.rank[p]] = p;
+    std::vector<std::uint32_t> listed_index(parts, 0);
+    for (std::size_t l = 0; l < listed.size(); ++l) listed_index[listed_part[l]] = std::uint32_t(l);
+    std::vector<std::vector<std::uint32_t>> incoming_from(parts);
+    std::vector<std::vector<FeatureLink>> incoming(parts);
+    for (std::size_t l = 0; l < listed.size(); ++l) {
+      FeaturePart& f = found[listed_part[l]];
+      for (const FeatureLink& link : f.links) {
+        const auto rank = std::uint32_t((link.other >> 32) & kMaxRank);
+        if (rank >= page_of_rank.size()) throw Error(path + ": a link to a page out of range");
+        const std::uint32_t owner = pages.part[page_of_rank[rank]];
+        incoming_from[owner].push_back(std::uint32_t(l));
+        incoming[owner].push_back(link);
+      }
+      f.links = {};
+    }
+    std::vector<std::pair<PartSurface, PartSurface>> joined;
+    for (std::size_t k = 0; k < parts; ++k) {
+      if (incoming[k].empty()) continue;
+      if (!has[k]) throw Error(path + ": a link to part " + std::to_string(k) + ", which has no leaves");
+      FeaturePart results;
+      load_part(folder.file("features" + std::to_string(k)), results);
+      const std::vector<std::uint64_t> keys = own_keys(pages, std::uint32_t(k));
+      const std::vector<std::uint32_t>& from = incoming_from[k];
+      for (std::size_t a = 0, b = 0; a < from.size(); a = b) {
+        while (b < from.size() && from[b] == from[a]) ++b;
+        resolve_feature_links(from[a], std::span(incoming[k]).subspan(a, b - a), listed_index[k],
+                              keys, results.component, joined);
+      }
+      incoming[k] = {}, incoming_from[k] = {};
+    }
+    const FeatureJoin join = join_feature_parts(listed, file->leaf_count(), joined);
     summary.emplace();
     summary->options = decided;
     summary->stats = joined_feature_stats(listed, join, spread_stats);
@@ -427,13 +474,7 @@ void add_features_in_parts(ChunkJobs& jobs, PtlV2PartWriter* writer, const WorkF
       if (has_own) {
         load_part(folder.file("features" + std::to_string(k)), results);
         std::filesystem::remove(folder.file("features" + std::to_string(k)));
-        for (const std::uint32_t p : list) {
-          file->decode_page(p, page);
-          for_each_leaf(pages, p, page, [&](std::uint32_t, std::uint64_t key, const SphereNode&) {
-            own_keys.push_back(key);
-          });
-        }
-        std::sort(own_keys.begin(), own_keys.end());
+        own_keys = ::pointillist::chunking::own_keys(pages, std::uint32_t(k));
         if (own_keys.size() != results.component.size()) {
           throw Error(path + ": the sharp features of part " + std::to_string(k) +
                       " do not match its leaves");

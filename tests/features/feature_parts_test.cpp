@@ -12,6 +12,7 @@
 #include <numeric>
 #include <random>
 
+#include "pointillist/core/error.hpp"
 #include "pointillist/prep/radii.hpp"
 #include "pointillist/scene/csg.hpp"
 
@@ -113,12 +114,28 @@ FeatureData by_parts(const Splats& s, int cells, const FeatureOptions& options, 
   // Pass 2: each part's own splats, then the join.
   std::vector<FeaturePart> found(parts.size());
   std::vector<const FeaturePart*> pointers;
+  std::vector<std::size_t> part_of;  // the part of each pointer
   for (std::size_t p = 0; p < parts.size(); ++p) {
     if (parts[p].keys.empty()) continue;
     found[p] = compute_feature_part(parts[p].input(), decided, pool);
     pointers.push_back(&found[p]);
+    part_of.push_back(p);
   }
-  const FeatureJoin join = join_feature_parts(pointers, n);
+  // Each part's links against every other part's own splats.
+  std::vector<std::pair<PartSurface, PartSurface>> joined;
+  for (std::size_t to = 0; to < part_of.size(); ++to) {
+    const Part& owner = parts[part_of[to]];
+    std::vector<std::uint64_t> keys;
+    for (std::size_t i = 0; i < owner.keys.size(); ++i) {
+      if (owner.owned[i]) keys.push_back(owner.keys[i]);
+    }
+    for (std::size_t from = 0; from < part_of.size(); ++from) {
+      if (from == to) continue;
+      resolve_feature_links(std::uint32_t(from), found[part_of[from]].links, std::uint32_t(to),
+                            keys, found[part_of[to]].component, joined);
+    }
+  }
+  const FeatureJoin join = join_feature_parts(pointers, n, joined);
   FeatureData out;
   out.options = decided;
   out.stats = joined_feature_stats(pointers, join, spread_stats);
@@ -250,22 +267,35 @@ TEST(FeatureParts, SpreadIsTheQuartileToTheBucketsWidth) {
   EXPECT_EQ(SpreadHistogram{}.spread(), 0.0f);
 }
 
-TEST(FeatureParts, JoinHonoursOnlyLinksListedBackAndNumbersByFirstSplat) {
-  // Part 0 owns keys 0, 1, 4 (two surfaces: {0, 4} and {1}); part 1 owns 2, 3, 5 ({3, 5}, {2}).
+TEST(FeatureParts, LinksJoinTheSurfacesOfTheirSplatsAndIdsFollowFirstSplats) {
+  // Part 0 owns keys 0, 1, 4 (surfaces {0, 4} and {1}); part 1 owns 2, 3, 5 (surfaces {3, 5}
+  // and {2}). Part 0's surface 0 reaches halo splat 5; part 1's surface 1 reaches 9, which no
+  // part owns (outside every part: left alone).
   FeaturePart p0, p1;
   p0.component_first = {0, 1};
   p0.component_size = {2, 1};
+  p0.component = {0, 1, 0};  // keys 0, 1, 4
+  p0.links = {{0, 5}};
   p1.component_first = {3, 2};
   p1.component_size = {2, 1};
-  // 4–5 is listed by both ends: joined. 1–2 only by part 0 (part 1 saw no smooth edge): not.
-  p0.links = {{1, 1, 2}, {0, 4, 5}};
-  p1.links = {{0, 5, 4}};
+  p1.component = {1, 0, 0};  // keys 2, 3, 5
+  p1.links = {{1, 9}};
+  const std::vector<std::uint64_t> keys0 = {0, 1, 4}, keys1 = {2, 3, 5};
+  std::vector<std::pair<PartSurface, PartSurface>> joined;
+  resolve_feature_links(0, p0.links, 1, keys1, p1.component, joined);
+  resolve_feature_links(1, p1.links, 0, keys0, p0.component, joined);
+  ASSERT_EQ(joined.size(), 1u);
+  EXPECT_EQ(joined[0].second.part, 1u);
+  EXPECT_EQ(joined[0].second.component, 0u);
   const FeaturePart* const parts[] = {&p0, &p1};
-  const FeatureJoin join = join_feature_parts(parts, 6);
+  const FeatureJoin join = join_feature_parts(parts, 6, joined);
   ASSERT_EQ(join.segments, 3u);
+  // Ids by first splat: {0, 4, 3, 5} first at 0, {1} at 1, {2} at 2.
   EXPECT_EQ(join.surface[0], (std::vector<std::uint32_t>{0, 1}));
   EXPECT_EQ(join.surface[1], (std::vector<std::uint32_t>{0, 2}));
   EXPECT_EQ(join.large_segments, 3u);  // 0.5 % of 6 splats is one splat
+  const std::pair<PartSurface, PartSurface> bad[] = {{{0, 0}, {1, 7}}};
+  EXPECT_THROW(join_feature_parts(parts, 6, bad), Error);
 }
 
 }  // namespace

@@ -4,9 +4,10 @@
 //     neighbour pairs' normal agreement to a SpreadHistogram; the histograms of all parts add up
 //     to the whole set's, which decides the sharp threshold (adapt_sharp_threshold);
 //  2. each part finds its own splats' sharp edges, clip planes and the surfaces they form inside
-//     the part, and lists the smooth edges that leave it (compute_feature_part);
-//  3. join_feature_parts merges surfaces that such edges join and numbers them as compute_features
-//     does (in the order of each surface's first splat).
+//     the part, and lists the halo splats those surfaces reach (compute_feature_part);
+//  3. resolve_feature_links finds those splats' surfaces in the parts that own them, and
+//     join_feature_parts merges the pairs and numbers the surfaces as compute_features does (in
+//     the order of each surface's first splat).
 // A part's splats are given in the whole set's order (`keys`, ascending); the results for its own
 // splats are bit for bit those of the whole set when the halo holds every splat within two graph
 // edges of them: feature_halo_reach says how far that is.
@@ -15,6 +16,7 @@
 #include <array>
 #include <cstdint>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "pointillist/features/features.hpp"
@@ -59,10 +61,11 @@ struct FeaturePartInput {
   std::span<const std::uint8_t> owned;     // 1: the part's own splat, 0: halo
 };
 
-// A continuous (smooth) edge from one of the part's splats to a splat of the halo.
+// A halo splat that one of the part's surfaces reaches by smooth edges: the part that owns it
+// has it on a surface of its own, which is the same surface.
 struct FeatureLink {
-  std::uint32_t component;  // the part's surface the own splat belongs to
-  std::uint64_t own, other;  // keys
+  std::uint32_t component;  // the part's surface
+  std::uint64_t other;      // the halo splat's key
 };
 
 // What a part finds for its own splats (in their order).
@@ -75,7 +78,7 @@ struct FeaturePart {
   // splat's key, and the surface's splat count.
   std::vector<std::uint64_t> component_first;
   std::vector<std::uint64_t> component_size;
-  std::vector<FeatureLink> links;          // ordered by own key, then other key
+  std::vector<FeatureLink> links;          // one per halo splat reached, by key
   std::uint64_t row_entries = 0;           // own splats' graph rows, summed (each edge twice overall)
   FeatureStats stats;                      // of the own splats; no edges, no surfaces yet
 };
@@ -92,16 +95,32 @@ FeaturePart compute_feature_part(const FeaturePartInput& part, const FeatureOpti
 // whole set's (graph edges join centres nearer than the sum of their drawn radii).
 inline float feature_halo_reach(float r_own, float r_max) { return r_own + 2.0f * r_max; }
 
+// A part's surface: the part's index in the list given to join_feature_parts, and the surface's
+// number in the part.
+struct PartSurface {
+  std::uint32_t part, component;
+};
+
+// The pairs of surfaces that `links` of part `from` join with part `to`'s, whose own splats'
+// keys (ascending) and surfaces are `to_keys` and `to_components`: links to splats `to` does not
+// own are left alone. Appends to `joined`.
+void resolve_feature_links(std::uint32_t from, std::span<const FeatureLink> links,
+                           std::uint32_t to, std::span<const std::uint64_t> to_keys,
+                           std::span<const std::uint32_t> to_components,
+                           std::vector<std::pair<PartSurface, PartSurface>>& joined);
+
 // What the surfaces of all parts come to.
 struct FeatureJoin {
   std::vector<std::vector<std::uint32_t>> surface;  // per part, per part surface: its id
   std::uint64_t segments = 0, large_segments = 0;
 };
 
-// Joins the parts' surfaces along their links (a link is honoured when the other splat's part
-// lists it back) and numbers the surfaces in the order of their first splats, over `splats`
-// splats in all (large: at least 0.5 % of them), as compute_features does.
-FeatureJoin join_feature_parts(std::span<const FeaturePart* const> parts, std::uint64_t splats);
+// Merges the parts' surfaces that `joined` pairs (resolve_feature_links, over every part's
+// links and the parts that own their splats) and numbers the surfaces in the order of their
+// first splats, over `splats` splats in all (large: at least 0.5 % of them), as
+// compute_features does.
+FeatureJoin join_feature_parts(std::span<const FeaturePart* const> parts, std::uint64_t splats,
+                               std::span<const std::pair<PartSurface, PartSurface>> joined);
 
 // Adds the counts of `from` to `to` (sharp, crossing and antiparallel edges, candidates,
 // clipped splats and their plane histogram, pass-throughs, undefined, nearest-rule and capped
