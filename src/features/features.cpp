@@ -265,7 +265,7 @@ FeaturePart features_over_graph(const NeighbourGraph& graph, std::span<const Vec
       out.component.push_back(label[i]);
       out.row_entries += graph.offsets[i + 1] - graph.offsets[i];
     } else if (label[i] != kNone) {
-      out.links.push_back({label[i], key(i)});
+      out.links.push_back({.component = label[i], .other = key(i)});
     }
   }
   return out;

@@ -9,9 +9,10 @@
 //      the top, skipping every page whose root spheres lie too far from the part's box (a leaf's
 //      disc lies inside each enclosing sphere);
 //   3. the spread pass: each part's own rows, with a halo one radius wide, add to the histogram
-//      that decides the threshold, and give the largest drawn radius;
-//   4. the feature pass: each part with the full halo (feature_halo_reach), its per-leaf results
-//      kept in the work folder; then the surfaces are joined;
+//      that decides the threshold, and give the largest drawn radius of the halo's sharp
+//      neighbours of own splats;
+//   4. the feature pass: each part with the full halo (feature_halo_reach with that radius), its
+//      per-leaf results kept in the work folder; then the surfaces are joined;
 //   5. the section: each page's block, pages of a part bottom-up so that an interior node's
 //      surface id comes from its children's, the top page last; then the head, and the blocks
 //      copied after it in page order.
@@ -310,9 +311,12 @@ void add_features_in_parts(ChunkJobs& jobs, PtlV2PartWriter* writer, const WorkF
   std::optional<ProgressPhase> phase(std::in_place, progress, "features",
                                      2 * file->leaf_count() + file->page_count());
 
-  // Pass 1: the spread, and the largest drawn radius; rank 0 decides the threshold.
+  // Pass 1: the spread (rank 0 decides the threshold), and for each part the largest drawn
+  // radius among the halo splats that are sharp neighbours of its own splats at the given
+  // threshold (adaptation only lowers it): only those need their own rows in pass 2, so they
+  // bound its halo, and an outlier's huge disc widens only the halos it reaches.
   SpreadHistogram spread;
-  float r_max = 0;
+  std::vector<float> r_sharp(parts, 0.0f);
   FeatureStats spread_stats;
   FeatureOptions decided = options;
   {
@@ -321,14 +325,20 @@ void add_features_in_parts(ChunkJobs& jobs, PtlV2PartWriter* writer, const WorkF
       for (const std::size_t k : mine) {
         const PartSplats s = gather_part(pages, std::uint32_t(k), scale, [](float r) { return r; });
         if (s.own_count == 0) continue;
-        r_max = std::max(r_max, s.r_own);
         std::vector<float> drawn(s.radii);
         for (float& r : drawn) r *= scale;
         const NeighbourGraph graph = build_neighbour_graph(s.centers, drawn, pool);
         spread.add(normal_spread_histogram(graph, s.normals, s.owned));
+        for (std::size_t i = 0; i < s.keys.size(); ++i) {
+          if (!s.owned[i]) continue;
+          for (const std::uint32_t j : graph.row(i)) {
+            if (!s.owned[j] && dot(s.normals[i], s.normals[j]) < options.sharp_threshold) {
+              r_sharp[k] = std::max(r_sharp[k], drawn[j]);
+            }
+          }
+        }
         phase->advance(s.own_count);
       }
-      w.put(r_max);
       w.put_vector(spread.slot);
       w.put_vector(spread.fine);
     });
@@ -338,7 +348,6 @@ void add_features_in_parts(ChunkJobs& jobs, PtlV2PartWriter* writer, const WorkF
       if (!root) return;
       for (std::size_t r = 1; r < all.size(); ++r) {
         MessageReader m(all[r]);
-        r_max = std::max(r_max, m.get<float>());
         SpreadHistogram theirs;
         theirs.slot = m.get_vector<std::uint32_t>();
         theirs.fine = m.get_vector<std::array<std::uint64_t, 256>>();
@@ -348,13 +357,11 @@ void add_features_in_parts(ChunkJobs& jobs, PtlV2PartWriter* writer, const WorkF
         spread.add(theirs);
       }
       decided = adapt_sharp_threshold(options, spread, spread_stats);
-      decision.put(r_max);
       decision.put(decided);
       decision.put(spread_stats);
     });
     jobs.broadcast(decision.bytes());
     MessageReader m(decision.bytes());
-    r_max = m.get<float>();
     decided = m.get<FeatureOptions>();
     spread_stats = m.get<FeatureStats>();
   }
@@ -366,8 +373,9 @@ void add_features_in_parts(ChunkJobs& jobs, PtlV2PartWriter* writer, const WorkF
     MessageWriter w;
     step(jobs, [&] {
       for (const std::size_t k : mine) {
-        const PartSplats s = gather_part(pages, std::uint32_t(k), scale,
-                                         [&](float r) { return feature_halo_reach(r, r_max); });
+        const PartSplats s = gather_part(
+            pages, std::uint32_t(k), scale,
+            [&](float r_own) { return feature_halo_reach(r_own, std::max(r_own, r_sharp[k])); });
         if (s.own_count == 0) continue;
         FeaturePart f = compute_feature_part(s.input(), decided, pool);
         save_part(folder.file("features" + std::to_string(k)), f);

@@ -275,11 +275,11 @@ TEST(FeatureParts, LinksJoinTheSurfacesOfTheirSplatsAndIdsFollowFirstSplats) {
   p0.component_first = {0, 1};
   p0.component_size = {2, 1};
   p0.component = {0, 1, 0};  // keys 0, 1, 4
-  p0.links = {{0, 5}};
+  p0.links = {{.component = 0, .other = 5}};
   p1.component_first = {3, 2};
   p1.component_size = {2, 1};
   p1.component = {1, 0, 0};  // keys 2, 3, 5
-  p1.links = {{1, 9}};
+  p1.links = {{.component = 1, .other = 9}};
   const std::vector<std::uint64_t> keys0 = {0, 1, 4}, keys1 = {2, 3, 5};
   std::vector<std::pair<PartSurface, PartSurface>> joined;
   resolve_feature_links(0, p0.links, 1, keys1, p1.component, joined);

@@ -64,8 +64,9 @@ struct FeaturePartInput {
 // A halo splat that one of the part's surfaces reaches by smooth edges: the part that owns it
 // has it on a surface of its own, which is the same surface.
 struct FeatureLink {
-  std::uint32_t component;  // the part's surface
-  std::uint64_t other;      // the halo splat's key
+  std::uint32_t component = 0;  // the part's surface
+  std::uint32_t reserved = 0;   // (no padding bytes: links go to disk and between ranks)
+  std::uint64_t other = 0;      // the halo splat's key
 };
 
 // What a part finds for its own splats (in their order).
@@ -90,10 +91,12 @@ FeaturePart compute_feature_part(const FeaturePartInput& part, const FeatureOpti
                                  ThreadPool& pool, Progress& progress = Progress::none());
 
 // How far around a part the halo must reach: every splat whose centre lies within
-// feature_halo_reach(r_own, r_max) + its own drawn radius of the part's own centres' box, where
-// r_own is the largest drawn radius among the part's own splats and r_max the largest of the
-// whole set's (graph edges join centres nearer than the sum of their drawn radii).
-inline float feature_halo_reach(float r_own, float r_max) { return r_own + 2.0f * r_max; }
+// feature_halo_reach(r_own, r_sharp) + its own drawn radius of the part's own centres' box, where
+// r_own is the largest drawn radius among the part's own splats and r_sharp the largest among
+// the splats that are sharp neighbours of them (n_i·n_j below the threshold), at least r_own;
+// the whole set's largest will do (graph edges join centres nearer than the sum of their drawn
+// radii, and a sharp neighbour's own row must be complete: its shape fit reads it).
+inline float feature_halo_reach(float r_own, float r_sharp) { return r_own + 2.0f * r_sharp; }
 
 // A part's surface: the part's index in the list given to join_feature_parts, and the surface's
 // number in the part.
