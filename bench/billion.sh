@@ -57,7 +57,7 @@ step full-frame "$bin" render "$model" -o "$work/full.png" --memory "$render_mem
   --stats "$work/full.json" -q
 for f in first full; do
   echo "$f frame:"
-  grep -oE '"(bytes_read|pages_loaded|page_count|splats|resident_bytes|select_ms|raster_ms|frame_ms)": *[0-9.]+' \
+  grep -oE '"(bytes_read|pages|pages_loaded|pages_evicted|complete|splats|resident_bytes_peak|select|raster|total)": *[0-9a-z.]+' \
     "$work/$f.json" | sort -u | tr '\n' ' '
   echo
 done
