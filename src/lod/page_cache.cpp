@@ -167,6 +167,11 @@ std::vector<PageRequest> PageCache::choose(std::size_t max_pages,
   // they are not evicted for each other).
   std::vector<PageRequest> chosen;
   std::uint64_t storage = 0;
+  // Once no page can be evicted, none can for the rest of this choice (choosing only marks
+  // pages used and parents busy), so later requests fit without eviction or not at all: the
+  // search over every page is not repeated for each of them (with 263 K pages and the cap
+  // full, that repeated search is the likely cause of a 133 s billion-point frame).
+  bool no_victims = false;
   for (const PageRequest& r : requests_) {
     if (chosen.size() >= max_pages) break;
     if (pages_[r.page] || in_flight_[r.page]) continue;
@@ -174,7 +179,10 @@ std::vector<PageRequest> PageCache::choose(std::size_t max_pages,
     if (!chosen.empty() && storage + read > max_storage_bytes) break;
     if (r.parent_page != kNoPage && !pages_[r.parent_page]) continue;
     const std::uint64_t bytes = source_.page_memory_bytes(r.page);
-    if (!make_room(bytes)) continue;
+    if (no_victims ? stats_.resident_bytes + bytes > cap_ : !make_room(bytes)) {
+      no_victims = true;
+      continue;
+    }
     stats_.resident_bytes += bytes;
     // Keep the parent from being evicted while the page is on its way.
     if (r.parent_page != kNoPage) {
