@@ -411,10 +411,8 @@ void add_features_in_parts(ChunkJobs& jobs, PtlV2PartWriter* writer, const WorkF
       }
     });
   }
-  file.reset();
   step(jobs, [&] {
     if (!root) return;
-    file = PtlV2File::open(path);
     std::vector<const FeaturePart*> listed;
     std::vector<std::size_t> listed_part;
     for (std::size_t k = 0; k < parts; ++k) {
