@@ -22,12 +22,7 @@ struct BvhNode {
 };
 
 // Squared distance from p to the box (0 inside).
-inline float box_distance_squared(const Aabb& box, Vec3f p) {
-  const float dx = std::max(std::max(box.lo.x - p.x, p.x - box.hi.x), 0.0f);
-  const float dy = std::max(std::max(box.lo.y - p.y, p.y - box.hi.y), 0.0f);
-  const float dz = std::max(std::max(box.lo.z - p.z, p.z - box.hi.z), 0.0f);
-  return dx * dx + dy * dy + dz * dz;
-}
+inline float box_distance_squared(const Aabb& box, Vec3f p) { return box.distance_squared(p); }
 
 class BoxTree {
  public:

@@ -307,6 +307,25 @@ FeaturePart compute_feature_part(const FeaturePartInput& part, const FeatureOpti
                              options, pool, progress);
 }
 
+FeaturePartSpread feature_part_spread(const FeaturePartInput& part, const FeatureOptions& options,
+                                      ThreadPool& pool) {
+  validate_feature_options(options);
+  check_part(part);
+  const std::vector<float> drawn = drawn_radii(part.radii, options);
+  const NeighbourGraph graph = build_neighbour_graph(part.centers, drawn, pool);
+  FeaturePartSpread out;
+  out.histogram = normal_spread_histogram(graph, part.normals, part.owned);
+  for (std::size_t i = 0; i < graph.vertex_count(); ++i) {
+    if (!part.owned[i]) continue;
+    for (const std::uint32_t j : graph.row(i)) {
+      if (!part.owned[j] && dot(part.normals[i], part.normals[j]) < options.sharp_threshold) {
+        out.r_sharp = std::max(out.r_sharp, drawn[j]);
+      }
+    }
+  }
+  return out;
+}
+
 FeatureData compute_features(std::span<const Vec3f> centers, std::span<const Vec3f> normals,
                              std::span<const float> radii, ThreadPool& pool,
                              const FeatureOptions& options, Progress& progress) {

@@ -31,7 +31,6 @@
 #include "chunk_stages.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/features/feature_parts.hpp"
-#include "pointillist/features/neighbour_graph.hpp"
 
 namespace pointillist::chunking {
 namespace {
@@ -141,13 +140,18 @@ std::vector<std::uint64_t> own_keys(const Pages& pages, std::uint32_t part) {
   return keys;
 }
 
-float box_distance(const Aabb& box, Vec3f c) {
-  float d2 = 0;
-  for (int a = 0; a < 3; ++a) {
-    const float gap = std::max({box.lo[a] - c[a], c[a] - box.hi[a], 0.0f});
-    d2 += gap * gap;
+float box_distance(const Aabb& box, Vec3f c) { return std::sqrt(box.distance_squared(c)); }
+
+// Calls fn(record, r) for each root r of child page `info` among the records of its parent
+// `page`: consecutive interior records from info.first_root (as PtlV2File::decode_all links
+// them). Returns how many it found (fewer than info.root_count: a damaged table).
+template <class Fn>
+std::uint32_t for_each_root(const PtlV2Page& page, const PtlV2PageInfo& info, Fn&& fn) {
+  std::uint32_t found = 0;
+  for (std::uint32_t v = info.first_root; v < page.nodes.size() && found < info.root_count; ++v) {
+    if (page.nodes[v].child_count != 0) fn(v, found++);
   }
-  return std::sqrt(d2);
+  return found;
 }
 
 // A part's own leaves and the halo around them, in key order.
@@ -200,19 +204,13 @@ PartSplats gather_part(const Pages& pages, std::uint32_t part, float scale, Reac
       if (pages.part[c] == part) continue;
       const PtlV2PageInfo& info = f.page_info(c);
       bool near = false;
-      std::uint32_t v = info.first_root, found = 0;
-      for (; v < page.nodes.size() && found < info.root_count; ++v) {
+      const std::uint32_t found = for_each_root(page, info, [&](std::uint32_t v, std::uint32_t) {
         const SphereNode& root = page.nodes[v];
-        if (root.child_count == 0) continue;
-        ++found;
         near = near || box_distance(box, root.center) - scale * root.radius * 1.001f < limit;
-      }
+      });
       if (near || found < info.root_count) stack.push_back(c);
     }
   }
-  std::vector<Leaf> all;
-  all.reserve(own.size() + halo.size());
-  std::vector<std::uint8_t> mine;
   std::sort(own.begin(), own.end(), [](const Leaf& a, const Leaf& b) { return a.key < b.key; });
   std::sort(halo.begin(), halo.end(), [](const Leaf& a, const Leaf& b) { return a.key < b.key; });
   std::size_t i = 0, j = 0;
@@ -325,18 +323,9 @@ void add_features_in_parts(ChunkJobs& jobs, PtlV2PartWriter* writer, const WorkF
       for (const std::size_t k : mine) {
         const PartSplats s = gather_part(pages, std::uint32_t(k), scale, [](float r) { return r; });
         if (s.own_count == 0) continue;
-        std::vector<float> drawn(s.radii);
-        for (float& r : drawn) r *= scale;
-        const NeighbourGraph graph = build_neighbour_graph(s.centers, drawn, pool);
-        spread.add(normal_spread_histogram(graph, s.normals, s.owned));
-        for (std::size_t i = 0; i < s.keys.size(); ++i) {
-          if (!s.owned[i]) continue;
-          for (const std::uint32_t j : graph.row(i)) {
-            if (!s.owned[j] && dot(s.normals[i], s.normals[j]) < options.sharp_threshold) {
-              r_sharp[k] = std::max(r_sharp[k], drawn[j]);
-            }
-          }
-        }
+        const FeaturePartSpread part = feature_part_spread(s.input(), options, pool);
+        spread.add(part.histogram);
+        r_sharp[k] = part.r_sharp;
         phase->advance(s.own_count);
       }
       w.put_vector(spread.slot);
@@ -503,12 +492,9 @@ void add_features_in_parts(ChunkJobs& jobs, PtlV2PartWriter* writer, const WorkF
         });
         // Interior records of the last level: their children are a child page's roots'.
         for (const std::uint32_t c : pages.children[p]) {
-          const PtlV2PageInfo& info = file->page_info(c);
-          std::uint32_t v = info.first_root, found_roots = 0;
-          for (; v < n && found_roots < info.root_count; ++v) {
-            if (page.nodes[v].child_count == 0) continue;
-            records.surface[v] = root_ids[c].at(found_roots++);
-          }
+          for_each_root(page, file->page_info(c), [&](std::uint32_t v, std::uint32_t r) {
+            records.surface[v] = root_ids[c].at(r);
+          });
         }
         // Interior records with children in the page, last first (children follow parents).
         for (std::size_t r = std::min<std::size_t>(page.last_level_begin, n); r-- > 0;) {

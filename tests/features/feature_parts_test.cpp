@@ -85,11 +85,7 @@ FeatureData by_parts(const Splats& s, int cells, const FeatureOptions& options, 
     Part& part = parts[std::size_t(p)];
     for (std::size_t i = 0; i < n; ++i) {
       const bool mine = cell_of(s.centers[i]) == p;
-      float d2 = 0;
-      for (int a = 0; a < 3; ++a) {
-        const float gap = std::max({own.lo[a] - s.centers[i][a], s.centers[i][a] - own.hi[a], 0.0f});
-        d2 += gap * gap;
-      }
+      const float d2 = own.distance_squared(s.centers[i]);
       const float limit = reach + s.radii[i] * options.radius_scale;
       if (!mine && !(d2 < limit * limit)) continue;
       part.centers.push_back(s.centers[i]);
@@ -103,10 +99,7 @@ FeatureData by_parts(const Splats& s, int cells, const FeatureOptions& options, 
   SpreadHistogram spread;
   for (const Part& part : parts) {
     if (part.keys.empty()) continue;
-    std::vector<float> drawn(part.radii);
-    for (float& r : drawn) r *= options.radius_scale;
-    const NeighbourGraph graph = build_neighbour_graph(part.centers, drawn, pool);
-    spread.add(normal_spread_histogram(graph, part.normals, part.owned));
+    spread.add(feature_part_spread(part.input(), options, pool).histogram);
   }
   FeatureStats spread_stats;
   const FeatureOptions decided = adapt_sharp_threshold(options, spread, spread_stats);

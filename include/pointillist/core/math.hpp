@@ -84,6 +84,13 @@ struct Aabb {
     const Vec3f e = extent();
     return (e.x >= e.y && e.x >= e.z) ? 0 : (e.y >= e.z ? 1 : 2);
   }
+  // Squared distance from p to the box (0 inside).
+  constexpr float distance_squared(Vec3f p) const {
+    const float dx = std::max(std::max(lo.x - p.x, p.x - hi.x), 0.0f);
+    const float dy = std::max(std::max(lo.y - p.y, p.y - hi.y), 0.0f);
+    const float dz = std::max(std::max(lo.z - p.z, p.z - hi.z), 0.0f);
+    return dx * dx + dy * dy + dz * dz;
+  }
 };
 
 struct Sphere {

@@ -61,6 +61,16 @@ struct FeaturePartInput {
   std::span<const std::uint8_t> owned;     // 1: the part's own splat, 0: halo
 };
 
+// What a part adds to the spread (its own rows; a halo one drawn radius wide is enough), and the
+// largest drawn radius among its halo splats that are sharp neighbours of its own splats at
+// options.sharp_threshold (which adaptation only lowers): feature_halo_reach's r_sharp.
+struct FeaturePartSpread {
+  SpreadHistogram histogram;
+  float r_sharp = 0;
+};
+FeaturePartSpread feature_part_spread(const FeaturePartInput& part,
+                                      const FeatureOptions& options, ThreadPool& pool);
+
 // A halo splat that one of the part's surfaces reaches by smooth edges: the part that owns it
 // has it on a surface of its own, which is the same surface.
 struct FeatureLink {
