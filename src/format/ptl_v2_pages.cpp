@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "pointillist/core/error.hpp"
+#include "ptl_v2_layout.hpp"
 
 namespace pointillist {
 namespace {
@@ -54,24 +55,33 @@ class PtlV2Pages final : public PageSource {
   std::uint64_t open_bytes() const override { return open_bytes_; }
   SphereTreeView summary() const override { return summary_; }
 
-  void load(std::uint32_t page, HierarchyPage& out) const override {
+  void load(std::uint32_t page, HierarchyPage& out, const PagePrefix& prefix) const override {
     out.nodes.clear();
     out.child_page.clear();
     PackedPage& packed = out.packed;
-    file_.pack_page(page, packed);
+    // What `out` holds already (an earlier prefix of this page) is kept, not read again.
+    const auto had = static_cast<std::uint32_t>(packed.records.size());
+    file_.pack_page(page, packed, prefix);
+    const PtlV2PageInfo& info = file_.page_info(page);
+    const auto count = static_cast<std::uint32_t>(packed.records.size());
+    out.storage_bytes = std::uint64_t{info.root_count} * ptl2::kRootEntrySize +
+                        std::uint64_t{count - had} * (file_.has_colors() ? 6 : 4);
+    if (count < info.node_count) {
+      load_prefix_rest(page, out);
+      return;
+    }
     const auto corrupt = [&](std::uint32_t node, const std::string& what) {
       throw FormatError(file_.path() + ": page " + str(page) + ", node " + str(node) + ": " + what +
                         "; the model file is corrupt (convert it again)");
     };
     // Link the last level's interior nodes to the child pages that hold their children.
-    const auto count = static_cast<std::uint32_t>(packed.records.size());
     std::vector<std::uint8_t> linked(count - packed.last_level_begin, 0);
     std::uint32_t previous = 0;
     for (const std::uint32_t q : children_[page]) {
-      const PtlV2PageInfo& info = file_.page_info(q);
+      const PtlV2PageInfo& child = file_.page_info(q);
       std::uint32_t offset = 0;
-      for (std::uint32_t j = 0; j < info.root_count; ++j) {
-        const std::uint32_t node = info.first_root + j;
+      for (std::uint32_t j = 0; j < child.root_count; ++j) {
+        const std::uint32_t node = child.first_root + j;
         const std::uint32_t children = quant::record_child_count(packed.records[node]);
         if (node < packed.last_level_begin || children == 0) {
           corrupt(node, "page " + str(q) + " continues it, but it is not an interior node of the "
@@ -105,6 +115,41 @@ class PtlV2Pages final : public PageSource {
   }
 
  private:
+  // A page's first levels were packed: the last one's interior nodes link to the next level's
+  // records in this page, and the features are the whole page's cut to the loaded records.
+  void load_prefix_rest(std::uint32_t page, HierarchyPage& out) const {
+    PackedPage& packed = out.packed;
+    const auto count = static_cast<std::uint32_t>(packed.records.size());
+    std::uint32_t first = count;
+    for (std::uint32_t i = packed.last_level_begin; i < count; ++i) {
+      const std::uint32_t children = quant::record_child_count(packed.records[i]);
+      if (children == 0) continue;
+      packed.links.push_back({page, first});
+      first += children;
+    }
+    if (!features_) {
+      out.features.clear();
+      return;
+    }
+    PageFeatures& f = out.features;
+    file_.page_features(
+        page,
+        [&](std::uint32_t k) {
+          const std::uint32_t rec = k < count ? packed.records[k] : file_.page_record(page, k);
+          return quant::record_child_count(rec) == 0;
+        },
+        f);
+    f.surface.resize(count);
+    const auto kept = static_cast<std::size_t>(
+        std::lower_bound(f.clipped.begin(), f.clipped.end(), count) - f.clipped.begin());
+    f.clipped.resize(kept);
+    f.clipped_mode.resize(kept);
+    if (!f.clipped_first.empty()) {
+      f.clipped_first.resize(kept + 1);
+      f.planes.resize(f.clipped_first[kept]);
+    }
+  }
+
   const PtlV2File& file_;
   std::vector<std::vector<std::uint32_t>> children_;  // child pages of each page, by first root
   std::vector<std::uint64_t> link_count_;             // roots of each page's child pages

@@ -270,7 +270,9 @@ PtlV2File::~PtlV2File() = default;
 template <class OnRecord>
 std::uint32_t PtlV2File::scan_page(std::uint32_t page, std::vector<Sphere>& root_spheres,
                                    std::vector<std::uint8_t>& root_child_counts,
-                                   OnRecord&& on_record) const {
+                                   OnRecord&& on_record, const PagePrefix& prefix,
+                                   std::uint32_t* scanned,
+                                   std::span<const std::uint32_t> known) const {
   assert(page < pages_.size());
   const PtlV2PageInfo& info = pages_[page];
   const auto* base = reinterpret_cast<const std::uint8_t*>(map_->bytes.view().data());
@@ -310,7 +312,13 @@ std::uint32_t PtlV2File::scan_page(std::uint32_t page, std::vector<Sphere>& root
   std::uint64_t next_parent = 0;  // scan position for interior records
   std::uint64_t i = 0, level_begin = 0;
   std::uint32_t levels = 0;
+  std::uint32_t node_level = 0;  // the level holding prefix.node, once reached
+  bool partial = false;
   while (need > 0 && i < count) {
+    if (prefix.enough(levels, i, node_level)) {
+      partial = true;
+      break;
+    }
     if (need > count - i) {
       fail_at(path_, records_at + i * rs,
               which() + "level " + str(levels + 1) + " needs " + str(need) +
@@ -319,6 +327,7 @@ std::uint32_t PtlV2File::scan_page(std::uint32_t page, std::vector<Sphere>& root
     level_begin = i;
     const std::uint64_t level_end = i + need;
     ++levels;
+    if (node_level == 0 && prefix.node < level_end) node_level = levels;
     need = 0;
     while (i < level_end) {
       // The level's records are exactly the children of these parents, so the scan stays
@@ -336,8 +345,9 @@ std::uint32_t PtlV2File::scan_page(std::uint32_t page, std::vector<Sphere>& root
       for (std::uint32_t c = 0; c < k; ++c, ++i) {
         const std::uint64_t at = records_at + i * rs;
         const std::uint8_t* r = base + at;
-        const std::uint32_t rec = load_u32(r);
-        const std::uint16_t color = rs == 6 ? load_u16(r + 4) : 0;
+        const bool is_known = i < known.size();
+        const std::uint32_t rec = is_known ? known[i] : load_u32(r);
+        const std::uint16_t color = rs == 6 && !is_known ? load_u16(r + 4) : 0;
         const std::uint32_t code = bits(rec, kSphereShift, kSphereBits);
         const std::uint32_t children = record_child_count(rec);
         const std::uint32_t normal = bits(rec, kNormalShift, kNormalBits);
@@ -358,10 +368,12 @@ std::uint32_t PtlV2File::scan_page(std::uint32_t page, std::vector<Sphere>& root
         }
         child_counts[i] = static_cast<std::uint8_t>(children);
         need += child_counts[i];
-        on_record(static_cast<std::uint32_t>(i), rec, color, parent, c == 0);
+        if (!is_known) on_record(static_cast<std::uint32_t>(i), rec, color, parent, c == 0);
       }
     }
   }
+  if (scanned != nullptr) *scanned = static_cast<std::uint32_t>(i);
+  if (partial) return static_cast<std::uint32_t>(level_begin);
   if (i != count) {
     fail_at(path_, records_at + i * rs,
             which() + "record " + str(i) + " of " + str(count) +
@@ -394,20 +406,39 @@ void PtlV2File::decode_page(std::uint32_t page, PtlV2Page& out) const {
       });
 }
 
-void PtlV2File::pack_page(std::uint32_t page, PackedPage& out) const {
+std::uint32_t PtlV2File::page_record(std::uint32_t page, std::uint32_t k) const {
+  assert(page < pages_.size() && k < pages_[page].node_count);
+  const PtlV2PageInfo& info = pages_[page];
+  const auto* base = reinterpret_cast<const std::uint8_t*>(map_->bytes.view().data());
+  return load_u32(base + info.offset + std::uint64_t{info.root_count} * kRootEntrySize +
+                  std::uint64_t{k} * record_size_);
+}
+
+void PtlV2File::pack_page(std::uint32_t page, PackedPage& out, const PagePrefix& prefix) const {
   const std::uint32_t count = pages_[page].node_count;
+  const std::size_t known = std::min<std::size_t>(out.records.size(), count);
   out.records.resize(count);
   out.colors.resize(has_colors_ ? count : 0);
   out.links.clear();
   out.leaf_trim = leaf_trim_;
   std::vector<Sphere> root_spheres;
   std::vector<std::uint8_t> root_child_counts;
+  std::uint32_t scanned = count;
   out.last_level_begin = scan_page(
       page, root_spheres, root_child_counts,
       [&](std::uint32_t i, std::uint32_t rec, std::uint16_t color, PageParent, bool) {
         out.records[i] = rec;
         if (has_colors_) out.colors[i] = color;
-      });
+      },
+      prefix, &scanned, std::span<const std::uint32_t>(out.records.data(), known));
+  if (scanned < count) {
+    out.records.resize(scanned);
+    out.records.shrink_to_fit();
+    if (has_colors_) {
+      out.colors.resize(scanned);
+      out.colors.shrink_to_fit();
+    }
+  }
   std::uint32_t first_level = 0;
   for (const std::uint8_t k : root_child_counts) first_level += k;
   out.index_links(first_level);

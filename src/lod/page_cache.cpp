@@ -18,7 +18,8 @@ namespace pointillist {
 struct PageCache::Loader {
   std::mutex mutex;
   std::condition_variable wake, idle;
-  std::deque<PageRequest> queue;  // handed over, not yet decoded
+  // Handed over, not yet decoded: each with what is resident of the page (a copy), continued.
+  std::deque<std::pair<PageRequest, std::unique_ptr<HierarchyPage>>> queue;
   std::vector<std::pair<PageRequest, std::unique_ptr<HierarchyPage>>> ready;
   std::exception_ptr error;
   std::size_t busy = 0;  // pages being decoded now
@@ -42,14 +43,14 @@ void PageCache::loader_loop() {
   for (;;) {
     l.wake.wait(lock, [&] { return l.stopping || !l.queue.empty(); });
     if (l.stopping) return;
-    const PageRequest r = l.queue.front();
+    const PageRequest r = l.queue.front().first;
+    std::unique_ptr<HierarchyPage> page = std::move(l.queue.front().second);
     l.queue.pop_front();
     ++l.busy;
     lock.unlock();
-    auto page = std::make_unique<HierarchyPage>();
     std::exception_ptr error;
     try {
-      source_.load(r.page, *page);
+      source_.load(r.page, *page, load_prefix(r));
     } catch (...) {
       error = std::current_exception();
     }
@@ -76,7 +77,7 @@ std::size_t PageCache::request_in_background(std::size_t max_pages,
     std::lock_guard<std::mutex> lock(loader_->mutex);
     for (const PageRequest& r : chosen) {
       in_flight_[r.page] = 1;
-      loader_->queue.push_back(r);
+      loader_->queue.emplace_back(r, start_page(r.page));
     }
     in_flight_count_ += chosen.size();
   }
@@ -122,6 +123,8 @@ PageCache::PageCache(const PageSource& source, std::uint64_t memory_cap, ThreadP
   parent_.assign(n, kNoPage);
   resident_children_.assign(n, 0);
   last_used_.assign(n, 0);
+  memory_.assign(n, 0);
+  reserved_.assign(n, 0);
   requested_.assign(n, 0);
   in_flight_.assign(n, 0);
   stats_.bytes_read = source.open_bytes();
@@ -140,14 +143,18 @@ bool PageCache::make_room(std::uint64_t bytes) {
   while (stats_.resident_bytes + bytes > cap_) {
     std::uint32_t victim = kNoPage;
     for (std::uint32_t p = 1; p < pages_.size(); ++p) {
-      if (!pages_[p] || resident_children_[p] != 0 || last_used_[p] >= frame_number_) continue;
+      if (!pages_[p] || resident_children_[p] != 0 || last_used_[p] >= frame_number_ ||
+          in_flight_[p]) {
+        continue;
+      }
       if (victim == kNoPage || last_used_[p] < last_used_[victim] ||
           (last_used_[p] == last_used_[victim] && p > victim)) {
         victim = p;
       }
     }
     if (victim == kNoPage) return false;
-    stats_.resident_bytes -= source_.page_memory_bytes(victim);
+    stats_.resident_bytes -= memory_[victim];
+    memory_[victim] = 0;
     pages_[victim].reset();
     if (parent_[victim] != kNoPage) --resident_children_[parent_[victim]];
     parent_[victim] = kNoPage;
@@ -174,18 +181,25 @@ std::vector<PageRequest> PageCache::choose(std::size_t max_pages,
   bool no_victims = false;
   for (const PageRequest& r : requests_) {
     if (chosen.size() >= max_pages) break;
-    if (pages_[r.page] || in_flight_[r.page]) continue;
+    if (in_flight_[r.page]) continue;
+    // A resident page is deepened (it holds only its first levels), from where it is used.
+    const HierarchyPage* have = pages_[r.page].get();
+    if (have != nullptr && r.first < have->node_count()) continue;
     const std::uint64_t read = source_.page_storage_bytes(r.page);
     if (!chosen.empty() && storage + read > max_storage_bytes) break;
-    if (r.parent_page != kNoPage && !pages_[r.parent_page]) continue;
-    const std::uint64_t bytes = source_.page_memory_bytes(r.page);
+    if (have == nullptr && r.parent_page != kNoPage && !pages_[r.parent_page]) continue;
+    const std::uint64_t full = source_.page_memory_bytes(r.page);
+    const std::uint64_t bytes = full - std::min(full, memory_[r.page]);
+    // The page being deepened is in use this frame: make_room leaves it alone.
+    if (have != nullptr) last_used_[r.page] = frame_number_;
     if (no_victims ? stats_.resident_bytes + bytes > cap_ : !make_room(bytes)) {
       no_victims = true;
       continue;
     }
     stats_.resident_bytes += bytes;
+    reserved_[r.page] = bytes;
     // Keep the parent from being evicted while the page is on its way.
-    if (r.parent_page != kNoPage) {
+    if (have == nullptr && r.parent_page != kNoPage) {
       ++resident_children_[r.parent_page];
       last_used_[r.parent_page] = std::max(last_used_[r.parent_page], frame_number_);
     }
@@ -199,11 +213,26 @@ std::vector<PageRequest> PageCache::choose(std::size_t max_pages,
   return chosen;
 }
 
+std::unique_ptr<HierarchyPage> PageCache::start_page(std::uint32_t page) const {
+  // A page resident in part is continued from a copy of what it holds (the source does not
+  // read that again); the resident one stays in use until the new one is adopted.
+  const HierarchyPage* have = pages_[page].get();
+  return have != nullptr ? std::make_unique<HierarchyPage>(*have)
+                         : std::make_unique<HierarchyPage>();
+}
+
 void PageCache::adopt(const PageRequest& r, std::unique_ptr<HierarchyPage> page) {
   const bool packed = pages_[0] ? pages_[0]->is_packed() : page->is_packed();
-  if (page->node_count() != source_.page_node_count(r.page) ||
-      page->memory_bytes() != source_.page_memory_bytes(r.page) || page->is_packed() != packed ||
-      (!packed && page->child_page.size() != page->nodes.size())) {
+  const std::uint64_t memory = page->memory_bytes(), full = source_.page_memory_bytes(r.page);
+  const HierarchyPage* had = pages_[r.page].get();
+  // A page comes whole, or (packed) as its first levels: more records than it had, fewer than
+  // the page table's, at most the page's memory.
+  const bool whole = page->node_count() == source_.page_node_count(r.page);
+  if ((whole ? memory != full
+             : !packed || page->node_count() > source_.page_node_count(r.page) ||
+                   memory > full) ||
+      (had != nullptr && page->node_count() <= had->node_count()) ||
+      page->is_packed() != packed || (!packed && page->child_page.size() != page->nodes.size())) {
     throw FormatError("page " + std::to_string(r.page) + " loaded as " +
                       std::to_string(page->node_count()) + " nodes in " +
                       std::to_string(page->memory_bytes()) + " bytes where the page table says " +
@@ -211,12 +240,20 @@ void PageCache::adopt(const PageRequest& r, std::unique_ptr<HierarchyPage> page)
                       std::to_string(source_.page_memory_bytes(r.page)) +
                       "; the model file is corrupt (convert it again)");
   }
+  // The reservation was for the whole page beyond what it held; keep what it takes.
+  stats_.resident_bytes = stats_.resident_bytes - reserved_[r.page] - memory_[r.page] + memory;
+  reserved_[r.page] = 0;
+  memory_[r.page] = memory;
+  stats_.bytes_read += page->storage_bytes;
+  if (had != nullptr) {
+    ++stats_.pages_deepened;
+  } else {
+    parent_[r.page] = r.parent_page;
+    ++stats_.pages_loaded;
+    ++stats_.resident_pages;
+  }
   pages_[r.page] = std::move(page);
-  parent_[r.page] = r.parent_page;
   last_used_[r.page] = std::max(last_used_[r.page], frame_number_);
-  stats_.bytes_read += source_.page_storage_bytes(r.page);
-  ++stats_.pages_loaded;
-  ++stats_.resident_pages;
 }
 
 std::size_t PageCache::load_requested(ThreadPool& pool, std::size_t max_pages,
@@ -224,9 +261,9 @@ std::size_t PageCache::load_requested(ThreadPool& pool, std::size_t max_pages,
   const std::vector<PageRequest> chosen = choose(max_pages, max_storage_bytes);
   std::vector<std::unique_ptr<HierarchyPage>> loaded(chosen.size());
   pool.run(chosen.size(), [&](std::size_t i) {
-    auto page = std::make_unique<HierarchyPage>();
     const PageRequest& r = chosen[i];
-    source_.load(r.page, *page);
+    std::unique_ptr<HierarchyPage> page = start_page(r.page);
+    source_.load(r.page, *page, load_prefix(r));
     loaded[i] = std::move(page);
   });
   for (std::size_t i = 0; i < chosen.size(); ++i) adopt(chosen[i], std::move(loaded[i]));

@@ -89,8 +89,9 @@ class InMemoryPages final : public PageSource {
   }
   std::uint64_t open_bytes() const override { return 0; }
   SphereTreeView summary() const override { return summary_; }
-  void load(std::uint32_t page, HierarchyPage& out) const override {
+  void load(std::uint32_t page, HierarchyPage& out, const PagePrefix&) const override {
     out = pages_.at(page);
+    out.storage_bytes = page_storage_bytes(page);
   }
 
  private:

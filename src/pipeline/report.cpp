@@ -97,6 +97,7 @@ std::string render_report_json(const RenderReport& r) {
     j["resident_bytes"] = p.cache.resident_bytes;
     j["resident_bytes_peak"] = p.cache.resident_bytes_peak;
     j["pages_loaded"] = p.cache.pages_loaded;
+    j["pages_deepened"] = p.cache.pages_deepened;
     j["pages_evicted"] = p.cache.pages_evicted;
     j["complete"] = p.complete;
   }

@@ -358,6 +358,7 @@ PagingStats Renderer::paging_stats() const {
     p.cache.resident_bytes_peak += c.resident_bytes_peak;
     p.cache.resident_pages += c.resident_pages;
     p.cache.pages_loaded += c.pages_loaded;
+    p.cache.pages_deepened += c.pages_deepened;
     p.cache.pages_evicted += c.pages_evicted;
     p.complete = p.complete && s->paged->complete();
   }

@@ -183,6 +183,46 @@ TEST(PtlV2Features, EveryPageCarriesItsNodesFeatures) {
   EXPECT_TRUE(plain.features.empty());
 }
 
+TEST(PtlV2Features, APagesFirstLevelsCarryTheFeaturesOfTheirNodes) {
+  // A page loaded in part (PagePrefix) carries the features of the nodes it holds: those of the
+  // whole page's load (checked against the tree above) cut to its records.
+  ThreadPool pool(2);
+  pointillist::testing::TempDir dir;
+  const std::string path = dir.file("cube.ptl");
+  write_cube_with_features(path, pool);
+  const auto file = PtlV2File::open(path);
+  const auto source = ptl_v2_page_source(*file);
+  std::size_t partial = 0, clipped = 0;
+  for (std::uint32_t p = 1; p < file->page_count(); ++p) {
+    HierarchyPage whole;
+    source->load(p, whole);
+    for (std::uint32_t extra = 0; extra + 1 < file->page_info(p).level_count; ++extra) {
+      HierarchyPage part;
+      source->load(p, part, {.node = 0, .extra_levels = extra});
+      const std::uint32_t n = part.node_count();
+      ASSERT_LT(n, whole.node_count());
+      ++partial;
+      ASSERT_EQ(part.features.surface.size(), n);
+      for (std::uint32_t r = 0; r < n; ++r) {
+        EXPECT_EQ(part.features.surface[r], whole.features.surface[r]);
+        ClipMode mode_part, mode_whole;
+        const auto a = part.features.planes_of(r, mode_part);
+        const auto b = whole.features.planes_of(r, mode_whole);
+        ASSERT_EQ(a.size(), b.size()) << "page " << p << " record " << r;
+        EXPECT_EQ(mode_part, mode_whole);
+        for (std::size_t k = 0; k < a.size(); ++k) {
+          EXPECT_EQ(a[k].n, b[k].n);
+          EXPECT_EQ(a[k].h, b[k].h);
+        }
+        clipped += !a.empty();
+      }
+      EXPECT_LE(part.memory_bytes(), whole.memory_bytes());
+    }
+  }
+  EXPECT_GT(partial, 4u);
+  EXPECT_GT(clipped, 0u);
+}
+
 TEST(PtlV2Features, FilesWithoutThemStillLoadAndKeepTheirBytes) {
   ThreadPool pool(1);
   const SphereTree tree = cube_tree(pool);

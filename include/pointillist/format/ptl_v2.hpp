@@ -17,14 +17,13 @@
 
 #include "pointillist/core/math.hpp"
 #include "pointillist/core/thread_pool.hpp"
+#include "pointillist/lod/pages.hpp"
 #include "pointillist/lod/quantization.hpp"
 #include "pointillist/lod/sphere_tree.hpp"
 #include "pointillist/lod/tree_features.hpp"
 
 namespace pointillist {
 
-struct PackedPage;    // lod/pages.hpp
-struct PageFeatures;  // lod/pages.hpp
 namespace ptl2 {
 struct FeatureSection;  // format/ptl_v2_features.hpp (private)
 }
@@ -237,8 +236,13 @@ class PtlV2File {
   // Copies page `page`'s records into `out` in their packed form (decoded later, during the
   // traversal), with last_level_begin, the link index (PackedPage::index_links), root_parent
   // (page 0) and leaf_trim; out.links is left empty for the caller, who knows the child pages.
-  // Validates the page as decode_page does.
-  void pack_page(std::uint32_t page, PackedPage& out) const;
+  // Validates the page as decode_page does. With a `prefix` that ends before the page does,
+  // only its first levels are copied (and validated): last_level_begin is then the last copied
+  // level's first record. Records already in `out` (an earlier prefix of this page) are kept,
+  // not read again.
+  void pack_page(std::uint32_t page, PackedPage& out, const PagePrefix& prefix = {}) const;
+  // Record k (< node count) of page `page`, its bits 0..31 as stored (not validated).
+  std::uint32_t page_record(std::uint32_t page, std::uint32_t k) const;
 
   // The whole hierarchy, breadth-first, node i being node i of the tree that was written:
   // decoded spheres (each enclosing the written sphere and its decoded children), decoded
@@ -305,11 +309,14 @@ class PtlV2File {
   // Validates page `page` (root table, page 0's root against the header's sphere, then each
   // record and the level structure) and calls
   // on_record(index, record bits 0..31, RGB 565 or 0, parent, is_first_child) for each record in
-  // order. Returns the index of the first record of the last level.
+  // order. Returns the index of the first record of the last level. With a `prefix`, stops
+  // after the first level where it is enough (`scanned`: the records seen). The `known` first
+  // records (whole levels) are taken from there, not read, and not passed to on_record.
   template <class OnRecord>
   std::uint32_t scan_page(std::uint32_t page, std::vector<Sphere>& root_spheres,
-                          std::vector<std::uint8_t>& root_child_counts,
-                          OnRecord&& on_record) const;
+                          std::vector<std::uint8_t>& root_child_counts, OnRecord&& on_record,
+                          const PagePrefix& prefix = {}, std::uint32_t* scanned = nullptr,
+                          std::span<const std::uint32_t> known = {}) const;
   std::string path_;
   std::unique_ptr<Mapping> map_;
   std::uint64_t size_ = 0;

@@ -5,6 +5,7 @@
 // are loaded, coarsest (largest on screen) first.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -22,14 +23,19 @@ struct PageCacheStats {
   std::uint64_t resident_bytes_peak = 0;
   std::uint64_t resident_pages = 0;
   std::uint64_t pages_loaded = 0;     // loads so far (a page dropped and loaded again counts twice)
+  std::uint64_t pages_deepened = 0;   // loads of more levels of a page resident in part
   std::uint64_t pages_evicted = 0;
 };
 
-// A page a traversal wants: the page holding the children of a node drawn as a stand-in.
+// A page a traversal wants: the page holding the children of a node drawn as a stand-in. The
+// page may be resident with only its first levels (pages.hpp): it is then deepened.
 struct PageRequest {
   std::uint32_t page;
   std::uint32_t parent_page;  // the page holding that node
   float priority;             // the node's projected radius (r / z): larger loads first
+  std::uint32_t first = 0;    // the record of `page` holding the node's first child
+  // Levels below the children's that the view will want too (from the node's size on screen).
+  std::uint32_t extra_levels = 0;
 };
 
 // Not thread-safe, except that the loader thread works on its own; one frame at a time.
@@ -54,18 +60,34 @@ class PageCache {
   const PageTable& pages() const { return pages_; }
   // The frame used `page` (resident): it is evicted last.
   void mark_used(std::uint32_t page) { last_used_[page] = frame_number_; }
-  // The frame wants `r.page` (not resident); a page already requested or on its way is ignored.
+  // The frame wants `r.page` (not resident, or resident without record r.first); a page on its
+  // way is ignored, one already requested keeps the largest priority and record.
   void request(const PageRequest& r) {
-    if (requested_[r.page] || in_flight_[r.page]) return;
-    requested_[r.page] = 1;
+    if (in_flight_[r.page]) return;
+    if (const std::uint32_t k = requested_[r.page]) {
+      PageRequest& q = requests_[k - 1];
+      q.priority = std::max(q.priority, r.priority);
+      q.first = std::max(q.first, r.first);
+      q.extra_levels = std::max(q.extra_levels, r.extra_levels);
+      return;
+    }
     requests_.push_back(r);
+    requested_[r.page] = static_cast<std::uint32_t>(requests_.size());
   }
+
+  // A page is loaded (and deepened, reading only what it lacks) by whole levels: through the
+  // children asked for and the levels the view will want below them, and at least this many
+  // records (the first levels of a page are small). A view whose detail ends in a page's first
+  // levels reads no more of it. Page 0 is loaded whole.
+  static constexpr std::uint32_t kMinLoadNodes = 256;
 
   // Loads the pages the last frame requested, largest on screen first, at most `max_pages` of
   // them and at most `max_storage_bytes` read (at least one page is always loaded when one
-  // fits in memory, however large), in parallel on `pool`. A page is loaded only when it fits
-  // under the cap after evicting pages the last frame did not use (least recently used first;
-  // only pages without resident child pages, never page 0). Returns the number of pages loaded.
+  // fits in memory, however large), in parallel on `pool`: each from its first level down to
+  // the levels asked for (see kMinLoadNodes; all of page 0). A page is loaded only
+  // when the whole of it fits under the cap after evicting pages the last frame did not use
+  // (least recently used first; only pages without resident child pages, never page 0); what it
+  // takes short of that is given back once loaded. Returns the number of pages loaded.
   std::size_t load_requested(ThreadPool& pool, std::size_t max_pages = SIZE_MAX,
                              std::uint64_t max_storage_bytes = UINT64_MAX);
   // Background loading, as an interactive viewer does it: hands the pages the last frame
@@ -90,8 +112,15 @@ class PageCache {
 
  private:
   bool make_room(std::uint64_t bytes);
+  // What to load of a requested page.
+  static PagePrefix load_prefix(const PageRequest& r) {
+    if (r.page == 0) return {};
+    return {.node = r.first, .extra_levels = r.extra_levels, .min_nodes = kMinLoadNodes};
+  }
   // Chooses requests to load (see load_requested), reserving their memory; clears requests_.
   std::vector<PageRequest> choose(std::size_t max_pages, std::uint64_t max_storage_bytes);
+  // A page to load `page` into: empty, or a copy of what is resident of it (continued).
+  std::unique_ptr<HierarchyPage> start_page(std::uint32_t page) const;
   // Makes a loaded page resident (its memory was reserved by choose).
   void adopt(const PageRequest& r, std::unique_ptr<HierarchyPage> page);
   void take_ready();
@@ -104,8 +133,10 @@ class PageCache {
   std::vector<std::uint32_t> parent_;            // parent page of each resident page
   std::vector<std::uint32_t> resident_children_;  // resident child pages of each page
   std::vector<std::uint64_t> last_used_;         // frame number of the last use
+  std::vector<std::uint64_t> memory_;            // memory of each resident page (0 elsewhere)
+  std::vector<std::uint64_t> reserved_;          // memory reserved for a page being loaded
   std::vector<PageRequest> requests_;
-  std::vector<std::uint8_t> requested_;          // per page: already in requests_
+  std::vector<std::uint32_t> requested_;         // per page: 1 + its index in requests_, or 0
   std::vector<std::uint8_t> in_flight_;          // per page: handed to the loader
   std::size_t in_flight_count_ = 0;
   std::uint64_t frame_number_ = 0;

@@ -104,11 +104,16 @@ struct PageFeatures {
 // Decoded form (`nodes` not empty): a node's children are nodes[first_child .. first_child +
 // child_count) of its own page when child_page[i] is kNoPage, and of page child_page[i]
 // otherwise. Packed form (`nodes` empty): see PackedPage.
+//
+// A packed page may hold only its first levels (PageSource::load's prefix): the interior
+// nodes of its last loaded level then link to their children's records in the same page, past
+// the loaded ones (PageLink{this page, first}, first >= node_count()).
 struct HierarchyPage {
   std::vector<SphereNode> nodes;
   std::vector<std::uint32_t> child_page;  // one per node; kNoPage: children (if any) are here
   PackedPage packed;
   PageFeatures features;  // the nodes' sharp features, when the model has them
+  std::uint64_t storage_bytes = 0;  // bytes read from storage to load what is here
 
   bool is_packed() const { return nodes.empty(); }
   std::uint32_t node_count() const {
@@ -124,6 +129,21 @@ struct HierarchyPage {
                                                    !packed.colors.empty())
                         : memory_bytes(nodes.size())) +
            (features.empty() ? 0 : features.memory_bytes());
+  }
+};
+
+// How much of a page to load: whole levels, through the one holding record `node`, then
+// `extra_levels` more, and on until they hold at least `min_nodes` records. The default is the
+// whole page.
+struct PagePrefix {
+  std::uint32_t node = UINT32_MAX;
+  std::uint32_t extra_levels = 0;
+  std::uint32_t min_nodes = 0;
+
+  // Whether a prefix of `levels` whole levels ending before record `end` is enough, where the
+  // level holding `node` is the `node_level`-th (0 while not reached).
+  bool enough(std::uint32_t levels, std::uint64_t end, std::uint32_t node_level) const {
+    return node_level != 0 && levels >= node_level + extra_levels && end >= min_nodes;
   }
 };
 
@@ -148,9 +168,12 @@ class PageSource {
   // arrays); null when the pages carry none.
   virtual const TreeFeatures* features() const { return nullptr; }
   // Loads page `page` into `out`, decoded or packed (every page of a source in the same form),
-  // with its features when the source has them.
-  // Safe to call concurrently for different pages. Throws FormatError or IoError.
-  virtual void load(std::uint32_t page, HierarchyPage& out) const = 0;
+  // with its features when the source has them, and out.storage_bytes. A packed source may load
+  // only the page's first levels (`prefix`; see HierarchyPage), and continues a prefix of the
+  // page that `out` holds (from an earlier load) without reading it again; a decoded one loads
+  // the whole page. Safe to call concurrently for different pages. Throws FormatError or
+  // IoError.
+  virtual void load(std::uint32_t page, HierarchyPage& out, const PagePrefix& prefix = {}) const = 0;
 };
 
 // `tree` cut into pages (with its features, when tree.features is set): page 0 takes the root and then whole sibling groups breadth-first while

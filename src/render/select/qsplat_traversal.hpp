@@ -10,9 +10,9 @@
 // plain depth-first order whatever the thread count. A node is expanded at the top only when its
 // children are resident; anything else is left for its task.
 //
-// Where a refined node's children are in a page that is not resident, the node stands in for
-// its subtree: it is drawn whatever its size (even when its mean normal faces away, lit from the
-// front then) and the page is requested.
+// Where a refined node's children are in a page that is not resident (or in levels of a page
+// not loaded yet), the node stands in for its subtree: it is drawn whatever its size (even when
+// its mean normal faces away, lit from the front then) and the page is requested.
 //
 // An Access policy has:
 //   static constexpr bool kPaged;            // false: children are always resident
@@ -58,6 +58,20 @@ struct TaskState {
   Counters counters;
 };
 
+// Levels below a refined node's children that the view will want too: a level about halves the
+// spheres' radii, until the projected diameter is within the threshold (at most 8; a node
+// around the eye plane wants them all).
+inline std::uint32_t levels_below(const SphereNode& n, const ViewConstants& v, float z) {
+  constexpr std::uint32_t kMax = 8;
+  const float depth = v.ortho ? 1.0f : z;
+  if (!(depth > 0.0f)) return kMax;
+  const float over = n.radius * v.size_per_radius / (v.threshold_px * depth);  // > 1: refined
+  if (!(over < 512.0f)) return kMax;
+  std::uint32_t levels = 0;
+  for (float size = over * 0.5f; size > 2.0f && levels < kMax; size *= 0.5f) ++levels;
+  return levels;
+}
+
 // Walks the subtree of `start` into `chunk`.
 template <class Access>
 void walk_subtree(const Access& access, const typename Access::Item& start,
@@ -92,15 +106,16 @@ void walk_subtree(const Access& access, const typename Access::Item& start,
         if constexpr (Access::kPaged) {
           // Under occlusion culling a hidden subtree in another page is neither opened nor
           // requested (nor drawn as a stand-in: its sphere holds the stand-in's splat too).
-          if (v.occlusion != nullptr && c.page != access.page(p) &&
+          if (v.occlusion != nullptr && (c.page != access.page(p) || !c.resident) &&
               v.occlusion->hidden(v.occlusion->context, n.center, n.radius)) {
             ++counters.culled_occluded;
             break;
           }
           if (!c.resident) {
             emit(n, access.page(p), access.index(p), d, z, true);
-            out.requests.push_back(
-                {c.page, access.page(p), z > 0 ? n.radius * (v.ortho ? 1.0f : 1.0f / z) : 0.0f});
+            out.requests.push_back({c.page, access.page(p),
+                                    z > 0 ? n.radius * (v.ortho ? 1.0f : 1.0f / z) : 0.0f,
+                                    c.first, levels_below(n, v, z)});
             break;
           }
           if (c.page != access.page(p)) out.touched.push_back(c.page);
