@@ -68,7 +68,7 @@ inline std::uint32_t levels_below(const SphereNode& n, const ViewConstants& v, f
   const float over = n.radius * v.size_per_radius / (v.threshold_px * depth);  // > 1: refined
   if (!(over < 512.0f)) return kMax;
   std::uint32_t levels = 0;
-  for (float size = over * 0.5f; size > 2.0f && levels < kMax; size *= 0.5f) ++levels;
+  for (float size = over * 0.7071f; size > 1.0f && levels < kMax; size *= 0.7071f) ++levels;
   return levels;
 }
 
