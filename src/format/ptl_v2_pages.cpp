@@ -115,18 +115,11 @@ class PtlV2Pages final : public PageSource {
   }
 
  private:
-  // A page's first levels were packed: the last one's interior nodes link to the next level's
-  // records in this page, and the features are the whole page's cut to the loaded records.
+  // A page's first levels were packed: the features are the whole page's cut to the loaded
+  // records.
   void load_prefix_rest(std::uint32_t page, HierarchyPage& out) const {
     PackedPage& packed = out.packed;
     const auto count = static_cast<std::uint32_t>(packed.records.size());
-    std::uint32_t first = count;
-    for (std::uint32_t i = packed.last_level_begin; i < count; ++i) {
-      const std::uint32_t children = quant::record_child_count(packed.records[i]);
-      if (children == 0) continue;
-      packed.links.push_back({page, first});
-      first += children;
-    }
     if (!features_) {
       out.features.clear();
       return;

@@ -432,6 +432,9 @@ void PtlV2File::pack_page(std::uint32_t page, PackedPage& out, const PagePrefix&
       },
       prefix, &scanned, std::span<const std::uint32_t>(out.records.data(), known));
   if (scanned < count) {
+    // The last loaded level's children are further down this page: every loaded record links
+    // to its children's place in the page (past the loaded ones for that level).
+    out.last_level_begin = scanned;
     out.records.resize(scanned);
     out.records.shrink_to_fit();
     if (has_colors_) {

@@ -237,9 +237,9 @@ class PtlV2File {
   // traversal), with last_level_begin, the link index (PackedPage::index_links), root_parent
   // (page 0) and leaf_trim; out.links is left empty for the caller, who knows the child pages.
   // Validates the page as decode_page does. With a `prefix` that ends before the page does,
-  // only its first levels are copied (and validated): last_level_begin is then the last copied
-  // level's first record. Records already in `out` (an earlier prefix of this page) are kept,
-  // not read again.
+  // only its first levels are copied (and validated), last_level_begin is the number copied
+  // and the link index of the last copied level points past them (see HierarchyPage). Records
+  // already in `out` (an earlier prefix of this page) are kept, not read again.
   void pack_page(std::uint32_t page, PackedPage& out, const PagePrefix& prefix = {}) const;
   // Record k (< node count) of page `page`, its bits 0..31 as stored (not validated).
   std::uint32_t page_record(std::uint32_t page, std::uint32_t k) const;

@@ -105,9 +105,9 @@ struct PageFeatures {
 // child_count) of its own page when child_page[i] is kNoPage, and of page child_page[i]
 // otherwise. Packed form (`nodes` empty): see PackedPage.
 //
-// A packed page may hold only its first levels (PageSource::load's prefix): the interior
-// nodes of its last loaded level then link to their children's records in the same page, past
-// the loaded ones (PageLink{this page, first}, first >= node_count()).
+// A packed page may hold only its first levels (PageSource::load's prefix): its
+// last_level_begin is then its record count, and the interior nodes of its last loaded level
+// have link() indices past the loaded records (where their children are in the whole page).
 struct HierarchyPage {
   std::vector<SphereNode> nodes;
   std::vector<std::uint32_t> child_page;  // one per node; kNoPage: children (if any) are here

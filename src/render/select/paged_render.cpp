@@ -128,11 +128,10 @@ class PackedAccess {
   ChildRef children(const Item& p, const SphereNode&) const {
     const PackedPage& pk = pages_[p.page]->packed;
     const std::uint32_t link = pk.link(p.index);
-    if (p.index < pk.last_level_begin) return {p.page, link, true};
-    // The children may be in a child page, or further down this page (resident in part).
+    // In this page (not loaded yet when the page is resident in part), or in a child page.
+    if (p.index < pk.last_level_begin) return {p.page, link, link < pk.records.size()};
     const PageLink& l = pk.links[link];
-    const HierarchyPage* holder = pages_[l.page].get();
-    return {l.page, l.first, holder != nullptr && l.first < holder->packed.records.size()};
+    return {l.page, l.first, pages_[l.page] != nullptr};
   }
   const SphereNode* load_children(ChildRef c, const SphereNode& n, SphereNode* scratch) const {
     const PackedPage& pk = pages_[c.page]->packed;
