@@ -139,27 +139,55 @@ PageCache::PageCache(const PageSource& source, std::uint64_t memory_cap, ThreadP
   load_requested(pool);
 }
 
+bool PageCache::evictable(std::uint32_t p) const {
+  return p != 0 && pages_[p] && resident_children_[p] == 0 && last_used_[p] < frame_number_ &&
+         !in_flight_[p];
+}
+
+namespace {
+// Heap order of eviction candidates (last use, page): the top is the least recently used, the
+// highest page number among equals.
+bool later_victim(const std::pair<std::uint64_t, std::uint32_t>& a,
+                  const std::pair<std::uint64_t, std::uint32_t>& b) {
+  return a.first > b.first || (a.first == b.first && a.second < b.second);
+}
+}  // namespace
+
 bool PageCache::make_room(std::uint64_t bytes) {
+  if (stats_.resident_bytes + bytes <= cap_) return true;
+  // The candidates, gathered once a choice (choosing only takes pages out of them, and an
+  // eviction can only add the victim's parent).
+  if (!victims_ready_) {
+    victims_.clear();
+    for (std::uint32_t p = 1; p < pages_.size(); ++p) {
+      if (evictable(p)) victims_.emplace_back(last_used_[p], p);
+    }
+    std::make_heap(victims_.begin(), victims_.end(), later_victim);
+    victims_ready_ = true;
+  }
   while (stats_.resident_bytes + bytes > cap_) {
     std::uint32_t victim = kNoPage;
-    for (std::uint32_t p = 1; p < pages_.size(); ++p) {
-      if (!pages_[p] || resident_children_[p] != 0 || last_used_[p] >= frame_number_ ||
-          in_flight_[p]) {
-        continue;
-      }
-      if (victim == kNoPage || last_used_[p] < last_used_[victim] ||
-          (last_used_[p] == last_used_[victim] && p > victim)) {
+    while (!victims_.empty()) {
+      std::pop_heap(victims_.begin(), victims_.end(), later_victim);
+      const std::uint32_t p = victims_.back().second;
+      victims_.pop_back();
+      if (evictable(p)) {
         victim = p;
+        break;
       }
     }
     if (victim == kNoPage) return false;
     stats_.resident_bytes -= memory_[victim];
     memory_[victim] = 0;
     pages_[victim].reset();
-    if (parent_[victim] != kNoPage) --resident_children_[parent_[victim]];
+    const std::uint32_t parent = parent_[victim];
     parent_[victim] = kNoPage;
     --stats_.resident_pages;
     ++stats_.pages_evicted;
+    if (parent != kNoPage && --resident_children_[parent] == 0 && evictable(parent)) {
+      victims_.emplace_back(last_used_[parent], parent);
+      std::push_heap(victims_.begin(), victims_.end(), later_victim);
+    }
   }
   return true;
 }
@@ -209,6 +237,7 @@ std::vector<PageRequest> PageCache::choose(std::size_t max_pages,
   }
   for (const PageRequest& r : requests_) requested_[r.page] = 0;
   requests_.clear();
+  victims_ready_ = false;
   stats_.resident_bytes_peak = std::max(stats_.resident_bytes_peak, stats_.resident_bytes);
   return chosen;
 }

@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "pointillist/core/thread_pool.hpp"
@@ -111,7 +112,11 @@ class PageCache {
   std::uint64_t memory_cap() const { return cap_; }
 
  private:
+  // Evicts least recently used pages until `bytes` more fit under the cap; false when not
+  // enough can be (pages used this frame, with resident child pages, on their way, and page 0
+  // stay).
   bool make_room(std::uint64_t bytes);
+  bool evictable(std::uint32_t page) const;
   // What to load of a requested page.
   static PagePrefix load_prefix(const PageRequest& r) {
     if (r.page == 0) return {};
@@ -138,6 +143,9 @@ class PageCache {
   std::vector<PageRequest> requests_;
   std::vector<std::uint32_t> requested_;         // per page: 1 + its index in requests_, or 0
   std::vector<std::uint8_t> in_flight_;          // per page: handed to the loader
+  // Eviction candidates of the current choice, a heap by (last use, page); see make_room.
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> victims_;
+  bool victims_ready_ = false;
   std::size_t in_flight_count_ = 0;
   std::uint64_t frame_number_ = 0;
   PageCacheStats stats_;
