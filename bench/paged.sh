@@ -46,6 +46,15 @@ rows() {  # rows NAME MODEL.ptl POINTS
   pm=$(median_ms "$work/paged.json"); mm=$(median_ms "$work/mem.json")
   printf '%-10s %-42s %12s\n' "" "frame ms: paged / in memory (ratio)" \
     "$pm / $mm ($(awk -v a="$pm" -v b="$mm" 'BEGIN { printf "%.2f", a / b }'))"
+  # Coarse views (a billion points at 1280x720 have about a thousand points a pixel): pages are
+  # read a level at a time; the baseline is the same pages read whole (resident_page_bytes).
+  local size
+  for size in 320x180 160x90; do
+    "$cli" render "$model" -o "$work/p.png" --size "$size" --memory 1000G -q \
+      --stats "$work/coarse.json"
+    printf '%-10s %-42s %12s\n' "" "$size: MB read / pages whole (ratio)" \
+      "$(jq -r '"\(.bytes_read / 1e6 * 10 | round / 10) / \(.resident_page_bytes / 1e6 * 10 | round / 10) (\(.bytes_read / .resident_page_bytes * 100 | round / 100))"' "$work/coarse.json")"
+  done
 }
 
 echo "== opening and streaming models (1280x720, 1 px threshold)"

@@ -179,6 +179,7 @@ bool PageCache::make_room(std::uint64_t bytes) {
     if (victim == kNoPage) return false;
     stats_.resident_bytes -= memory_[victim];
     memory_[victim] = 0;
+    stats_.resident_page_bytes -= source_.page_storage_bytes(victim);
     pages_[victim].reset();
     const std::uint32_t parent = parent_[victim];
     parent_[victim] = kNoPage;
@@ -280,6 +281,7 @@ void PageCache::adopt(const PageRequest& r, std::unique_ptr<HierarchyPage> page)
     parent_[r.page] = r.parent_page;
     ++stats_.pages_loaded;
     ++stats_.resident_pages;
+    stats_.resident_page_bytes += source_.page_storage_bytes(r.page);
   }
   pages_[r.page] = std::move(page);
   last_used_[r.page] = std::max(last_used_[r.page], frame_number_);

@@ -96,6 +96,7 @@ std::string render_report_json(const RenderReport& r) {
     j["bytes_read"] = p.cache.bytes_read;
     j["resident_bytes"] = p.cache.resident_bytes;
     j["resident_bytes_peak"] = p.cache.resident_bytes_peak;
+    j["resident_page_bytes"] = p.cache.resident_page_bytes;
     j["pages_loaded"] = p.cache.pages_loaded;
     j["pages_deepened"] = p.cache.pages_deepened;
     j["pages_evicted"] = p.cache.pages_evicted;

@@ -357,6 +357,7 @@ PagingStats Renderer::paging_stats() const {
     p.cache.resident_bytes += c.resident_bytes;
     p.cache.resident_bytes_peak += c.resident_bytes_peak;
     p.cache.resident_pages += c.resident_pages;
+    p.cache.resident_page_bytes += c.resident_page_bytes;
     p.cache.pages_loaded += c.pages_loaded;
     p.cache.pages_deepened += c.pages_deepened;
     p.cache.pages_evicted += c.pages_evicted;

@@ -162,6 +162,7 @@ TEST(PtlV2Prefix, CoarseViewsReadThePagesFirstLevelsAndDrawTheWholeModelsImage) 
       if (paged.cache().pages()[p]) whole += file->page_info(p).byte_size;
     }
     const PagedRenderStats& s = paged.stats();
+    EXPECT_EQ(s.resident_page_bytes, whole);
     EXPECT_LE(double(s.bytes_read - source->open_bytes()), view.max_share * double(whole))
         << s.pages_loaded << " pages loaded, " << s.pages_deepened << " deepened";
     if (view.threshold == 5.0f) {  // (seen fine, the first loads take whole pages)

@@ -23,6 +23,9 @@ struct PageCacheStats {
   std::uint64_t resident_bytes = 0;   // memory of the resident pages now
   std::uint64_t resident_bytes_peak = 0;
   std::uint64_t resident_pages = 0;
+  // Storage bytes of the resident pages read whole (what loading them whole would have read;
+  // they may be resident in part, see pages.hpp).
+  std::uint64_t resident_page_bytes = 0;
   std::uint64_t pages_loaded = 0;     // loads so far (a page dropped and loaded again counts twice)
   std::uint64_t pages_deepened = 0;   // loads of more levels of a page resident in part
   std::uint64_t pages_evicted = 0;
