@@ -2,6 +2,7 @@
 // with MPI (POINTILLIST_HAVE_MPI).
 #include "pointillist/pipeline/chunk_jobs.hpp"
 
+#include <algorithm>
 #include <climits>
 #include <cstdint>
 #include <cstdlib>
@@ -54,6 +55,13 @@ class MpiJob final : public ChunkJobs {
     MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
     MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
     MPI_Comm_size(MPI_COMM_WORLD, &size_);
+    piece_ = std::uint64_t(INT_MAX / size_);
+    // Tests make the gather's rounds small with POINTILLIST_MPI_PIECE_BYTES (every rank must
+    // see the same value; mpirun -x passes it on).
+    if (const char* v = std::getenv("POINTILLIST_MPI_PIECE_BYTES")) {
+      const long long bytes = std::atoll(v);
+      if (bytes > 0) piece_ = std::min(piece_, std::uint64_t(bytes));
+    }
   }
   ~MpiJob() override {
     if (owns_) MPI_Finalize();
@@ -92,30 +100,42 @@ class MpiJob final : public ChunkJobs {
   void broadcast(std::vector<char>& bytes) override { broadcast_from(0, bytes); }
 
   std::vector<std::vector<char>> gather(const std::vector<char>& bytes) override {
-    if (bytes.size() > std::size_t(INT_MAX)) throw Error("MPI: a message over 2 GB");
-    const int count = int(bytes.size());
-    std::vector<int> counts(std::size_t(size_), 0);
-    check(MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, MPI_COMM_WORLD),
-          "MPI_Gather");
-    std::vector<int> offsets(std::size_t(size_), 0);
-    std::vector<char> all;
+    // Every rank learns every size, then all take part in the same rounds of at most
+    // INT_MAX / size bytes a rank (MPI counts and offsets are int), so no message size makes
+    // one rank leave the collectives the others wait in.
+    const std::uint64_t size = bytes.size();
+    std::vector<std::uint64_t> sizes(std::size_t(size_), 0);
+    check(MPI_Allgather(&size, 1, MPI_UINT64_T, sizes.data(), 1, MPI_UINT64_T, MPI_COMM_WORLD),
+          "MPI_Allgather");
+    const std::uint64_t piece = piece_;
+    const std::uint64_t largest = *std::max_element(sizes.begin(), sizes.end());
+    std::vector<std::vector<char>> out;
     if (rank_ == 0) {
-      std::int64_t total = 0;
+      out.resize(std::size_t(size_));
+      for (int r = 0; r < size_; ++r) out[std::size_t(r)].resize(sizes[std::size_t(r)]);
+    }
+    std::vector<int> counts(std::size_t(size_), 0), offsets(std::size_t(size_), 0);
+    std::vector<char> round;
+    const auto part = [&](std::uint64_t total, std::uint64_t at) {
+      return int(std::min(piece, total - std::min(total, at)));
+    };
+    for (std::uint64_t at = 0; at < largest; at += piece) {
+      int total = 0;
       for (int r = 0; r < size_; ++r) {
-        offsets[std::size_t(r)] = int(total);
+        counts[std::size_t(r)] = part(sizes[std::size_t(r)], at);
+        offsets[std::size_t(r)] = total;
         total += counts[std::size_t(r)];
       }
-      if (total > INT_MAX) throw Error("MPI: gathered messages over 2 GB");
-      all.resize(std::size_t(total));
-    }
-    check(MPI_Gatherv(bytes.data(), count, MPI_CHAR, all.data(), counts.data(), offsets.data(),
-                      MPI_CHAR, 0, MPI_COMM_WORLD),
-          "MPI_Gatherv");
-    std::vector<std::vector<char>> out;
-    if (rank_ != 0) return out;
-    for (int r = 0; r < size_; ++r) {
-      const char* begin = all.data() + offsets[std::size_t(r)];
-      out.emplace_back(begin, begin + counts[std::size_t(r)]);
+      if (rank_ == 0) round.resize(std::size_t(total));
+      check(MPI_Gatherv(bytes.data() + std::min(size, at), part(size, at), MPI_CHAR, round.data(),
+                        counts.data(), offsets.data(), MPI_CHAR, 0, MPI_COMM_WORLD),
+            "MPI_Gatherv");
+      if (rank_ != 0) continue;
+      for (int r = 0; r < size_; ++r) {
+        if (counts[std::size_t(r)] == 0) continue;
+        const char* begin = round.data() + offsets[std::size_t(r)];
+        std::copy(begin, begin + counts[std::size_t(r)], out[std::size_t(r)].data() + at);
+      }
     }
     return out;
   }
@@ -133,6 +153,7 @@ class MpiJob final : public ChunkJobs {
   }
 
   int rank_ = 0, size_ = 1;
+  std::uint64_t piece_ = 0;  // bytes a rank sends in one round of gather()
   bool owns_ = false;
 };
 
