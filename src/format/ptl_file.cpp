@@ -37,9 +37,7 @@ std::string leading_bytes(const std::uint8_t* p, std::size_t size) {
   return format_detail::printable_bytes(p, std::min<std::size_t>(size, 8));
 }
 
-[[noreturn]] void fail_at(const std::string& path, std::uint64_t byte, const std::string& what) {
-  throw FormatError(path + ": byte " + std::to_string(byte) + ": " + what);
-}
+using ptl::fail_at;
 
 bool finite_box(const Aabb& b) { return is_finite(b.lo) && is_finite(b.hi); }
 

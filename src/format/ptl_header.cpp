@@ -2,6 +2,8 @@
 
 #include <cstring>
 
+#include "pointillist/core/error.hpp"
+
 namespace pointillist::ptl {
 namespace {
 
@@ -81,6 +83,10 @@ Header decode_header(const std::uint8_t* b) {
   h.metadata_offset = get_u64(b + offset::kMetadataOffset);
   h.metadata_size = get_u64(b + offset::kMetadataSize);
   return h;
+}
+
+void fail_at(const std::string& path, std::uint64_t byte, const std::string& what) {
+  throw FormatError(path + ": byte " + std::to_string(byte) + ": " + what);
 }
 
 }  // namespace pointillist::ptl

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <string>
 
 #include "pointillist/core/math.hpp"
 
@@ -61,5 +62,8 @@ struct Header {
 std::array<std::uint8_t, kHeaderSize> encode_header(const Header& h);
 // Fields of a header; `bytes` holds at least kHeaderSize bytes. Does not check the magic.
 Header decode_header(const std::uint8_t* bytes);
+
+// Throws FormatError "PATH: byte BYTE: WHAT" (the readers of both .ptl versions).
+[[noreturn]] void fail_at(const std::string& path, std::uint64_t byte, const std::string& what);
 
 }  // namespace pointillist::ptl
