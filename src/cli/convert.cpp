@@ -122,8 +122,8 @@ Command add_convert_command(CLI::App& app) {
   auto memory = std::make_shared<std::string>();
   cmd->add_option("--memory", *memory,
                   "Memory the conversion may use (e.g. 8G, 500M; default: half of the physical "
-                  "memory). Scans that need more are converted to .ptl in chunks (a mesh is "
-                  "read whole first, at about 56 bytes a vertex)");
+                  "memory). Scans that need more are converted to .ptl in chunks (a mesh over "
+                  "the budget at 56 bytes a vertex streams its faces: binary PLY only)");
   cmd->add_option("--chunk-points", o->convert.chunk_points,
                   ".ptl: convert in chunks of at most this many points, whatever the memory");
   add_columns(cmd, o->convert.columns);

@@ -74,14 +74,6 @@ double load_value(ScalarType type, const unsigned char* p, bool swap) {
   });
 }
 
-// Integer types only (list counts and indices).
-std::int64_t load_integer(ScalarType type, const unsigned char* p, bool swap) {
-  return with_type(type, [&](auto tag) -> std::int64_t {
-    using T = decltype(tag);
-    return swap ? static_cast<std::int64_t>(load<T, true>(p))
-                : static_cast<std::int64_t>(load<T, false>(p));
-  });
-}
 
 using ColumnFn = void (*)(const unsigned char* src, std::size_t stride, std::size_t n, float* out);
 
@@ -491,6 +483,14 @@ void fail_binary_truncated(const BodyContext& ctx, std::size_t e, std::size_t st
     offset += size;
   }
   ctx.fail_at_byte(ctx.data.size(), ctx.instance(e, index) + ": file ends early");  // not reached
+}
+
+std::int64_t load_integer(ScalarType type, const unsigned char* p, bool swap) {
+  return with_type(type, [&](auto tag) -> std::int64_t {
+    using T = decltype(tag);
+    return swap ? static_cast<std::int64_t>(load<T, true>(p))
+                : static_cast<std::int64_t>(load<T, false>(p));
+  });
 }
 
 void decode_binary_body(const BodyContext& ctx, std::vector<Triangle>& triangles) {

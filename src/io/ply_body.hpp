@@ -100,6 +100,9 @@ struct BodyContext {
 void decode_binary_body(const BodyContext& ctx, std::vector<Triangle>& triangles);
 void decode_ascii_body(const BodyContext& ctx, std::vector<Triangle>& triangles);
 
+// An integer value (list counts and indices) at `p`, byte-swapped when `swap`.
+std::int64_t load_integer(ScalarType type, const unsigned char* p, bool swap);
+
 // What a producer still filling ctx.data has delivered.
 struct StreamState {
   std::size_t available = 0;  // bytes of ctx.data that are valid
@@ -172,6 +175,15 @@ struct FanBuilder {
 }  // namespace pointillist::ply
 
 namespace pointillist::io_detail {
+
+class FileWindow;
+
+// The faces of element `face` of a binary PLY file as a stream (ply_face_stream.cpp); `plan` is
+// the element's plan, `vertex_count` the vertex element's count.
+std::unique_ptr<FaceStream> make_ply_face_stream(std::unique_ptr<FileWindow> file,
+                                                 const ply::Header& header, std::size_t face,
+                                                 const ply::ElementPlan& plan,
+                                                 std::uint64_t vertex_count);
 
 // The vertex element of an ASCII PLY file (plain or gzip), `info` filled from its header, read
 // a window of lines at a time (ply_ascii_stream.cpp). `scales`: the three colour scales.

@@ -407,6 +407,17 @@ namespace {
 using namespace ply;
 
 
+// The start of a file, decompressed, up to its whole header (or 16 MB).
+std::vector<char> header_prefix(const FileWindow& file) {
+  constexpr std::size_t kMaxHeaderBytes = 16 << 20;
+  std::vector<char> prefix;
+  for (std::size_t want = 1 << 16;; want *= 4) {
+    file.read_some(0, want, prefix);
+    const std::string_view head(prefix.data(), prefix.size());
+    if (has_header_end(head) || prefix.size() < want || want >= kMaxHeaderBytes) return prefix;
+  }
+}
+
 class PlyStream final : public PointStream {
  public:
   PlyStream(std::unique_ptr<FileWindow> file, const Header& header, std::size_t vertex_element,
@@ -473,13 +484,7 @@ class PlyStream final : public PointStream {
 std::unique_ptr<PointStream> open_ply_stream(const std::string& path,
                                              const PointReadOptions& options) {
   auto file = std::make_unique<FileWindow>(path);
-  constexpr std::size_t kMaxHeaderBytes = 16 << 20;
-  std::vector<char> prefix;
-  for (std::size_t want = 1 << 16;; want *= 4) {
-    file->read_some(0, want, prefix);  // decompressed for a gzip file
-    const std::string_view head(prefix.data(), prefix.size());
-    if (has_header_end(head) || prefix.size() < want || want >= kMaxHeaderBytes) break;
-  }
+  const std::vector<char> prefix = header_prefix(*file);
   PlyProgress progress(Progress::none(), 1);
   const PlyReadOptions read_options{.read_colors = options.read_colors, .pool = options.pool};
   PlyRead read(path, read_options, progress);
@@ -544,6 +549,28 @@ std::unique_ptr<PointStream> open_ply_stream(const std::string& path,
                                             offset, read.vertex_plan(), options.pool);
   stream->set_info(std::move(info));
   return stream;
+}
+
+std::unique_ptr<FaceStream> open_ply_face_stream(const std::string& path) {
+  auto file = std::make_unique<FileWindow>(path);
+  const std::vector<char> prefix = header_prefix(*file);
+  PlyProgress progress(Progress::none(), 1);
+  const PlyReadOptions options;  // (PlyRead keeps a reference)
+  PlyRead read(path, options, progress);
+  read.prepare({prefix.data(), prefix.size()}, file->compressed());
+  const Header& header = read.header;
+  if (header.format == Format::Ascii) return nullptr;
+  for (std::size_t e = 0; e < header.elements.size(); ++e) {
+    if (read.ctx.plans[e].kind != ElementPlan::Kind::Face || header.elements[e].count == 0) continue;
+    if (read.ctx.vertex_count > 0xffffffffu) {
+      fail_line(path, header.elements[e].header_line,
+                "faces cannot index more than 2^32 vertices (the file has " +
+                    std::to_string(read.ctx.vertex_count) + ")");
+    }
+    return make_ply_face_stream(std::move(file), header, e, read.ctx.plans[e],
+                                read.ctx.vertex_count);
+  }
+  return nullptr;
 }
 
 }  // namespace io_detail

@@ -175,6 +175,14 @@ std::unique_ptr<PointStream> open_point_stream(const std::string& path,
   return std::make_unique<WholeFileStream>(path, read_point_file(path, Progress::none(), options));
 }
 
+std::unique_ptr<FaceStream> open_face_stream(const std::string& path) {
+  if (!std::filesystem::exists(path)) {
+    throw IoError(path + ": no such file; check the path");
+  }
+  if (kind_of(path) == Kind::Ply) return io_detail::open_ply_face_stream(path);
+  return nullptr;
+}
+
 std::optional<std::uint64_t> exact_point_count(const std::string& path) {
   if (!std::filesystem::exists(path)) {
     throw IoError(path + ": no such file; check the path (models fetched by "

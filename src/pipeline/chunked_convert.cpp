@@ -19,6 +19,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <cstdio>
@@ -38,6 +39,7 @@
 #include "chunk_stages.hpp"
 #include "chunk_progress.hpp"
 #include "chunked.hpp"
+#include "mesh_streamed.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/format/ptl_v2.hpp"
 #include "pointillist/io/ply.hpp"
@@ -53,8 +55,10 @@ namespace {
 std::string relations_kind(int rank) { return "relations" + std::to_string(rank); }
 
 // A mesh's vertices as a point file in the work folder, with the normals and radii its faces
-// give (prepare_mesh_vertices): the chunks hold points only. The mesh is read whole, so it must
-// fit the budget at about kMeshBytesPerVertex; other inputs pass through.
+// give (prepare_mesh_vertices): the chunks hold points only. A mesh that fits the budget at
+// about kMeshBytesPerVertex is read whole; a larger one streams its faces past its vertices'
+// sums on disk (mesh_streamed.hpp) when its format allows (binary PLY). Other inputs pass
+// through.
 std::vector<std::string> meshes_as_points(std::span<const std::string> inputs,
                                           const WorkFolder& folder, const ConvertOptions& o,
                                           std::uint64_t budget, ThreadPool& pool,
@@ -64,20 +68,14 @@ std::vector<std::string> meshes_as_points(std::span<const std::string> inputs,
     const std::string& path = inputs[k];
     // Opening a LAS or text stream reads the whole file once; only PLY and OBJ hold faces.
     if (!may_hold_faces(path)) continue;
+    std::uint64_t need = 0;
     {
       const auto stream = open_point_stream(path, {.columns = o.columns});
       if (!stream->info().is_mesh) continue;
       // The arrays, and the file's bytes (mapped, or for gzip decompressed: deflate mostly
       // shrinks a binary mesh to a quarter or more).
-      const std::uint64_t need = stream->info().point_count * kMeshBytesPerVertex +
-                                 stream->info().file_size * (path.ends_with(".gz") ? 4 : 1);
-      if (need > budget) {
-        throw Error(path + ": a mesh of " + std::to_string(stream->info().point_count) +
-                    " vertices needs about " + std::to_string(need / 1'000'000) +
-                    " MB to find its normals and radii from its faces, over the memory budget of " +
-                    std::to_string(budget / 1'000'000) + " MB; raise --memory (meshes are read "
-                    "whole; their points are then converted in chunks)");
-      }
+      need = stream->info().point_count * kMeshBytesPerVertex +
+             stream->info().file_size * (path.ends_with(".gz") ? 4 : 1);
     }
     if (o.keep_faces) {
       warnings.push_back(path + ": its faces are not kept (a mesh converted in chunks keeps "
@@ -85,11 +83,25 @@ std::vector<std::string> meshes_as_points(std::span<const std::string> inputs,
                          "larger --memory)");
     }
     progress.detail(path);
-    PointSet mesh = read_point_file(path, progress, {.columns = o.columns});
     PrepareOptions prepare = o.prepare;
     prepare.input_name = path;
-    prepare_mesh_vertices(mesh, pool, progress, prepare);
     out[k] = folder.file("mesh" + std::to_string(k) + ".ply");
+    if (need > budget) {
+      // The streams' windows and batches take about 200 MB besides the pages.
+      const StreamedMeshOptions streamed{
+          .cache_bytes = budget > (std::uint64_t{400} << 20) ? budget / 2 : budget / 4};
+      if (prepare_mesh_streamed(path, out[k], folder.file("mesh" + std::to_string(k) + ".sums"),
+                                prepare, progress, streamed)) {
+        std::filesystem::remove(folder.file("mesh" + std::to_string(k) + ".sums"));
+        continue;
+      }
+      throw Error(path + ": a mesh of this size needs about " + std::to_string(need / 1'000'000) +
+                  " MB to find its normals and radii from its faces, over the memory budget of " +
+                  std::to_string(budget / 1'000'000) + " MB, and its faces cannot be streamed "
+                  "from this format (ASCII PLY, OBJ); raise --memory, or save it as binary PLY");
+    }
+    PointSet mesh = read_point_file(path, progress, {.columns = o.columns});
+    prepare_mesh_vertices(mesh, pool, progress, prepare);
     write_ply(out[k], mesh);
   }
   return out;
@@ -112,11 +124,17 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
   std::optional<WorkFolder> folder;
   Progress* progress_ptr = &Progress::none();
   std::uint64_t input_points = 0;
+  double mesh_seconds = -1;  // the meshes' preparation, when some input is one
   step(jobs, [&] {
     if (!root) return;
     folder.emplace(output);
+    const auto start = std::chrono::steady_clock::now();
     const std::vector<std::string> sources =
         meshes_as_points(inputs, *folder, o, budget, pool, outer_progress, result.warnings);
+    if (!std::equal(sources.begin(), sources.end(), inputs.begin())) {
+      mesh_seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    }
     in.emplace(sources, o.columns);
     input_points = in->count();
     sh.colors = in->has_colors();
@@ -405,6 +423,9 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
   result.output_points = 0;
   for (const std::uint64_t count : own_count) result.output_points += count;
   if (overall) result.phase_seconds = overall->phase_seconds();
+  if (mesh_seconds >= 0) {
+    result.phase_seconds.insert(result.phase_seconds.begin(), {"mesh", mesh_seconds});
+  }
   return result;
 }
 

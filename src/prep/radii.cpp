@@ -18,6 +18,8 @@ namespace {
 
 constexpr std::size_t kGrain = 1 << 15;
 
+}  // namespace
+
 // Radius of the smallest circle enclosing triangle (a, b, c): half the longest edge when the
 // triangle is right or obtuse (that edge is then a diameter), otherwise the circumradius
 // |ab|·|bc|·|ca| / (2·|ab × ac|). Discs of this radius centred on the three corners cover the
@@ -40,8 +42,6 @@ float enclosing_circle_radius(Vec3f a, Vec3f b, Vec3f c) {
   if (!(twice_area > 0)) return static_cast<float>(0.5 * std::sqrt(longest));
   return static_cast<float>(std::sqrt(lab * lac * lbc) / (2.0 * twice_area));
 }
-
-}  // namespace
 
 std::vector<float> mesh_radii(std::span<const Vec3f> positions,
                               std::span<const std::array<std::uint32_t, 3>> triangles, float scale,

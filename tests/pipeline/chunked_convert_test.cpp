@@ -360,20 +360,35 @@ TEST(ChunkedConvert, AMeshInManySmallChunksGivesTheOnePieceModel) {
   EXPECT_NE(c.parts_result.warnings[0].find("faces are not kept"), std::string::npos);
 }
 
-TEST(ChunkedConvert, AMeshTooLargeOrBrokenStopsWithoutLeavingAnything) {
+TEST(ChunkedConvert, AMeshLargerThanTheBudgetStreamsItsFacesOrStopsWithoutLeavingAnything) {
   TempDir dir;
   PointSet mesh = torus_mesh(60, 40);
   const std::string input = dir.file("torus.ply");
   write_ply(input, mesh);
   ThreadPool pool(1);
   const std::vector<std::string> inputs{input};
-  // A budget under what reading the mesh whole takes (about 56 bytes a vertex and the file).
+  // A budget under what reading the mesh whole takes (about 56 bytes a vertex and the file): a
+  // binary PLY streams its faces, and gives the one-piece model's splats.
+  {
+    const Converted c = convert_both(dir, input, {.memory_budget = 60 * 40 * 30});
+    EXPECT_GE(c.parts_result.chunks, 2u);
+    EXPECT_EQ(c.parts.leaf_count, c.whole.leaf_count);
+    expect_renders_alike(c);
+    EXPECT_FALSE(std::filesystem::exists(dir.file("parts.ptl.chunks")));
+  }
+  // An ASCII PLY has no face stream: refused, saying what to do.
+  const std::string ascii = dir.file("ascii.ply");
+  write_ply(ascii, mesh, {.encoding = PlyEncoding::Ascii});
   try {
-    convert(inputs, dir.file("a.ptl"), {.memory_budget = 60 * 40 * 30}, pool, Progress::none());
-    FAIL() << "a mesh over the budget was converted";
+    convert(std::vector<std::string>{ascii}, dir.file("a.ptl"), {.memory_budget = 60 * 40 * 30},
+            pool, Progress::none());
+    FAIL() << "an ASCII mesh over the budget was converted";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("--memory"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("binary PLY"), std::string::npos) << e.what();
   }
+  EXPECT_FALSE(std::filesystem::exists(dir.file("a.ptl")));
+  EXPECT_FALSE(std::filesystem::exists(dir.file("a.ptl.chunks")));
   // A face naming a vertex that is not there (written by hand: write_ply refuses it).
   {
     std::ofstream f(input, std::ios::binary | std::ios::trunc);

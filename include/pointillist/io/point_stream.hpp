@@ -80,4 +80,30 @@ std::uint64_t point_count_estimate(const std::string& path);
 // point_count_estimate (IoError for a missing file).
 std::optional<std::uint64_t> exact_point_count(const std::string& path);
 
+// The faces of a mesh file read a window at a time, in constant memory: the triangles
+// read_point_file gives (polygons fan-triangulated), in the same order, checked the same way.
+// What a mesh larger than memory is prepared from (pipeline/mesh_streamed.cpp).
+class FaceStream {
+ public:
+  virtual ~FaceStream() = default;
+  // Replaces `triangles` with the triangles of the next whole faces (about a window of the
+  // file; faces of fewer than 3 vertices give none); false at the end. Throws FormatError
+  // naming the file, the byte and the face of bad data (an index out of range, a negative
+  // count, the file ending early), IoError when reading fails.
+  virtual bool read(std::vector<std::array<std::uint32_t, 3>>& triangles) = 0;
+  // Faces read so far (for progress).
+  virtual std::uint64_t faces_done() const = 0;
+  std::uint64_t vertex_count() const { return vertex_count_; }
+  std::uint64_t face_count() const { return face_count_; }
+
+ protected:
+  std::uint64_t vertex_count_ = 0, face_count_ = 0;
+};
+
+// The faces of `path` as a stream: binary PLY files, plain or gzip, whatever their element
+// layout. Null for a file without faces and for files whose faces have no streamed form yet
+// (ASCII PLY, OBJ: read them whole). Throws what read_point_file throws for a bad header, and
+// IoError for a missing file.
+std::unique_ptr<FaceStream> open_face_stream(const std::string& path);
+
 }  // namespace pointillist

@@ -24,6 +24,11 @@ std::vector<float> mesh_radii(std::span<const Vec3f> positions,
                               std::span<const std::array<std::uint32_t, 3>> triangles, float scale,
                               ThreadPool& pool);
 
+// The radius mesh_radii gives a triangle's corners: of the smallest circle enclosing (a, b, c),
+// in double, rounded to float. For callers that walk the faces themselves (a mesh streamed
+// from disk).
+float enclosing_circle_radius(Vec3f a, Vec3f b, Vec3f c);
+
 // Default coverage factor of cloud radii, chosen by measurement. On spheres, tori and the demo
 // scene sampled uniformly at random (Poisson) with 2k to 200k samples, discs of radius
 // mean-5-NN-distance × c (centred on the samples, in their tangent planes) leave part of the

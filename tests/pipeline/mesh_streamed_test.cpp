@@ -1,0 +1,227 @@
+// A mesh prepared by streaming its faces past its vertices' sums on disk (mesh_streamed.hpp)
+// against the mesh read whole and prepared in memory (read_point_file + prepare_mesh_vertices,
+// which walk the faces per vertex range), and against the torus's analytic normals. The files
+// are written byte by byte here, with quads, a two-vertex face, an extra face property, faces in
+// random order, big-endian and gzip variants; a cache of a few small pages makes most pages go
+// out to disk and come back.
+#include <gtest/gtest.h>
+#include <zlib.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include "mesh_streamed.hpp"
+#include "pointillist/core/error.hpp"
+#include "pointillist/core/thread_pool.hpp"
+#include "pointillist/io/ply.hpp"
+#include "pointillist/io/point_file.hpp"
+#include "pointillist/io/point_stream.hpp"
+#include "testing/testing.hpp"
+#include "testing/torus_mesh.hpp"
+
+namespace pointillist::chunking {
+namespace {
+
+using testing::TempDir;
+
+constexpr std::uint32_t kRows = 60, kColumns = 40;
+
+struct Layout {
+  bool big_endian = false;
+  bool gzip = false;
+  bool shuffle = true;
+  bool polygons = true;      // quads and a two-vertex face besides triangles
+  bool extra_vertex = true;  // a vertex no face uses
+  bool bad_index = false;    // the last face names a vertex that is not there
+  bool truncate = false;     // the file stops inside the last face
+};
+
+template <class T>
+void put(std::string& out, T value, bool big) {
+  auto bytes = std::bit_cast<std::array<char, sizeof(T)>>(value);
+  if (big) std::reverse(bytes.begin(), bytes.end());
+  out.append(bytes.data(), bytes.size());
+}
+
+// The torus as a binary PLY: xyz and rgb, then faces as `list uchar int vertex_indices` and a
+// `uchar flags` property.
+std::string write_torus(const TempDir& dir, const Layout& l) {
+  const PointSet m = testing::torus_mesh(kRows, kColumns);
+  std::vector<std::vector<std::int32_t>> faces;
+  for (std::size_t t = 0; t < m.triangles.size(); t += 2) {
+    const auto& a = m.triangles[t];
+    const auto& b = m.triangles[t + 1];
+    // A grid square's triangles (i,j)(i,j+1)(i+1,j) and (i+1,j)(i,j+1)(i+1,j+1); every fourth
+    // square is the quad (i+1,j)(i,j)(i,j+1)(i+1,j+1), which fans into the same two.
+    if (l.polygons && t % 8 == 0) {
+      faces.push_back({std::int32_t(a[2]), std::int32_t(a[0]), std::int32_t(a[1]),
+                       std::int32_t(b[2])});
+    } else {
+      faces.push_back({std::int32_t(a[0]), std::int32_t(a[1]), std::int32_t(a[2])});
+      faces.push_back({std::int32_t(b[0]), std::int32_t(b[1]), std::int32_t(b[2])});
+    }
+  }
+  if (l.polygons) faces.push_back({0, 5});
+  if (l.shuffle) std::shuffle(faces.begin(), faces.end(), std::mt19937(7));
+  const std::uint32_t vertices = std::uint32_t(m.size()) + (l.extra_vertex ? 1 : 0);
+  if (l.bad_index) faces.push_back({0, 1, std::int32_t(vertices)});
+  std::string body;
+  for (std::uint32_t i = 0; i < vertices; ++i) {
+    const Vec3f p = i < m.size() ? m.positions[i] : Vec3f{5, 5, 5};
+    const Rgb8 c = i < m.size() ? m.colors[i] : Rgb8{255, 0, 0};
+    put(body, p.x, l.big_endian), put(body, p.y, l.big_endian), put(body, p.z, l.big_endian);
+    body += char(c.r), body += char(c.g), body += char(c.b);
+  }
+  for (const auto& f : faces) {
+    body += char(f.size());
+    for (const std::int32_t v : f) put(body, v, l.big_endian);
+    body += char(1);  // flags
+  }
+  if (l.truncate) body.resize(body.size() - 3);
+  const std::string head = std::string("ply\nformat ") +
+                           (l.big_endian ? "binary_big_endian" : "binary_little_endian") +
+                           " 1.0\nelement vertex " + std::to_string(vertices) +
+                           "\nproperty float x\nproperty float y\nproperty float z\n"
+                           "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+                           "element face " + std::to_string(faces.size()) +
+                           "\nproperty list uchar int vertex_indices\nproperty uchar flags\n"
+                           "end_header\n";
+  const std::string path = dir.file(l.gzip ? "torus.ply.gz" : "torus.ply");
+  if (l.gzip) {
+    gzFile gz = gzopen(path.c_str(), "wb");
+    gzwrite(gz, head.data(), unsigned(head.size()));
+    gzwrite(gz, body.data(), unsigned(body.size()));
+    gzclose(gz);
+  } else {
+    std::ofstream(path, std::ios::binary) << head << body;
+  }
+  return path;
+}
+
+PointSet streamed(const TempDir& dir, const std::string& input, const PrepareOptions& prepare,
+                  const StreamedMeshOptions& options) {
+  const std::string out = dir.file("streamed.ply");
+  EXPECT_TRUE(prepare_mesh_streamed(input, out, dir.file("sums"), prepare, Progress::none(),
+                                    options));
+  return read_point_file(out);
+}
+
+PointSet in_memory(const std::string& input, const PrepareOptions& prepare) {
+  PointSet m = read_point_file(input);
+  ThreadPool pool(2);
+  prepare_mesh_vertices(m, pool, Progress::none(), prepare);
+  return m;
+}
+
+void expect_same(const PointSet& a, const PointSet& b) {
+  ASSERT_EQ(a.size(), b.size());
+  ASSERT_EQ(a.normals.size(), b.normals.size());
+  ASSERT_EQ(a.radii.size(), b.radii.size());
+  ASSERT_EQ(a.colors.size(), b.colors.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    ASSERT_EQ(std::memcmp(&a.positions[i], &b.positions[i], sizeof(Vec3f)), 0) << i;
+    if (!a.normals.empty()) {
+      ASSERT_EQ(std::memcmp(&a.normals[i], &b.normals[i], sizeof(Vec3f)), 0) << i;
+    }
+    if (!a.radii.empty()) {
+      ASSERT_EQ(a.radii[i], b.radii[i]) << i;
+    }
+    if (!a.colors.empty()) {
+      ASSERT_EQ(a.colors[i].r, b.colors[i].r) << i;
+    }
+  }
+}
+
+// Small pages and only four of them: the 2,400 vertices fill 150 pages, and shuffled faces touch
+// them in any order, so pages are written out and read back all the time.
+constexpr StreamedMeshOptions kTinyCache{.cache_bytes = 0, .page_vertices = 16};
+
+TEST(StreamedMesh, GivesTheNormalsAndRadiiOfTheMeshReadWholeBitForBit) {
+  for (const Layout l : {Layout{}, Layout{.big_endian = true, .gzip = true},
+                         Layout{.shuffle = false, .polygons = false}}) {
+    TempDir dir;
+    const std::string input = write_torus(dir, l);
+    const PointSet whole = in_memory(input, {});
+    for (const StreamedMeshOptions& o : {StreamedMeshOptions{}, kTinyCache}) {
+      SCOPED_TRACE("big endian " + std::to_string(l.big_endian) + ", shuffled " +
+                   std::to_string(l.shuffle) + ", pages of " + std::to_string(o.page_vertices));
+      const PointSet s = streamed(dir, input, {}, o);
+      EXPECT_EQ(s.size(), std::size_t{kRows} * kColumns);  // the unused vertex is dropped
+      expect_same(s, whole);
+    }
+    // The file's normals kept, or none for PCA: the same choices as in memory.
+    const PointSet pca = streamed(dir, input, {.normals = NormalSource::Pca}, kTinyCache);
+    EXPECT_TRUE(pca.normals.empty());
+    expect_same(pca, in_memory(input, {.normals = NormalSource::Pca}));
+  }
+}
+
+TEST(StreamedMesh, NormalsFollowTheTorusAndRadiiCoverItsTriangles) {
+  TempDir dir;
+  const std::string input = write_torus(dir, {.polygons = false});
+  const PointSet s = streamed(dir, input, {}, kTinyCache);
+  ASSERT_EQ(s.size(), std::size_t{kRows} * kColumns);
+  const PointSet m = testing::torus_mesh(kRows, kColumns);
+  double worst = 0;
+  for (std::uint32_t i = 0; i < kRows; ++i) {
+    for (std::uint32_t j = 0; j < kColumns; ++j) {
+      const double u = 2 * kPi * i / kRows, v = 2 * kPi * j / kColumns;
+      const Vec3f n{float(std::cos(v) * std::cos(u)), float(std::sin(v)),
+                    float(std::cos(v) * std::sin(u))};
+      const std::size_t k = std::size_t{i} * kColumns + j;
+      worst = std::max(worst, std::acos(std::clamp(double(dot(s.normals[k], n)), -1.0, 1.0)));
+    }
+  }
+  EXPECT_LT(worst * 180 / kPi, 5.0);  // a 60 x 40 grid: faces 6 and 9 degrees apart
+  // Every corner's radius reaches its triangles' circumcentres (or longest edges' midpoints):
+  // at least half of every incident edge.
+  for (const auto& t : m.triangles) {
+    for (int e = 0; e < 3; ++e) {
+      const std::uint32_t a = t[e], b = t[(e + 1) % 3];
+      const float half = 0.5f * distance(m.positions[a], m.positions[b]);
+      EXPECT_GE(s.radii[a], half * 0.9999f);
+      EXPECT_GE(s.radii[b], half * 0.9999f);
+    }
+  }
+}
+
+TEST(StreamedMesh, BadFacesAreNamedAndNothingIsWritten) {
+  for (const Layout l : {Layout{.bad_index = true}, Layout{.truncate = true}}) {
+    TempDir dir;
+    const std::string input = write_torus(dir, l);
+    try {
+      (void)prepare_mesh_streamed(input, dir.file("out.ply"), dir.file("sums"), {},
+                                  Progress::none(), kTinyCache);
+      FAIL() << "a broken face was accepted";
+    } catch (const FormatError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(input), std::string::npos) << what;
+      EXPECT_NE(what.find(": byte "), std::string::npos) << what;
+      EXPECT_NE(what.find(l.bad_index ? "out of range" : "file ends early"), std::string::npos)
+          << what;
+    }
+    EXPECT_FALSE(std::filesystem::exists(dir.file("out.ply")));
+  }
+}
+
+TEST(StreamedMesh, FormatsWithoutStreamedFacesAreLeftToTheWholeReader) {
+  TempDir dir;
+  PointSet m = testing::torus_mesh(6, 5);
+  const std::string ascii = dir.file("torus.ply");
+  write_ply(ascii, m, {.encoding = PlyEncoding::Ascii});
+  EXPECT_FALSE(prepare_mesh_streamed(ascii, dir.file("out.ply"), dir.file("sums"), {},
+                                     Progress::none()));
+  EXPECT_FALSE(std::filesystem::exists(dir.file("out.ply")));
+  m.triangles.clear();  // a binary file without faces has no face stream
+  const std::string cloud = dir.file("cloud.ply");
+  write_ply(cloud, m);
+  EXPECT_EQ(open_face_stream(cloud), nullptr);
+}
+
+}  // namespace
+}  // namespace pointillist::chunking
