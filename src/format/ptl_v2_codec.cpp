@@ -93,6 +93,19 @@ void search_enclosing(const Sphere& parent, const Sphere& target, GoOn&& go_on,
   // Widens the box by what the decoded floats may differ from the lattice; the exact test decides.
   const double slack = estimate_margin(parent);
   const int m_first = std::clamp(int(std::floor(kSphereGrid * s)), 1, kSphereGrid);
+  // The distance from the target's centre to the nearest centre of each lattice, unbounded:
+  // lattice coordinates u = 13 (X + 1) are even for even m, odd for odd m.
+  double lattice_distance[2];
+  for (int parity = 0; parity < 2; ++parity) {
+    double e2 = 0;
+    for (int a = 0; a < 3; ++a) {
+      const double u = kSphereGrid * (t[a] + 1);
+      const double k = 2 * std::floor((u - parity) * 0.5 + 0.5) + parity;
+      const double e = (k - u) / kSphereGrid;
+      e2 += e * e;
+    }
+    lattice_distance[parity] = std::sqrt(e2);
+  }
   const std::int16_t* const codes = qs_detail::sphere_code_table().data();
   const qs_detail::SphereCandidate* const table = qs_detail::sphere_table().data();
   for (int m = m_first; m <= kSphereGrid; ++m) {
@@ -101,6 +114,10 @@ void search_enclosing(const Sphere& parent, const Sphere& target, GoOn&& go_on,
     const double reach = std::min(radius - s, max_distance()) + slack;
     const double room = 1 - radius + slack;
     if (reach < 0) continue;
+    // No cell of this size is nearer the target than the nearest point of its lattice (centres
+    // at (m + 2x)/13 - 1: the lattice depends only on m's parity); when `wanted` turns that
+    // down, it turns down every cell of the box, which is then not worth computing.
+    if (!wanted(lattice_distance[m & 1], radius)) continue;
     int lo[3], hi[3];
     bool empty = false;
     for (int a = 0; a < 3 && !empty; ++a) {
