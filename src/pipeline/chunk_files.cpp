@@ -1,6 +1,7 @@
 // The files of a chunked conversion (see chunk_files.hpp).
 #include "chunk_files.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -35,7 +36,16 @@ WorkFolder::~WorkFolder() {
 ChunkFiles::ChunkFiles(const WorkFolder& folder, std::size_t chunks, const char* kind,
                        std::size_t buffer_bytes)
     : buffers_(chunks), buffer_bytes_(buffer_bytes) {
+  // Room for a record past the threshold, so that appending never doubles a buffer.
+  for (std::vector<char>& b : buffers_) b.reserve(buffer_bytes + 256);
   for (std::size_t c = 0; c < chunks; ++c) paths_.push_back(folder.file(name(kind, c)));
+}
+
+std::size_t ChunkFiles::buffer_bytes(std::size_t chunks, std::uint64_t most,
+                                     std::uint64_t budget) {
+  const std::uint64_t all = std::min(most, budget / 8);
+  return static_cast<std::size_t>(
+      std::clamp<std::uint64_t>(all / std::max<std::size_t>(chunks, 1), 4096, 1 << 20));
 }
 
 std::string ChunkFiles::name(const char* kind, std::size_t c) {

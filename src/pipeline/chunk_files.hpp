@@ -34,6 +34,9 @@ class WorkFolder {
 // Appends records to one file per chunk (KIND-NNNNN in the folder) through a buffer each.
 class ChunkFiles {
  public:
+  // The buffer of each of `chunks` files when all of them may take `most` bytes, an eighth of
+  // the memory budget at most: between 4 KB and 1 MB.
+  static std::size_t buffer_bytes(std::size_t chunks, std::uint64_t most, std::uint64_t budget);
   ChunkFiles(const WorkFolder& folder, std::size_t chunks, const char* kind,
              std::size_t buffer_bytes);
   static std::string name(const char* kind, std::size_t c);

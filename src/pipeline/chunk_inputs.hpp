@@ -1,6 +1,7 @@
 // The inputs of a chunked conversion as one stream (private to pipeline; chunked_convert.cpp).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <memory>
 #include <optional>
@@ -16,7 +17,7 @@
 namespace pointillist::chunking {
 
 constexpr Rgb8 kMissingColor{180, 180, 180};  // as merge_inputs gives parts without colours
-constexpr std::size_t kBatch = 1 << 20;      // points per read
+constexpr std::size_t kBatch = 1 << 20;      // points per read, at most
 
 // The inputs as one stream, with merge_inputs' rules: parts move into the first part's frame,
 // normals and radii survive when every part has them, colours when any has them (grey else).
@@ -24,6 +25,12 @@ class MergedInputs {
  public:
   // Opens every input (a mesh is refused). Throws what open_point_stream throws.
   MergedInputs(std::span<const std::string> paths, const std::string& columns);
+
+  // Reads batches that take about a 256th of `budget` (a point and its window bytes, about
+  // 64 bytes, in 1 M-point batches from a 256 MB budget up).
+  void fit_batches(std::uint64_t budget) {
+    batch_ = static_cast<std::size_t>(std::clamp<std::uint64_t>(budget / 256, 4096, kBatch));
+  }
 
   // As merge_inputs warns: files without colours among files with them are drawn grey.
   std::optional<std::string> colour_warning() const;
@@ -40,6 +47,7 @@ class MergedInputs {
   Vec3f up() const { return up_; }
   const std::vector<std::string>& comments() const { return comments_; }
   const std::vector<std::unique_ptr<PointStream>>& streams() const { return streams_; }
+  std::size_t batch_points() const { return batch_; }
   // After a full pass: a part whose normals were all unusable has none (as read_point_file).
   void drop_unusable_normals() {
     for (const auto& s : streams_) normals_ = normals_ && s->saw_usable_normals();
@@ -65,7 +73,7 @@ class MergedInputs {
       const std::array<double, 3>& o = stream->info().origin;
       const double shift[3] = {o[0] - origin_[0], o[1] - origin_[1], o[2] - origin_[2]};
       const bool shifted = shift[0] != 0 || shift[1] != 0 || shift[2] != 0;
-      while (const std::size_t n = stream->read(batch, kBatch)) {
+      while (const std::size_t n = stream->read(batch, batch_)) {
         if (shifted) {
           for (Vec3f& p : batch.positions) {
             p = {float(p.x + shift[0]), float(p.y + shift[1]), float(p.z + shift[2])};
@@ -91,6 +99,7 @@ class MergedInputs {
 
  private:
   std::vector<std::unique_ptr<PointStream>> streams_;
+  std::size_t batch_ = kBatch;
   std::uint64_t count_ = 0;
   bool normals_ = true, radii_ = true, colors_ = false;
   std::array<double, 3> origin_{};

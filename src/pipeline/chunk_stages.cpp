@@ -178,9 +178,8 @@ void scan_plan_distribute(MergedInputs& in, const WorkFolder& folder, const Conv
   }
 
   // 3. Distribute.
-  const std::size_t buffer_bytes =
-      std::clamp<std::size_t>((std::size_t{256} << 20) / chunks, 4096, 1 << 20);
-  ChunkFiles files(folder, chunks, "chunk", buffer_bytes);
+  ChunkFiles files(folder, chunks, "chunk",
+                   ChunkFiles::buffer_bytes(chunks, std::uint64_t{256} << 20, budget));
   ProgressPhase phase(progress, "distribute", n);
   std::vector<char> record(sh.layout.size());
   in.for_each_batch(progress, [&](const PointSet& b, std::uint64_t first) {

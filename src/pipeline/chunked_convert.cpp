@@ -136,6 +136,7 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     }
     in.emplace(sources, o.columns);
+    in->fit_batches(budget);
     input_points = in->count();
     sh.colors = in->has_colors();
     overall.emplace(outer_progress, input_points,
@@ -180,9 +181,8 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
   std::atomic<bool> pieces{false};
   step(jobs, [&] {
     const std::string kind = relations_kind(jobs.rank());
-    const std::size_t buffer_bytes =
-        std::clamp<std::size_t>((std::size_t{64} << 20) / chunks, 4096, 1 << 20);
-    ChunkFiles relations(*folder, chunks, kind.c_str(), buffer_bytes);
+    ChunkFiles relations(*folder, chunks, kind.c_str(),
+                         ChunkFiles::buffer_bytes(chunks, std::uint64_t{64} << 20, budget));
     std::mutex relations_mutex;
     ProgressPhase phase(progress, "prepare", my_points);
     for_each_chunk(mine, pool, [&](std::size_t c, ThreadPool& chunk_pool) {
