@@ -1,7 +1,7 @@
 // libFuzzer harness for read_ply: ascii and binary (both byte orders) bodies, gzip, the header
-// parser; the seeds hold one of each. The face stream (open_face_stream) runs on the same input:
-// it may refuse only as readers do, and where read_ply read the file, it must give the same
-// triangles.
+// parser; the seeds hold one of each. The face stream (open_face_stream, binary or ASCII) runs on
+// the same input: it may refuse only as readers do, and where read_ply read the file, it must
+// give the same triangles.
 #include "fuzz_support.hpp"
 #include "pointillist/io/ply.hpp"
 #include "pointillist/io/point_stream.hpp"
@@ -24,7 +24,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   fuzz::expect_reader_errors(named, [&] {
     const std::unique_ptr<FaceStream> faces = open_face_stream(named);
     opened = true;
-    if (!faces) return;  // ASCII, or no faces
+    if (!faces) return;  // no faces
     has_stream = true;
     std::vector<std::array<std::uint32_t, 3>> part;
     while (faces->read(part)) {

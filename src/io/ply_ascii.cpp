@@ -358,9 +358,9 @@ std::uint64_t count_element_lines(const char* begin, const char* end) {
 }
 
 std::uint64_t parse_ascii_lines(const BodyContext& ctx, const char* begin, const char* end,
-                                std::uint64_t first) {
+                                std::uint64_t first, std::vector<Triangle>* triangles) {
   std::vector<Triangle> unused;
-  return AsciiParser(ctx, unused).parse(begin, end, first);
+  return AsciiParser(ctx, triangles ? *triangles : unused).parse(begin, end, first);
 }
 
 void fail_ascii_ends_early(const BodyContext& ctx, std::uint64_t lines) {

@@ -1,7 +1,7 @@
-// ASCII PLY files (plain or gzip) streamed a window of lines at a time: the vertex lines parsed
-// by the whole-file reader's own parser (parse_ascii_lines), so the points and the messages for
-// bad values (file line numbers included) are read_ply's. Lines of elements before the vertex
-// element are skipped; faces after it are not read (the stream says the file is a mesh).
+// ASCII PLY files (plain or gzip) streamed a window of lines at a time: the vertex lines, or
+// the face lines (a FaceStream), parsed by the whole-file reader's own parser
+// (parse_ascii_lines), so the points, the triangles and the messages for bad values (file line
+// numbers included) are read_ply's. Lines of the elements before the one read are skipped.
 #include <algorithm>
 #include <memory>
 #include <string>
@@ -34,15 +34,65 @@ std::string_view trimmed(const char* s, const char* e) {
 // Vertex lines parsed at a time (a few MB of text).
 constexpr std::uint64_t kWindowLines = 1 << 17;
 
+// Element lines before element `element` (elements without properties have none).
+std::uint64_t lines_before(const Header& header, std::size_t element) {
+  std::uint64_t skip = 0;
+  for (std::size_t e = 0; e < element; ++e) {
+    if (!header.elements[e].properties.empty()) skip += header.elements[e].count;
+  }
+  return skip;
+}
+
+// Moves `lines` past the header and `skip` element lines; returns the file lines consumed.
+std::uint64_t position_after(LineWindow& lines, const std::string& path, std::uint64_t skip,
+                             const char* what) {
+  lines.rewind();
+  std::uint64_t line_no = 0;
+  const char *s = nullptr, *e = nullptr;
+  for (;;) {  // the header, through its end_header line
+    if (!lines.next_line(s, e)) {
+      throw FormatError(path + ": line " + std::to_string(line_no + 1) +
+                        ": the file ends in its header (no end_header line); the file is "
+                        "truncated");
+    }
+    ++line_no;
+    if (trimmed(s, e) == "end_header") break;
+  }
+  for (std::uint64_t k = 0; k < skip;) {  // lines of the elements before
+    if (!lines.next_line(s, e)) {
+      throw FormatError(path + ": line " + std::to_string(line_no + 1) + ": file ends early: " +
+                        std::to_string(k) + " of the " + std::to_string(skip) +
+                        " element lines before the " + what + "; the file is truncated");
+    }
+    ++line_no;
+    if (!blank_line(s, e)) ++k;
+  }
+  return line_no;
+}
+
+// Appends the next `n` element lines (blank ones kept, but not counted) to `text`; the window
+// ends early only at the end of the file. Returns how many it found.
+std::uint64_t take_lines(LineWindow& lines, std::uint64_t n, std::string& text,
+                         std::uint64_t& line_no) {
+  std::uint64_t got = 0;
+  while (got < n) {
+    const char *s = nullptr, *e = nullptr;
+    if (!lines.next_line(s, e)) break;
+    text.append(s, e);
+    text.push_back('\n');
+    ++line_no;
+    if (!blank_line(s, e)) ++got;
+  }
+  return got;
+}
+
 class AsciiPlyStream final : public PointStream {
  public:
   AsciiPlyStream(const std::string& path, const Header& header, std::size_t vertex,
                  const ElementPlan& plan, const ColorScale* scales, PointStreamInfo info)
       : lines_(path) {
     info_ = std::move(info);
-    for (std::size_t e = 0; e < vertex; ++e) {
-      if (!header.elements[e].properties.empty()) skip_ += header.elements[e].count;
-    }
+    skip_ = lines_before(header, vertex);
     window_header_.format = header.format;
     window_header_.elements = {header.elements[vertex]};
     window_header_.body_offset = 0;
@@ -71,16 +121,9 @@ class AsciiPlyStream final : public PointStream {
     ctx_.index_base = next_;
     ctx_.index_total = info_.point_count;
     ctx_.vertex_count = n;
-    for (std::uint64_t got = 0; got < n;) {
-      const char *s = nullptr, *e = nullptr;
-      if (!lines_.next_line(s, e)) {
-        ctx_.data = text_;
-        fail_ascii_ends_early(ctx_, got);
-      }
-      text_.append(s, e);
-      text_.push_back('\n');
-      ++line_no_;
-      if (!blank_line(s, e)) ++got;
+    if (const std::uint64_t got = take_lines(lines_, n, text_, line_no_); got < n) {
+      ctx_.data = text_;
+      fail_ascii_ends_early(ctx_, got);
     }
     ctx_.data = text_;
     ctx_.vertex.positions = batch.positions.data();
@@ -95,29 +138,8 @@ class AsciiPlyStream final : public PointStream {
   }
 
   void rewind() override {
-    lines_.rewind();
-    line_no_ = 0;
+    line_no_ = position_after(lines_, info_.path, skip_, "vertices");
     next_ = 0;
-    const char *s = nullptr, *e = nullptr;
-    for (;;) {  // the header, through its end_header line
-      if (!lines_.next_line(s, e)) {
-        throw FormatError(info_.path + ": line " + std::to_string(line_no_ + 1) +
-                          ": the file ends in its header (no end_header line); the file is "
-                          "truncated");
-      }
-      ++line_no_;
-      if (trimmed(s, e) == "end_header") break;
-    }
-    for (std::uint64_t k = 0; k < skip_;) {  // lines of the elements before the vertices
-      if (!lines_.next_line(s, e)) {
-        throw FormatError(info_.path + ": line " + std::to_string(line_no_ + 1) +
-                          ": file ends early: " + std::to_string(k) + " of the " +
-                          std::to_string(skip_) +
-                          " element lines before the vertices; the file is truncated");
-      }
-      ++line_no_;
-      if (!blank_line(s, e)) ++k;
-    }
     positioned_ = true;
   }
 
@@ -136,7 +158,62 @@ class AsciiPlyStream final : public PointStream {
   std::string text_;
 };
 
+class AsciiPlyFaceStream final : public FaceStream {
+ public:
+  AsciiPlyFaceStream(const std::string& path, const Header& header, std::size_t face,
+                     const ElementPlan& plan, std::uint64_t vertex_count)
+      : lines_(path), path_(path) {
+    vertex_count_ = vertex_count;
+    face_count_ = header.elements[face].count;
+    window_header_.format = header.format;
+    window_header_.elements = {header.elements[face]};
+    window_header_.body_offset = 0;
+    ctx_.path = path;
+    ctx_.header = &window_header_;
+    ctx_.plans = {plan};
+    ctx_.vertex_count = vertex_count;
+    ctx_.index_total = face_count_;
+    line_no_ = position_after(lines_, path, lines_before(header, face), "faces");
+  }
+
+  bool read(std::vector<std::array<std::uint32_t, 3>>& triangles) override {
+    triangles.clear();
+    if (next_ == face_count_) {
+      lines_.release();
+      return false;
+    }
+    const std::uint64_t n = std::min<std::uint64_t>(face_count_ - next_, kWindowLines);
+    text_.clear();
+    window_header_.elements[0].count = n;
+    ctx_.line_base = line_no_;
+    ctx_.index_base = next_;
+    if (const std::uint64_t got = take_lines(lines_, n, text_, line_no_); got < n) {
+      ctx_.data = text_;
+      fail_ascii_ends_early(ctx_, got);
+    }
+    ctx_.data = text_;
+    parse_ascii_lines(ctx_, text_.data(), text_.data() + text_.size(), 0, &triangles);
+    next_ += n;
+    return true;
+  }
+  std::uint64_t faces_done() const override { return next_; }
+
+ private:
+  LineWindow lines_;
+  std::string path_;
+  Header window_header_;
+  BodyContext ctx_;
+  std::uint64_t line_no_ = 0, next_ = 0;
+  std::string text_;
+};
+
 }  // namespace
+
+std::unique_ptr<FaceStream> open_ascii_face_stream(const std::string& path, const Header& header,
+                                                   std::size_t face, const ElementPlan& plan,
+                                                   std::uint64_t vertex_count) {
+  return std::make_unique<AsciiPlyFaceStream>(path, header, face, plan, vertex_count);
+}
 
 std::unique_ptr<PointStream> open_ascii_vertex_stream(const std::string& path,
                                                       const Header& header, std::size_t vertex,

@@ -118,7 +118,7 @@ void decode_ascii_stream(const BodyContext& ctx, std::vector<Triangle>& triangle
 // element line `first` of ctx.header's body; returns how many it parsed. Throws as
 // decode_ascii_body. For windows of a streamed file (ctx.line_base numbers their lines).
 std::uint64_t parse_ascii_lines(const BodyContext& ctx, const char* begin, const char* end,
-                                std::uint64_t first);
+                                std::uint64_t first, std::vector<Triangle>* triangles = nullptr);
 
 // Throws FormatError when an element count cannot fit in the bytes after the header, so callers
 // can allocate for the counts safely. Names the exact place when it can (a binary body whose
@@ -187,6 +187,13 @@ std::unique_ptr<FaceStream> make_ply_face_stream(std::unique_ptr<FileWindow> fil
 
 // The vertex element of an ASCII PLY file (plain or gzip), `info` filled from its header, read
 // a window of lines at a time (ply_ascii_stream.cpp). `scales`: the three colour scales.
+// The face element `face` of an ASCII PLY file (plain or gzip) read a window of lines at a
+// time, by the same parser (ply_ascii_stream.cpp).
+std::unique_ptr<FaceStream> open_ascii_face_stream(const std::string& path,
+                                                   const ply::Header& header, std::size_t face,
+                                                   const ply::ElementPlan& plan,
+                                                   std::uint64_t vertex_count);
+
 std::unique_ptr<PointStream> open_ascii_vertex_stream(const std::string& path,
                                                       const ply::Header& header,
                                                       std::size_t vertex,

@@ -559,13 +559,15 @@ std::unique_ptr<FaceStream> open_ply_face_stream(const std::string& path) {
   PlyRead read(path, options, progress);
   read.prepare({prefix.data(), prefix.size()}, file->compressed());
   const Header& header = read.header;
-  if (header.format == Format::Ascii) return nullptr;
   for (std::size_t e = 0; e < header.elements.size(); ++e) {
     if (read.ctx.plans[e].kind != ElementPlan::Kind::Face || header.elements[e].count == 0) continue;
     if (read.ctx.vertex_count > 0xffffffffu) {
       fail_line(path, header.elements[e].header_line,
                 "faces cannot index more than 2^32 vertices (the file has " +
                     std::to_string(read.ctx.vertex_count) + ")");
+    }
+    if (header.format == Format::Ascii) {
+      return open_ascii_face_stream(path, header, e, read.ctx.plans[e], read.ctx.vertex_count);
     }
     return make_ply_face_stream(std::move(file), header, e, read.ctx.plans[e],
                                 read.ctx.vertex_count);

@@ -24,7 +24,7 @@ struct StreamedMeshOptions {
 // face, in file order, with the file's normals or the faces' area-weighted normals (normalized,
 // bit for bit those of mesh_vertex_normals), or none for Pca, and the file's radii or the faces'
 // enclosing-circle radii (mesh_radii with scale 1). `records` is a scratch file. Returns false,
-// doing nothing, when the input's faces cannot be streamed (ASCII PLY, OBJ). Throws as
+// doing nothing, when the input's faces cannot be streamed (OBJ). Throws as
 // prepare_mesh_vertices and the readers do, IoError when the disk is full.
 bool prepare_mesh_streamed(const std::string& input, const std::string& output,
                            const std::string& records, const PrepareOptions& prepare,

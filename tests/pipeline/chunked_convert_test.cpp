@@ -376,13 +376,19 @@ TEST(ChunkedConvert, AMeshLargerThanTheBudgetStreamsItsFacesOrStopsWithoutLeavin
     expect_renders_alike(c);
     EXPECT_FALSE(std::filesystem::exists(dir.file("parts.ptl.chunks")));
   }
-  // An ASCII PLY has no face stream: refused, saying what to do.
-  const std::string ascii = dir.file("ascii.ply");
-  write_ply(ascii, mesh, {.encoding = PlyEncoding::Ascii});
+  // An OBJ mesh has no face stream: refused, saying what to do.
+  const std::string obj = dir.file("torus.obj");
+  {
+    std::ofstream f(obj);
+    for (const Vec3f& p : mesh.positions) f << "v " << p.x << " " << p.y << " " << p.z << "\n";
+    for (const auto& t : mesh.triangles) {
+      f << "f " << t[0] + 1 << " " << t[1] + 1 << " " << t[2] + 1 << "\n";
+    }
+  }
   try {
-    convert(std::vector<std::string>{ascii}, dir.file("a.ptl"), {.memory_budget = 60 * 40 * 30},
+    convert(std::vector<std::string>{obj}, dir.file("a.ptl"), {.memory_budget = 60 * 40 * 30},
             pool, Progress::none());
-    FAIL() << "an ASCII mesh over the budget was converted";
+    FAIL() << "an OBJ mesh over the budget was converted";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("--memory"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("binary PLY"), std::string::npos) << e.what();

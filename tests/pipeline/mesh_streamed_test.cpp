@@ -209,15 +209,49 @@ TEST(StreamedMesh, BadFacesAreNamedAndNothingIsWritten) {
   }
 }
 
-TEST(StreamedMesh, FormatsWithoutStreamedFacesAreLeftToTheWholeReader) {
+TEST(StreamedMesh, AsciiPlyStreamsItsFacesToo) {
   TempDir dir;
-  PointSet m = testing::torus_mesh(6, 5);
+  PointSet m = testing::torus_mesh(kRows, kColumns);
+  m.positions.push_back({5, 5, 5});  // used by no face
+  m.colors.push_back({255, 0, 0});
+  std::shuffle(m.triangles.begin(), m.triangles.end(), std::mt19937(3));
   const std::string ascii = dir.file("torus.ply");
   write_ply(ascii, m, {.encoding = PlyEncoding::Ascii});
-  EXPECT_FALSE(prepare_mesh_streamed(ascii, dir.file("out.ply"), dir.file("sums"), {},
+  const PointSet s = streamed(dir, ascii, {}, kTinyCache);
+  EXPECT_EQ(s.size(), std::size_t{kRows} * kColumns);
+  expect_same(s, in_memory(ascii, {}));
+  // A face naming a vertex that is not there, on the file's last line: named by line.
+  std::ofstream(ascii, std::ios::app) << "3 0 1 99999\n";
+  {
+    std::string text;
+    std::ifstream in(ascii);
+    text.assign(std::istreambuf_iterator<char>(in), {});
+    const std::string from = "element face " + std::to_string(m.triangles.size()) + "\n";
+    const std::string to = "element face " + std::to_string(m.triangles.size() + 1) + "\n";
+    text.replace(text.find(from), from.size(), to);
+    std::ofstream(ascii, std::ios::trunc) << text;
+  }
+  try {
+    (void)prepare_mesh_streamed(ascii, dir.file("out.ply"), dir.file("sums"), {},
+                                Progress::none(), kTinyCache);
+    FAIL() << "a face out of range was accepted";
+  } catch (const FormatError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(": line "), std::string::npos) << what;
+    EXPECT_NE(what.find("out of range"), std::string::npos) << what;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.file("out.ply")));
+}
+
+TEST(StreamedMesh, FormatsWithoutStreamedFacesAreLeftToTheWholeReader) {
+  TempDir dir;
+  const std::string obj = dir.file("tri.obj");
+  std::ofstream(obj) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  EXPECT_FALSE(prepare_mesh_streamed(obj, dir.file("out.ply"), dir.file("sums"), {},
                                      Progress::none()));
   EXPECT_FALSE(std::filesystem::exists(dir.file("out.ply")));
-  m.triangles.clear();  // a binary file without faces has no face stream
+  PointSet m = testing::torus_mesh(6, 5);
+  m.triangles.clear();  // a file without faces has no face stream
   const std::string cloud = dir.file("cloud.ply");
   write_ply(cloud, m);
   EXPECT_EQ(open_face_stream(cloud), nullptr);

@@ -100,10 +100,10 @@ class FaceStream {
   std::uint64_t vertex_count_ = 0, face_count_ = 0;
 };
 
-// The faces of `path` as a stream: binary PLY files, plain or gzip, whatever their element
-// layout. Null for a file without faces and for files whose faces have no streamed form yet
-// (ASCII PLY, OBJ: read them whole). Throws what read_point_file throws for a bad header, and
-// IoError for a missing file.
+// The faces of `path` as a stream: PLY files, binary or ASCII, plain or gzip, whatever their
+// element layout. Null for a file without faces and for files whose faces have no streamed form
+// yet (OBJ: read it whole). Throws what read_point_file throws for a bad header, and IoError
+// for a missing file.
 std::unique_ptr<FaceStream> open_face_stream(const std::string& path);
 
 }  // namespace pointillist
