@@ -18,12 +18,6 @@ using namespace io_detail;
 
 constexpr std::int64_t kMaxVertices = std::numeric_limits<std::uint32_t>::max();
 
-// The largest index seen before what it refers to was defined, and where.
-struct ForwardReference {
-  std::int64_t index = 0;  // 1-based, as in the file
-  const char* token = nullptr;
-};
-
 class ObjParser {
  public:
   ObjParser(const std::string& path, std::string_view data, const ObjReadOptions& options,
@@ -88,68 +82,23 @@ class ObjParser {
 
   void parse_normal(const char* p, const char* le) {
     float values[3] = {};
-    for (int c = 0; c < 3; ++c) {
-      p = skip_blanks(p, le);
-      const char* q = p < le ? parse_real(p, le, values[c]) : nullptr;
-      if (!q)
-        fail(p, "vn: value " + std::to_string(c + 1) + ": expected a number, found " +
-                    quote_token(p, le) + " (vn lines hold 3 numbers)");
-      p = q;
-    }
-    p = skip_blanks(p, le);
-    if (p < le)
-      fail(p, "vn: extra value " + quote_token(p, le) + " (vn lines hold 3 numbers)");
+    parse_obj_normal(p, le, values, [this](const char* pos, const std::string& what) {
+      fail(pos, what);
+    });
     normals_.push_back({values[0], values[1], values[2]});
   }
 
-  // A corner's 0-based index. A positive index past what is defined so far refers forward; it
-  // is checked at the end (`forward` keeps the largest).
-  std::int64_t resolve(std::int64_t index, std::size_t defined, const char* token,
-                       const char* what, ForwardReference& forward) const {
-    if (index == 0)
-      fail(token, std::string("f: ") + what + " index 0 (OBJ indices start at 1; negative ones " +
-                      "count back from the last " + what + ")");
-    if (index < 0) {
-      const std::int64_t resolved = static_cast<std::int64_t>(defined) + index;
-      if (resolved < 0)
-        fail(token, std::string("f: relative ") + what + " index " + std::to_string(index) +
-                        " points before the first " + what + " (" + std::to_string(defined) +
-                        " defined so far)");
-      return resolved;
-    }
-    if (index > kMaxVertices)
-      fail(token, std::string("f: ") + what + " index " + std::to_string(index) +
-                      " is larger than 2^32 - 1");
-    if (static_cast<std::size_t>(index) > defined && index > forward.index)
-      forward = {index, token};
-    return index - 1;
-  }
-
   void parse_face(const char* p, const char* le) {
+    const auto fail_at = [this](const char* pos, const std::string& what) { fail(pos, what); };
     ply::FanBuilder fan;
-    for (;;) {
-      p = skip_blanks(p, le);
-      if (p == le) break;
-      const char* token = p;
-      std::int64_t v = 0, vt = 0, vn = 0;
-      bool has_vn = false;
-      p = parse_index(p, le, v);
-      if (p && p < le && *p == '/') {
-        ++p;
-        if (p < le && *p != '/') p = parse_index(p, le, vt);  // texture index: unused
-        if (p && p < le && *p == '/') {
-          has_vn = true;
-          p = parse_index(p + 1, le, vn);
-        }
-      }
-      if (!p || (p < le && !is_blank(*p)))
-        fail(token, "f: corner " + std::to_string(fan.seen + 1) +
-                        ": expected v, v/vt, v//vn or v/vt/vn with integer indices, found " +
-                        quote_token(token, le));
-      const std::int64_t vi = resolve(v, positions_.size(), token, "vertex", forward_vertex_);
+    ObjCorner c;
+    while ((p = parse_obj_corner(p, le, fan.seen + 1, c, fail_at))) {
+      const std::int64_t vi =
+          resolve_obj_index(c.v, positions_.size(), c.token, "vertex", forward_vertex_, fail_at);
       fan.add(static_cast<std::uint32_t>(vi), triangles_);
-      if (!has_vn) continue;
-      const std::int64_t ni = resolve(vn, normals_.size(), token, "normal", forward_normal_);
+      if (!c.has_vn) continue;
+      const std::int64_t ni =
+          resolve_obj_index(c.vn, normals_.size(), c.token, "normal", forward_normal_, fail_at);
       has_normal_refs_ = true;
       if (static_cast<std::size_t>(vi) < positions_.size() &&
           static_cast<std::size_t>(ni) < normals_.size())
