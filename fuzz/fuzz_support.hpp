@@ -154,6 +154,11 @@ void check_reader_and_stream(InputFile& file, const std::uint8_t* data, std::siz
   if (done) expect_stream_matches(file.named(extension), whole);
 }
 
+// Differential check of a face stream (open_face_stream) on `path`: it may refuse only as
+// readers do; when the whole reader read the file (`read`, giving `whole`), the stream must open
+// and give the same triangles, no more at any point.
+inline void expect_face_stream_matches(const std::string& path, bool read, const PointSet& whole);
+
 // Runs `read` (which reads `path`), catching what a reader may throw for bad input: FormatError
 // (whose message must name the file), IoError, OptionError, and std::bad_alloc when a reader
 // legitimately refuses. Anything else escapes to libFuzzer as a finding.
@@ -167,6 +172,28 @@ void expect_reader_errors(const std::string& path, Read&& read) {
   } catch (const IoError&) {
   } catch (const OptionError&) {
   } catch (const std::bad_alloc&) {
+  }
+}
+
+inline void expect_face_stream_matches(const std::string& path, bool read, const PointSet& whole) {
+  bool opened = false, has_stream = false, streamed = false;
+  std::vector<std::array<std::uint32_t, 3>> all;
+  expect_reader_errors(path, [&] {
+    const std::unique_ptr<FaceStream> faces = open_face_stream(path);
+    opened = true;
+    if (!faces) return;  // no faces
+    has_stream = true;
+    std::vector<std::array<std::uint32_t, 3>> part;
+    while (faces->read(part)) {
+      all.insert(all.end(), part.begin(), part.end());
+      if (read && all.size() > whole.triangles.size()) finding("the face stream gives more");
+    }
+    streamed = true;
+  });
+  if (read && !opened) finding("the face stream refused what the whole reader read");
+  if (read && has_stream && !streamed) finding("the face stream refused faces the reader read");
+  if (read && streamed && all != whole.triangles) {
+    finding("the face stream's triangles differ from the whole reader's");
   }
 }
 

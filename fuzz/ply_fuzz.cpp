@@ -18,25 +18,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     fuzz::check_point_set(whole);
     read = true;
   });
-  const std::string& named = file.named(".ply");
-  bool opened = false, has_stream = false, streamed = false;
-  std::vector<std::array<std::uint32_t, 3>> all;
-  fuzz::expect_reader_errors(named, [&] {
-    const std::unique_ptr<FaceStream> faces = open_face_stream(named);
-    opened = true;
-    if (!faces) return;  // no faces
-    has_stream = true;
-    std::vector<std::array<std::uint32_t, 3>> part;
-    while (faces->read(part)) {
-      all.insert(all.end(), part.begin(), part.end());
-      if (read && all.size() > whole.triangles.size()) fuzz::finding("the face stream gives more");
-    }
-    streamed = true;
-  });
-  if (read && !opened) fuzz::finding("the face stream refused a header read_ply read");
-  if (read && has_stream && !streamed) fuzz::finding("the face stream refused faces read_ply read");
-  if (read && streamed && all != whole.triangles) {
-    fuzz::finding("the face stream's triangles differ from read_ply's");
-  }
+  fuzz::expect_face_stream_matches(file.named(".ply"), read, whole);
   return 0;
 }

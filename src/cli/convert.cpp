@@ -123,7 +123,7 @@ Command add_convert_command(CLI::App& app) {
   cmd->add_option("--memory", *memory,
                   "Memory the conversion may use (e.g. 8G, 500M; default: half of the physical "
                   "memory). Scans that need more are converted to .ptl in chunks (a mesh over "
-                  "the budget at 56 bytes a vertex streams its faces: PLY only)");
+                  "the budget at 56 bytes a vertex streams its faces)");
   cmd->add_option("--chunk-points", o->convert.chunk_points,
                   ".ptl: convert in chunks of at most this many points, whatever the memory");
   add_columns(cmd, o->convert.columns);

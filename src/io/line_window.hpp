@@ -98,13 +98,21 @@ class LineWindow {
     }
     gzbuffer(file_, 1 << 20);
   }
-  // Moves the unread bytes to the front and reads more after them.
+  // Moves the unread bytes to the front and reads more after them. The window starts at 64 KB
+  // and doubles at each refill up to kTextWindowBytes: a small file is not given 8 MB (the
+  // fuzzers open thousands a second), a large one reaches the full window after a few.
   void refill() {
-    if (buffer_.size() < kTextWindowBytes) buffer_.resize(kTextWindowBytes);
+    if (buffer_.size() < kTextWindowBytes) {
+      buffer_.resize(std::clamp<std::size_t>(2 * buffer_.size(), std::size_t{64} << 10,
+                                             kTextWindowBytes));
+    }
     lines_before_ += std::size_t(std::count(buffer_.data(), buffer_.data() + begin_, '\n'));
     if (end_ > begin_) std::memmove(buffer_.data(), buffer_.data() + begin_, end_ - begin_);
     end_ -= begin_;
     begin_ = 0;
+    if (end_ == buffer_.size() && buffer_.size() < kTextWindowBytes) {
+      buffer_.resize(std::min(2 * buffer_.size(), kTextWindowBytes));  // a long line
+    }
     if (end_ == buffer_.size()) {
       throw FormatError(path_ + ": line " + std::to_string(lines_before_ + 1) +
                         ": longer than " + std::to_string(kTextWindowBytes >> 20) +

@@ -4,6 +4,7 @@
 // vertex has a colour and on which scale, and whether faces make triangles (a mesh: its vertices
 // stream, but the chunked conversion refuses meshes). Each read parses the next `v` lines.
 #include <filesystem>
+#include <memory>
 #include <string_view>
 
 #include "line_window.hpp"
@@ -135,7 +136,137 @@ class ObjStream final : public PointStream {
   bool pending_start_ = true;
 };
 
+// The faces of an OBJ file a window of lines at a time, with the corners that name file normals,
+// and the `vn` lines in a pass of their own. Opening counts the v, vn and f lines, so a corner
+// naming a vertex or normal defined later is checked at once against the file's count.
+class ObjFaceStream final : public FaceStream {
+  struct Fail {
+    const std::string& path;
+    const std::uint64_t& line;
+    [[noreturn]] void operator()(const char*, const std::string& what) const {
+      throw FormatError(path + ": line " + std::to_string(line) + ": " + what);
+    }
+  };
+
+ public:
+  explicit ObjFaceStream(const std::string& path) : path_(path), window_(path) {
+    window_.rewind();
+    const char* t;
+    const char* le;
+    std::string_view keyword;
+    while (next(window_, line_, t, le, keyword)) {
+      if (keyword == "v") ++vertex_count_;
+      if (keyword == "vn") ++normal_count_;
+      if (keyword == "f") ++face_count_;
+    }
+    if (vertex_count_ > 0xffffffffu) {
+      throw FormatError(path + ": more than 2^32 - 1 vertices (triangles hold 32-bit indices)");
+    }
+    window_.rewind();
+    line_ = 0;
+  }
+
+  bool read(std::vector<std::array<std::uint32_t, 3>>& triangles) override {
+    triangles.clear();
+    normal_refs_.clear();
+    if (done_) return false;
+    const Fail fail{path_, line_};
+    const char* t;
+    const char* le;
+    std::string_view keyword;
+    for (std::uint64_t faces = 0; faces < kWindowFaces;) {
+      if (!next(window_, line_, t, le, keyword)) {
+        done_ = true;
+        window_.release();
+        break;
+      }
+      if (keyword == "v") ++defined_v_;
+      if (keyword == "vn") ++defined_vn_;
+      if (keyword != "f") continue;
+      ply::FanBuilder fan;
+      ObjCorner c;
+      for (const char* p = t; (p = parse_obj_corner(p, le, fan.seen + 1, c, fail));) {
+        const std::int64_t v =
+            resolve_obj_index(c.v, defined_v_, c.token, "vertex", forward_, fail);
+        if (std::uint64_t(v) >= vertex_count_) {
+          fail(c.token, "f: vertex index " + std::to_string(c.v) + " out of range (the file has " +
+                            std::to_string(vertex_count_) + " vertices)");
+        }
+        fan.add(static_cast<std::uint32_t>(v), triangles);
+        if (!c.has_vn) continue;
+        const std::int64_t n =
+            resolve_obj_index(c.vn, defined_vn_, c.token, "normal", forward_, fail);
+        if (std::uint64_t(n) >= normal_count_) {
+          fail(c.token, "f: normal index " + std::to_string(c.vn) + " out of range (the file has " +
+                            std::to_string(normal_count_) + " vn lines)");
+        }
+        normal_refs_.push_back({static_cast<std::uint32_t>(v), static_cast<std::uint32_t>(n)});
+      }
+      ++faces;
+      ++faces_done_;
+    }
+    return true;
+  }
+  std::uint64_t faces_done() const override { return faces_done_; }
+
+  bool read_normals(std::vector<Vec3f>& normals) override {
+    normals.clear();
+    if (!normal_window_) {
+      normal_window_ = std::make_unique<LineWindow>(path_);
+      normal_window_->rewind();
+      normal_line_ = 0;
+    }
+    const Fail fail{path_, normal_line_};
+    const char* t;
+    const char* le;
+    std::string_view keyword;
+    while (normals.size() < kWindowFaces) {
+      if (!next(*normal_window_, normal_line_, t, le, keyword)) {
+        normal_window_->release();
+        break;
+      }
+      if (keyword != "vn") continue;
+      float values[3] = {};
+      parse_obj_normal(t, le, values, fail);
+      normals.push_back({values[0], values[1], values[2]});
+    }
+    return !normals.empty();
+  }
+
+ private:
+  static constexpr std::uint64_t kWindowFaces = 1 << 16;
+  // The next line that is not blank or a comment: t after its keyword, its end, the keyword.
+  static bool next(LineWindow& window, std::uint64_t& line, const char*& t, const char*& le,
+                   std::string_view& keyword) {
+    const char* start;
+    while (window.next_line(start, le)) {
+      ++line;
+      const char* k = skip_blanks(start, le);
+      if (k == le || *k == '#') continue;
+      t = k;
+      while (t < le && !is_blank(*t)) ++t;
+      keyword = std::string_view(k, std::size_t(t - k));
+      return true;
+    }
+    return false;
+  }
+
+  std::string path_;  // before window_, which uses it
+  LineWindow window_;
+  std::unique_ptr<LineWindow> normal_window_;
+  std::uint64_t line_ = 0, normal_line_ = 0;
+  std::uint64_t defined_v_ = 0, defined_vn_ = 0, faces_done_ = 0;
+  ForwardReference forward_;  // (checked at once against the counts)
+  bool done_ = false;
+};
+
 }  // namespace
+
+std::unique_ptr<FaceStream> open_obj_face_stream(const std::string& path) {
+  auto stream = std::make_unique<ObjFaceStream>(path);
+  if (stream->face_count() == 0) return nullptr;
+  return stream;
+}
 
 std::unique_ptr<PointStream> open_obj_stream(const std::string& path,
                                              const PointReadOptions& options) {

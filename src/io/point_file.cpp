@@ -180,6 +180,7 @@ std::unique_ptr<FaceStream> open_face_stream(const std::string& path) {
     throw IoError(path + ": no such file; check the path");
   }
   if (kind_of(path) == Kind::Ply) return io_detail::open_ply_face_stream(path);
+  if (kind_of(path) == Kind::Obj) return io_detail::open_obj_face_stream(path);
   return nullptr;
 }
 

@@ -22,6 +22,10 @@ std::unique_ptr<PointStream> open_ply_stream(const std::string& path,
 // without faces. Throws what read_ply throws for a bad header.
 std::unique_ptr<FaceStream> open_ply_face_stream(const std::string& path);
 
+// The faces of an OBJ file (plain or gzip) as a stream, checked as read_obj checks them; null
+// for a file without `f` lines.
+std::unique_ptr<FaceStream> open_obj_face_stream(const std::string& path);
+
 // A LAS file (plain or gzip), read a window of records at a time after one pass over all of
 // them (the origin and the colour scale, as read_las finds them). Throws what read_las throws.
 std::unique_ptr<PointStream> open_las_stream(const std::string& path,

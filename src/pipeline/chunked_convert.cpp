@@ -57,7 +57,7 @@ std::string relations_kind(int rank) { return "relations" + std::to_string(rank)
 // A mesh's vertices as a point file in the work folder, with the normals and radii its faces
 // give (prepare_mesh_vertices): the chunks hold points only. A mesh that fits the budget at
 // about kMeshBytesPerVertex is read whole; a larger one streams its faces past its vertices'
-// sums on disk (mesh_streamed.hpp) when its format allows (PLY). Other inputs pass
+// sums on disk (mesh_streamed.hpp). Other inputs pass
 // through.
 std::vector<std::string> meshes_as_points(std::span<const std::string> inputs,
                                           const WorkFolder& folder, const ConvertOptions& o,
@@ -98,7 +98,7 @@ std::vector<std::string> meshes_as_points(std::span<const std::string> inputs,
       throw Error(path + ": a mesh of this size needs about " + std::to_string(need / 1'000'000) +
                   " MB to find its normals and radii from its faces, over the memory budget of " +
                   std::to_string(budget / 1'000'000) + " MB, and its faces cannot be streamed "
-                  "from this format (OBJ); raise --memory, or save it as binary PLY");
+                  "from this file; raise --memory");
     }
     PointSet mesh = read_point_file(path, progress, {.columns = o.columns});
     prepare_mesh_vertices(mesh, pool, progress, prepare);

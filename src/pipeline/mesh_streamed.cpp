@@ -15,6 +15,7 @@
 #include <array>
 #include <cerrno>
 #include <cstring>
+#include <optional>
 #include <vector>
 
 #include "pointillist/core/error.hpp"
@@ -41,7 +42,10 @@ class ScratchFile {
                     " (the output's folder must be writable)");
     }
   }
-  ~ScratchFile() { ::close(fd_); }
+  ~ScratchFile() {
+    ::close(fd_);
+    ::unlink(path_.c_str());
+  }
   ScratchFile(const ScratchFile&) = delete;
   ScratchFile& operator=(const ScratchFile&) = delete;
 
@@ -76,16 +80,17 @@ class ScratchFile {
   int fd_ = -1;
 };
 
-// The records of the scratch file a page at a time: a page is read when first touched and
+// The records of a scratch file a page at a time: a page is read when first touched and
 // written again when a newer one pushes it out (clock order), until freeze().
-class SumPages {
+template <class Record>
+class Pages {
  public:
-  SumPages(ScratchFile& file, std::uint64_t count, std::uint64_t page, std::uint64_t cache_bytes)
+  Pages(ScratchFile& file, std::uint64_t count, std::uint64_t page, std::uint64_t cache_bytes)
       : file_(file), count_(count), page_(std::max<std::uint64_t>(1, page)) {
     slot_of_.assign(static_cast<std::size_t>((count + page_ - 1) / page_), -1);
-    max_slots_ = std::max<std::uint64_t>(4, cache_bytes / (page_ * sizeof(VertexSums)));
+    max_slots_ = std::max<std::uint64_t>(4, cache_bytes / (page_ * sizeof(Record)));
   }
-  VertexSums& at(std::uint64_t v) {
+  Record& at(std::uint64_t v) {
     const std::uint64_t page = v / page_;
     if (page != last_page_) {
       last_ = hold(page);
@@ -97,8 +102,8 @@ class SumPages {
   // only read from here on (pages pushed out later must come back from the file whole).
   void freeze() {
     for (const Slot& slot : slots_) {
-      file_.write(first(slot.page) * sizeof(VertexSums), slot.sums.data(),
-                  slot.sums.size() * sizeof(VertexSums));
+      file_.write(first(slot.page) * sizeof(Record), slot.sums.data(),
+                  slot.sums.size() * sizeof(Record));
     }
     write_back_ = false;
   }
@@ -107,13 +112,13 @@ class SumPages {
   struct Slot {
     std::uint64_t page = 0;
     bool referenced = false;
-    std::vector<VertexSums> sums;
+    std::vector<Record> sums;
   };
   std::uint64_t first(std::uint64_t page) const { return page * page_; }
   std::size_t size(std::uint64_t page) const {
     return static_cast<std::size_t>(std::min(page_, count_ - first(page)));
   }
-  VertexSums* hold(std::uint64_t page) {
+  Record* hold(std::uint64_t page) {
     std::int64_t s = slot_of_[page];
     if (s >= 0) {
       slots_[std::size_t(s)].referenced = true;
@@ -131,8 +136,8 @@ class SumPages {
       hand_ = (hand_ + 1) % slots_.size();
       Slot& old = slots_[std::size_t(s)];
       if (write_back_) {
-        file_.write(first(old.page) * sizeof(VertexSums), old.sums.data(),
-                    old.sums.size() * sizeof(VertexSums));
+        file_.write(first(old.page) * sizeof(Record), old.sums.data(),
+                    old.sums.size() * sizeof(Record));
       }
       slot_of_[old.page] = -1;
     }
@@ -140,8 +145,8 @@ class SumPages {
     slot.page = page;
     slot.referenced = true;
     slot.sums.resize(size(page));
-    file_.read(first(page) * sizeof(VertexSums), slot.sums.data(),
-               slot.sums.size() * sizeof(VertexSums));
+    file_.read(first(page) * sizeof(Record), slot.sums.data(),
+               slot.sums.size() * sizeof(Record));
     slot_of_[page] = s;
     return slot.sums.data();
   }
@@ -152,7 +157,7 @@ class SumPages {
   std::vector<Slot> slots_;
   std::size_t hand_ = 0;
   std::uint64_t last_page_ = ~std::uint64_t{0};
-  VertexSums* last_ = nullptr;
+  Record* last_ = nullptr;
   bool write_back_ = true;
 };
 
@@ -193,13 +198,29 @@ bool prepare_mesh_streamed(const std::string& input, const std::string& output,
       phase.advance(got);
     }
   }
-  const bool file_normals = info.has_normals && vertices->saw_usable_normals();
-  const NormalSource source = prepare.normals;
-  if (source == NormalSource::Keep && !file_normals) {
-    throw Error("--normals keep: " + name +
-                " has no normals (no nx/ny/nz vertex properties); use --normals auto or pca");
+  // OBJ's file normals: the vn lines go to a scratch file, and each vertex sums those its
+  // corners name, in file order (read_obj's sums), in a scratch file of its own.
+  std::optional<ScratchFile> vn_file, vn_sum_file;
+  std::optional<Pages<Vec3f>> vn, vn_sums;
+  std::uint64_t cache = options.cache_bytes;
+  if (faces->normal_count() > 0) {
+    cache /= 3;
+    vn_file.emplace(records + ".vn");
+    std::vector<Vec3f> values;
+    for (std::uint64_t at = 0; faces->read_normals(values); at += values.size()) {
+      vn_file->write(at * sizeof(Vec3f), values.data(), values.size() * sizeof(Vec3f));
+    }
+    vn_sum_file.emplace(records + ".vns");
+    values.assign(kBatch, Vec3f{0, 0, 0});
+    for (std::uint64_t at = 0; at < n; at += kBatch) {
+      vn_sum_file->write(at * sizeof(Vec3f), values.data(),
+                         std::min<std::uint64_t>(kBatch, n - at) * sizeof(Vec3f));
+    }
+    vn.emplace(*vn_file, faces->normal_count(), options.page_vertices, cache);
+    vn_sums.emplace(*vn_sum_file, n, options.page_vertices, cache);
   }
-  SumPages pages(file, n, options.page_vertices, options.cache_bytes);
+  bool normal_refs = false;
+  Pages<VertexSums> pages(file, n, options.page_vertices, cache);
   std::uint64_t used = 0, triangle_count = 0;
   {
     ProgressPhase phase(progress, "mesh faces", faces->face_count());
@@ -219,6 +240,11 @@ bool prepare_mesh_streamed(const std::string& input, const std::string& output,
           s.radius = std::max(std::max(s.radius, 0.0f), r);
         }
       }
+      for (const auto& [v, k] : faces->normal_refs()) {
+        const Vec3f value = vn->at(k);
+        vn_sums->at(v) += value;
+        normal_refs = true;
+      }
       triangle_count += triangles.size();
       phase.advance(faces->faces_done() - reported);
       reported = faces->faces_done();
@@ -226,6 +252,15 @@ bool prepare_mesh_streamed(const std::string& input, const std::string& output,
   }
   faces.reset();
   pages.freeze();
+  if (vn_sums) vn_sums->freeze();
+  // Every vertex of an OBJ whose corners name normals has one (read_obj: the faces' where its
+  // own sum is zero).
+  const bool file_normals = (info.has_normals && vertices->saw_usable_normals()) || normal_refs;
+  const NormalSource source = prepare.normals;
+  if (source == NormalSource::Keep && !file_normals) {
+    throw Error("--normals keep: " + name +
+                " has no normals (no nx/ny/nz vertex properties); use --normals auto or pca");
+  }
   // A file whose faces make no triangle is a point cloud: every vertex is kept, as in one piece.
   const bool mesh = triangle_count > 0;
   const bool mesh_normals =
@@ -255,6 +290,10 @@ bool prepare_mesh_streamed(const std::string& input, const std::string& output,
         out.positions.push_back(batch.positions[i]);
         if (mesh_normals) {
           out.normals.push_back(normalized(s.normal, {0, 0, 1}));
+        } else if (normals && normal_refs) {
+          Vec3f sum = vn_sums->at(done + i);
+          if (!(length_squared(sum) > 0.0f) || !is_finite(sum)) sum = s.normal;
+          out.normals.push_back(normalized(sum));
         } else if (normals) {
           out.normals.push_back(batch.normals[i]);
         }

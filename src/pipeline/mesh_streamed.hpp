@@ -21,10 +21,13 @@ struct StreamedMeshOptions {
 
 // Writes to `output` (a binary PLY) what prepare_mesh_vertices makes of the mesh `input`, in
 // memory bounded by `options.cache_bytes` and the streams' windows: the vertices used by some
-// face, in file order, with the file's normals or the faces' area-weighted normals (normalized,
-// bit for bit those of mesh_vertex_normals), or none for Pca, and the file's radii or the faces'
-// enclosing-circle radii (mesh_radii with scale 1). `records` is a scratch file. Returns false,
-// doing nothing, when the input's faces cannot be streamed (OBJ). Throws as
+// face, in file order, with the file's normals (a PLY's, or an OBJ's `vn` sums as read_obj
+// makes them; bit for bit, but for corners that name a normal defined after them, which read_obj
+// adds last) or the faces' area-weighted normals (normalized, bit for bit those of
+// mesh_vertex_normals), or none for Pca, and the file's radii or the faces' enclosing-circle
+// radii (mesh_radii with scale 1). `records` names scratch files (it, and with a suffix for an
+// OBJ's normals), removed when done. Returns false,
+// doing nothing, when the input has no face stream (no faces, or not PLY or OBJ). Throws as
 // prepare_mesh_vertices and the readers do, IoError when the disk is full.
 bool prepare_mesh_streamed(const std::string& input, const std::string& output,
                            const std::string& records, const PrepareOptions& prepare,

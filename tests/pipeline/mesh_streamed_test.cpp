@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <sstream>
 
 #include "mesh_streamed.hpp"
 #include "pointillist/core/error.hpp"
@@ -243,13 +244,90 @@ TEST(StreamedMesh, AsciiPlyStreamsItsFacesToo) {
   EXPECT_FALSE(std::filesystem::exists(dir.file("out.ply")));
 }
 
-TEST(StreamedMesh, FormatsWithoutStreamedFacesAreLeftToTheWholeReader) {
+// The torus as OBJ: a face that names vertices defined after it (first line), v lines with
+// colours, vn lines for every third vertex, faces with v, v//vn and v/vt/vn corners, relative
+// (negative) indices and quads, and a vertex no face uses.
+std::string write_torus_obj(const TempDir& dir, bool normals) {
+  const PointSet m = testing::torus_mesh(kRows, kColumns);
+  const std::size_t n = m.size();
+  std::ostringstream f;
+  f.precision(9);
+  const auto corner = [&](std::uint32_t v, bool relative) {
+    std::string c = relative ? std::to_string(std::int64_t(v) - std::int64_t(n + 1))
+                             : std::to_string(v + 1);
+    if (normals && v % 3 == 0) c += (v % 2 ? "/1/" : "//") + std::to_string(v / 3 + 1);
+    return c;
+  };
+  const auto face_line = [&](std::size_t t, bool relative) {
+    const auto& a = m.triangles[t];
+    return "f " + corner(a[0], relative) + " " + corner(a[1], relative) + " " +
+           corner(a[2], relative) + "\n";
+  };
+  f << "# a torus\n" << face_line(1, false);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3f p = m.positions[i];
+    f << "v " << p.x << " " << p.y << " " << p.z << " " << m.colors[i].r / 255.0 << " "
+      << m.colors[i].g / 255.0 << " " << m.colors[i].b / 255.0 << "\n";
+  }
+  f << "v 5 5 5 1 0 0\nvt 0.5 0.5\n";
+  if (normals) {
+    for (std::size_t i = 0; i < n; i += 3) {
+      const Vec3f p = m.positions[i];
+      f << "vn " << p.x << " " << p.y * 3 << " " << p.z << "\n";  // not unit length
+    }
+  }
+  for (std::size_t t = 0; t < m.triangles.size(); t += 2) {
+    if (t % 8 == 4) {  // a quad: the square's two triangles
+      const auto& a = m.triangles[t];
+      const auto& b = m.triangles[t + 1];
+      f << "f " << corner(a[2], false) << " " << corner(a[0], false) << " "
+        << corner(a[1], false) << " " << corner(b[2], false) << "\n";
+      continue;
+    }
+    f << face_line(t, t % 6 == 2);
+    if (t + 1 != 1) f << face_line(t + 1, false);  // (triangle 1 is the first line)
+  }
+  const std::string path = dir.file(normals ? "torus-vn.obj" : "torus.obj");
+  std::ofstream(path) << f.str();
+  return path;
+}
+
+TEST(StreamedMesh, ObjStreamsItsFacesAndItsFileNormals) {
+  for (const bool normals : {false, true}) {
+    SCOPED_TRACE(normals ? "with vn" : "without vn");
+    TempDir dir;
+    const std::string obj = write_torus_obj(dir, normals);
+    const PointSet whole = in_memory(obj, {});
+    ASSERT_EQ(whole.normals.size(), whole.size());
+    for (const StreamedMeshOptions& o : {StreamedMeshOptions{}, kTinyCache}) {
+      const PointSet s = streamed(dir, obj, {}, o);
+      EXPECT_EQ(s.size(), std::size_t{kRows} * kColumns);
+      expect_same(s, whole);
+    }
+    expect_same(streamed(dir, obj, {.normals = NormalSource::Mesh}, kTinyCache),
+                in_memory(obj, {.normals = NormalSource::Mesh}));
+  }
+  // A corner naming a vertex the file does not have: named by line.
   TempDir dir;
-  const std::string obj = dir.file("tri.obj");
-  std::ofstream(obj) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
-  EXPECT_FALSE(prepare_mesh_streamed(obj, dir.file("out.ply"), dir.file("sums"), {},
-                                     Progress::none()));
+  const std::string bad = dir.file("bad.obj");
+  std::ofstream(bad) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 7\n";
+  try {
+    (void)prepare_mesh_streamed(bad, dir.file("out.ply"), dir.file("sums"), {},
+                                Progress::none(), kTinyCache);
+    FAIL() << "a corner out of range was accepted";
+  } catch (const FormatError& e) {
+    EXPECT_NE(std::string(e.what()).find(bad + ": line 5: f: vertex index 7 out of range"),
+              std::string::npos)
+        << e.what();
+  }
   EXPECT_FALSE(std::filesystem::exists(dir.file("out.ply")));
+}
+
+TEST(StreamedMesh, FilesWithoutFacesHaveNoFaceStream) {
+  TempDir dir;
+  const std::string obj = dir.file("points.obj");
+  std::ofstream(obj) << "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+  EXPECT_EQ(open_face_stream(obj), nullptr);
   PointSet m = testing::torus_mesh(6, 5);
   m.triangles.clear();  // a file without faces has no face stream
   const std::string cloud = dir.file("cloud.ply");

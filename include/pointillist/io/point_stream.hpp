@@ -96,14 +96,26 @@ class FaceStream {
   std::uint64_t vertex_count() const { return vertex_count_; }
   std::uint64_t face_count() const { return face_count_; }
 
+  // OBJ's file normals: the corners of the faces just read that name one (`f v//vn`), as
+  // (vertex, normal) 0-based indices in file order (read_obj sums each vertex's), and the `vn`
+  // lines themselves, a window at a time in a pass of their own (false at the end). PLY has
+  // none.
+  const std::vector<std::array<std::uint32_t, 2>>& normal_refs() const { return normal_refs_; }
+  std::uint64_t normal_count() const { return normal_count_; }
+  virtual bool read_normals(std::vector<Vec3f>& normals) {
+    normals.clear();
+    return false;
+  }
+
  protected:
-  std::uint64_t vertex_count_ = 0, face_count_ = 0;
+  std::uint64_t vertex_count_ = 0, face_count_ = 0, normal_count_ = 0;
+  std::vector<std::array<std::uint32_t, 2>> normal_refs_;
 };
 
-// The faces of `path` as a stream: PLY files, binary or ASCII, plain or gzip, whatever their
-// element layout. Null for a file without faces and for files whose faces have no streamed form
-// yet (OBJ: read it whole). Throws what read_point_file throws for a bad header, and IoError
-// for a missing file.
+// The faces of `path` as a stream: PLY files, binary or ASCII, whatever their element layout,
+// and OBJ files, plain or gzip. Null for a file without faces. Throws what read_point_file
+// throws for a bad header (PLY) or a bad line found by the OBJ stream's first pass (which
+// counts the lines), and IoError for a missing file.
 std::unique_ptr<FaceStream> open_face_stream(const std::string& path);
 
 }  // namespace pointillist
