@@ -179,11 +179,13 @@ namespace pointillist::io_detail {
 class FileWindow;
 
 // The faces of element `face` of a binary PLY file as a stream (ply_face_stream.cpp); `plan` is
-// the element's plan, `vertex_count` the vertex element's count.
+// the element's plan, `vertex_count` the vertex element's count; windows of at most
+// `window_bytes` (more only for a face larger than that).
 std::unique_ptr<FaceStream> make_ply_face_stream(std::unique_ptr<FileWindow> file,
                                                  const ply::Header& header, std::size_t face,
                                                  const ply::ElementPlan& plan,
-                                                 std::uint64_t vertex_count);
+                                                 std::uint64_t vertex_count,
+                                                 std::size_t window_bytes);
 
 // The vertex element of an ASCII PLY file (plain or gzip), `info` filled from its header, read
 // a window of lines at a time (ply_ascii_stream.cpp). `scales`: the three colour scales.

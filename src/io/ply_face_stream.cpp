@@ -72,8 +72,9 @@ Walk whole_records(const Element& element, const unsigned char* data, std::size_
 class PlyFaceStream final : public FaceStream {
  public:
   PlyFaceStream(std::unique_ptr<FileWindow> file, const Header& header, std::size_t face,
-                const ElementPlan& plan, std::uint64_t vertex_count)
+                const ElementPlan& plan, std::uint64_t vertex_count, std::size_t window_bytes)
       : file_(std::move(file)),
+        window_bytes_(std::max<std::size_t>(window_bytes, 16)),
         swap_((header.format == Format::BinaryBigEndian) != (std::endian::native == std::endian::big)) {
     vertex_count_ = vertex_count;
     face_count_ = header.elements[face].count;
@@ -118,7 +119,7 @@ class PlyFaceStream final : public FaceStream {
   // the window while it holds not one whole record and the file goes on.
   Walk window(const Element& element, std::uint64_t at, std::uint64_t most) {
     // (a plain file's window stops at its end: a small file is not given a large buffer)
-    std::size_t want = kStreamWindowBytes;
+    std::size_t want = window_bytes_;
     if (!file_->compressed() && file_->size() > at) {
       want = static_cast<std::size_t>(std::min<std::uint64_t>(want, file_->size() - at));
     }
@@ -162,6 +163,7 @@ class PlyFaceStream final : public FaceStream {
   }
 
   std::unique_ptr<FileWindow> file_;
+  const std::size_t window_bytes_;
   const bool swap_;
   Header window_header_;
   BodyContext ctx_;
@@ -174,8 +176,10 @@ class PlyFaceStream final : public FaceStream {
 std::unique_ptr<FaceStream> make_ply_face_stream(std::unique_ptr<FileWindow> file,
                                                  const Header& header, std::size_t face,
                                                  const ElementPlan& plan,
-                                                 std::uint64_t vertex_count) {
-  return std::make_unique<PlyFaceStream>(std::move(file), header, face, plan, vertex_count);
+                                                 std::uint64_t vertex_count,
+                                                 std::size_t window_bytes) {
+  return std::make_unique<PlyFaceStream>(std::move(file), header, face, plan, vertex_count,
+                                         window_bytes);
 }
 
 }  // namespace pointillist::io_detail

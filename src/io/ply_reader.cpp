@@ -551,7 +551,8 @@ std::unique_ptr<PointStream> open_ply_stream(const std::string& path,
   return stream;
 }
 
-std::unique_ptr<FaceStream> open_ply_face_stream(const std::string& path) {
+std::unique_ptr<FaceStream> open_ply_face_stream(const std::string& path,
+                                                 std::size_t window_bytes) {
   auto file = std::make_unique<FileWindow>(path);
   const std::vector<char> prefix = header_prefix(*file);
   PlyProgress progress(Progress::none(), 1);
@@ -570,7 +571,7 @@ std::unique_ptr<FaceStream> open_ply_face_stream(const std::string& path) {
       return open_ascii_face_stream(path, header, e, read.ctx.plans[e], read.ctx.vertex_count);
     }
     return make_ply_face_stream(std::move(file), header, e, read.ctx.plans[e],
-                                read.ctx.vertex_count);
+                                read.ctx.vertex_count, window_bytes);
   }
   return nullptr;
 }

@@ -175,11 +175,11 @@ std::unique_ptr<PointStream> open_point_stream(const std::string& path,
   return std::make_unique<WholeFileStream>(path, read_point_file(path, Progress::none(), options));
 }
 
-std::unique_ptr<FaceStream> open_face_stream(const std::string& path) {
+std::unique_ptr<FaceStream> open_face_stream(const std::string& path, std::size_t window_bytes) {
   if (!std::filesystem::exists(path)) {
     throw IoError(path + ": no such file; check the path");
   }
-  if (kind_of(path) == Kind::Ply) return io_detail::open_ply_face_stream(path);
+  if (kind_of(path) == Kind::Ply) return io_detail::open_ply_face_stream(path, window_bytes);
   if (kind_of(path) == Kind::Obj) return io_detail::open_obj_face_stream(path);
   return nullptr;
 }

@@ -18,9 +18,11 @@ namespace pointillist::io_detail {
 std::unique_ptr<PointStream> open_ply_stream(const std::string& path,
                                              const PointReadOptions& options);
 
-// The faces of a binary PLY file (plain or gzip) as a stream; null for an ASCII file or one
-// without faces. Throws what read_ply throws for a bad header.
-std::unique_ptr<FaceStream> open_ply_face_stream(const std::string& path);
+// The faces of a PLY file (binary or ASCII, plain or gzip) as a stream, a binary file's windows
+// of at most `window_bytes`; null for a file without faces. Throws what read_ply throws for a
+// bad header.
+std::unique_ptr<FaceStream> open_ply_face_stream(const std::string& path,
+                                                 std::size_t window_bytes);
 
 // The faces of an OBJ file (plain or gzip) as a stream, checked as read_obj checks them; null
 // for a file without `f` lines.

@@ -168,7 +168,12 @@ constexpr std::size_t kBatch = 1 << 16;
 bool prepare_mesh_streamed(const std::string& input, const std::string& output,
                            const std::string& records, const PrepareOptions& prepare,
                            Progress& progress, const StreamedMeshOptions& options) {
-  std::unique_ptr<FaceStream> faces = open_face_stream(input);
+  // A binary PLY's face window and its triangles: each a quarter of the pages' memory, 1 to
+  // 32 MB.
+  std::unique_ptr<FaceStream> faces = open_face_stream(
+      input, static_cast<std::size_t>(std::clamp<std::uint64_t>(options.cache_bytes / 4,
+                                                                std::uint64_t{1} << 20,
+                                                                std::uint64_t{32} << 20)));
   if (!faces) return false;
   const std::string& name = prepare.input_name;
   if (prepare.drop_outliers) {

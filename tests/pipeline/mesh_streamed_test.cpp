@@ -191,6 +191,27 @@ TEST(StreamedMesh, NormalsFollowTheTorusAndRadiiCoverItsTriangles) {
   }
 }
 
+TEST(StreamedMesh, SmallWindowsCutFacesAndStillGiveEveryTriangle) {
+  for (const Layout l : {Layout{}, Layout{.big_endian = true, .gzip = true}}) {
+    TempDir dir;
+    const std::string input = write_torus(dir, l);
+    const PointSet whole = read_point_file(input);
+    for (const std::size_t window : {16, 61, 1000}) {
+      const auto faces = open_face_stream(input, window);
+      ASSERT_NE(faces, nullptr);
+      std::vector<std::array<std::uint32_t, 3>> all, part;
+      std::size_t reads = 0;
+      while (faces->read(part)) {
+        all.insert(all.end(), part.begin(), part.end());
+        ++reads;
+      }
+      EXPECT_GT(reads, 10u) << window;
+      EXPECT_EQ(faces->faces_done(), faces->face_count());
+      EXPECT_TRUE(all == whole.triangles) << "window " << window;
+    }
+  }
+}
+
 TEST(StreamedMesh, BadFacesAreNamedAndNothingIsWritten) {
   for (const Layout l : {Layout{.bad_index = true}, Layout{.truncate = true}}) {
     TempDir dir;
@@ -207,6 +228,10 @@ TEST(StreamedMesh, BadFacesAreNamedAndNothingIsWritten) {
           << what;
     }
     EXPECT_FALSE(std::filesystem::exists(dir.file("out.ply")));
+    // The same in windows that cut the faces.
+    const auto faces = open_face_stream(input, 61);
+    std::vector<std::array<std::uint32_t, 3>> part;
+    EXPECT_THROW(while (faces->read(part)) {}, FormatError);
   }
 }
 

@@ -115,7 +115,10 @@ class FaceStream {
 // The faces of `path` as a stream: PLY files, binary or ASCII, whatever their element layout,
 // and OBJ files, plain or gzip. Null for a file without faces. Throws what read_point_file
 // throws for a bad header (PLY) or a bad line found by the OBJ stream's first pass (which
-// counts the lines), and IoError for a missing file.
-std::unique_ptr<FaceStream> open_face_stream(const std::string& path);
+// counts the lines), and IoError for a missing file. `window_bytes`: the most a binary PLY's
+// face window holds (its triangles take about as much again; text files read windows of at most
+// 128 K lines).
+std::unique_ptr<FaceStream> open_face_stream(const std::string& path,
+                                             std::size_t window_bytes = std::size_t{32} << 20);
 
 }  // namespace pointillist
