@@ -15,16 +15,33 @@
 namespace pointillist::io_detail {
 namespace {
 
-class ObjStream final : public PointStream {
-  // Errors name the line being parsed, as read_obj's do.
-  struct Fail {
-    const std::string& path;
-    const std::uint64_t& line;
-    [[noreturn]] void operator()(const char*, const std::string& what) const {
-      throw FormatError(path + ": line " + std::to_string(line) + ": " + what);
-    }
-  };
+// Errors name the line being parsed, as read_obj's do.
+struct Fail {
+  const std::string& path;
+  const std::uint64_t& line;
+  [[noreturn]] void operator()(const char*, const std::string& what) const {
+    throw FormatError(path + ": line " + std::to_string(line) + ": " + what);
+  }
+};
 
+// The next line of `window` that is not blank or a comment (`line` counts the lines read): t
+// after its keyword, its end, the keyword.
+bool next_obj_line(LineWindow& window, std::uint64_t& line, const char*& t, const char*& le,
+                   std::string_view& keyword) {
+  const char* start;
+  while (window.next_line(start, le)) {
+    ++line;
+    const char* k = skip_blanks(start, le);
+    if (k == le || *k == '#') continue;
+    t = k;
+    while (t < le && !is_blank(*t)) ++t;
+    keyword = std::string_view(k, std::size_t(t - k));
+    return true;
+  }
+  return false;
+}
+
+class ObjStream final : public PointStream {
  public:
   ObjStream(const std::string& path, const PointReadOptions& options)
       : path_(path), window_(path) {
@@ -111,19 +128,8 @@ class ObjStream final : public PointStream {
     }
     return n;
   }
-  // The next line that is not blank or a comment: t after its keyword, its end, the keyword.
   bool next(const char*& t, const char*& le, std::string_view& keyword) {
-    const char* start;
-    while (window_.next_line(start, le)) {
-      ++line_;
-      const char* k = skip_blanks(start, le);
-      if (k == le || *k == '#') continue;
-      t = k;
-      while (t < le && !is_blank(*t)) ++t;
-      keyword = std::string_view(k, std::size_t(t - k));
-      return true;
-    }
-    return false;
+    return next_obj_line(window_, line_, t, le, keyword);
   }
   Fail fail_at() const { return {path_, line_}; }
 
@@ -140,21 +146,13 @@ class ObjStream final : public PointStream {
 // and the `vn` lines in a pass of their own. Opening counts the v, vn and f lines, so a corner
 // naming a vertex or normal defined later is checked at once against the file's count.
 class ObjFaceStream final : public FaceStream {
-  struct Fail {
-    const std::string& path;
-    const std::uint64_t& line;
-    [[noreturn]] void operator()(const char*, const std::string& what) const {
-      throw FormatError(path + ": line " + std::to_string(line) + ": " + what);
-    }
-  };
-
  public:
   explicit ObjFaceStream(const std::string& path) : path_(path), window_(path) {
     window_.rewind();
     const char* t;
     const char* le;
     std::string_view keyword;
-    while (next(window_, line_, t, le, keyword)) {
+    while (next_obj_line(window_, line_, t, le, keyword)) {
       if (keyword == "v") ++vertex_count_;
       if (keyword == "vn") ++normal_count_;
       if (keyword == "f") ++face_count_;
@@ -175,7 +173,7 @@ class ObjFaceStream final : public FaceStream {
     const char* le;
     std::string_view keyword;
     for (std::uint64_t faces = 0; faces < kWindowFaces;) {
-      if (!next(window_, line_, t, le, keyword)) {
+      if (!next_obj_line(window_, line_, t, le, keyword)) {
         done_ = true;
         window_.release();
         break;
@@ -221,7 +219,7 @@ class ObjFaceStream final : public FaceStream {
     const char* le;
     std::string_view keyword;
     while (normals.size() < kWindowFaces) {
-      if (!next(*normal_window_, normal_line_, t, le, keyword)) {
+      if (!next_obj_line(*normal_window_, normal_line_, t, le, keyword)) {
         normal_window_->release();
         break;
       }
@@ -235,21 +233,6 @@ class ObjFaceStream final : public FaceStream {
 
  private:
   static constexpr std::uint64_t kWindowFaces = 1 << 16;
-  // The next line that is not blank or a comment: t after its keyword, its end, the keyword.
-  static bool next(LineWindow& window, std::uint64_t& line, const char*& t, const char*& le,
-                   std::string_view& keyword) {
-    const char* start;
-    while (window.next_line(start, le)) {
-      ++line;
-      const char* k = skip_blanks(start, le);
-      if (k == le || *k == '#') continue;
-      t = k;
-      while (t < le && !is_blank(*t)) ++t;
-      keyword = std::string_view(k, std::size_t(t - k));
-      return true;
-    }
-    return false;
-  }
 
   std::string path_;  // before window_, which uses it
   LineWindow window_;
