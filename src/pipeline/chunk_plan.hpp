@@ -91,15 +91,24 @@ ChunkPlan plan_chunks(std::vector<PlanPoint> points, std::uint32_t levels, Threa
 ChunkPlan plan_chunks(std::span<const Vec3f> positions, std::uint32_t levels, ThreadPool& pool,
                       std::vector<std::vector<std::uint32_t>>* members = nullptr);
 
+// What plan_chunks_on_disk may hold in memory.
+struct DiskPlanMemory {
+  std::size_t max_candidates = 1 << 20;  // points kept for selection (32 bytes each)
+  // The counts of the ranges' next digits: 256 KiB a range and thread. Ranges beyond what
+  // this holds are counted in further passes over the file (at least one range a pass).
+  std::size_t histogram_bytes = std::size_t{1} << 30;
+  std::size_t window_points = std::size_t{1} << 21;  // positions read at a time (12 bytes each)
+};
+
 // The plan of plan_chunks without the positions in memory: `path` holds the `n` positions
 // (Vec3f records, 12 bytes each, in index order), `box` is their box. Each level reads the file
 // about twice (a count of the split coordinates' top 16 bits for every range, then the points of
 // the bucket holding each median, selected in memory); more when a bucket holds more than
-// `max_candidates` points (the level's ranges together), as with many equal coordinates.
-// Memory: 256 KiB a range and thread, and 32 bytes a candidate. The same plan for any thread
-// count. Reports n / levels to `progress` after each level. Throws IoError.
+// `max_candidates` points (the level's ranges together), as with many equal coordinates, or
+// when the level's counts do not fit `histogram_bytes`. The same plan for any thread count and
+// memory. Reports n / levels to `progress` after each level. Throws IoError.
 ChunkPlan plan_chunks_on_disk(const std::string& path, std::uint64_t n, const Aabb& box,
-                              std::uint32_t levels, std::size_t max_candidates, ThreadPool& pool,
-                              Progress& progress);
+                              std::uint32_t levels, const DiskPlanMemory& memory,
+                              ThreadPool& pool, Progress& progress);
 
 }  // namespace pointillist::chunking

@@ -85,8 +85,8 @@ class PositionFile {
 }  // namespace
 
 ChunkPlan plan_chunks_on_disk(const std::string& path, std::uint64_t n, const Aabb& box,
-                              std::uint32_t levels, std::size_t max_candidates, ThreadPool& pool,
-                              Progress& progress) {
+                              std::uint32_t levels, const DiskPlanMemory& memory,
+                              ThreadPool& pool, Progress& progress) {
   if (n == 0 || n >= (std::uint64_t{1} << 32) || levels > 20 || (levels > 0 && (n >> levels) < 2)) {
     throw Error("cannot plan " + std::to_string(std::size_t{1} << levels) + " chunks over " +
                 std::to_string(n) + " points");
@@ -96,8 +96,12 @@ ChunkPlan plan_chunks_on_disk(const std::string& path, std::uint64_t n, const Aa
   plan.splits.resize((std::size_t{1} << levels) - 1);
   PositionFile file(path);
   const std::size_t threads = pool.thread_count();
-  const std::size_t window = std::size_t{1} << 21;  // points a read (24 MiB)
+  const std::size_t window = std::max<std::size_t>(memory.window_points, 1);
   std::vector<Vec3f> buffer(static_cast<std::size_t>(std::min<std::uint64_t>(n, window)));
+  const std::size_t max_candidates = std::max<std::size_t>(memory.max_candidates, 1);
+  // Ranges whose digits one pass can count (at least one).
+  const std::size_t counted_at_once =
+      std::max<std::size_t>(memory.histogram_bytes / (threads * kBuckets * 4), 1);
 
   std::vector<Aabb> boxes{box};
   std::vector<std::uint64_t> counts{n};
@@ -112,13 +116,19 @@ ChunkPlan plan_chunks_on_disk(const std::string& path, std::uint64_t n, const Aa
     for (std::size_t active = ranges; active > 0;) {
       // Candidates kept in one pass, shared among the ranges still open.
       const std::size_t limit = std::max<std::size_t>(max_candidates / active, 1);
+      // This pass counts the next digit of the first open ranges that fit the histograms'
+      // memory; the others that still count wait for a later pass (skipped below).
+      std::vector<std::uint8_t> counting(ranges, 0);
+      for (std::size_t j = 0, taken = 0; j < ranges && taken < counted_at_once; ++j) {
+        if (!r[j].done && !r[j].collecting) counting[j] = 1, ++taken;
+      }
       std::vector<Gathered> g(threads);
       for (Gathered& t : g) {
         t.histogram.resize(ranges);
         t.candidates.resize(ranges);
         t.side.resize(ranges);
         for (std::size_t j = 0; j < ranges; ++j) {
-          if (!r[j].done && !r[j].collecting) t.histogram[j].assign(kBuckets, 0);
+          if (counting[j]) t.histogram[j].assign(kBuckets, 0);
         }
       }
       file.rewind();
@@ -139,7 +149,7 @@ ChunkPlan plan_chunks_on_disk(const std::string& path, std::uint64_t n, const Aa
             }
             j -= first;
             const Range& range = r[j];
-            if (range.done) continue;
+            if (range.done || !(range.collecting || counting[j])) continue;
             const std::uint32_t key = ordered(p[range.axis]);
             int side = -1;  // -1: shares the chosen digits
             for (int d = 0; d < range.depth && side < 0; ++d) {
@@ -160,7 +170,7 @@ ChunkPlan plan_chunks_on_disk(const std::string& path, std::uint64_t n, const Aa
       // Merge, then choose a digit or select the split for each open range.
       for (std::size_t j = 0; j < ranges; ++j) {
         Range& range = r[j];
-        if (range.done) continue;
+        if (range.done || !(range.collecting || counting[j])) continue;
         for (Gathered& t : g) {
           range.side[0].extend(t.side[j][0]);
           range.side[1].extend(t.side[j][1]);

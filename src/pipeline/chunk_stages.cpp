@@ -151,9 +151,14 @@ void scan_plan_distribute(MergedInputs& in, const WorkFolder& folder, const Conv
     ProgressPhase phase(progress, "plan", n);
     if (plan_on_disk) {
       const std::string path = folder.file(ChunkFiles::name("positions", 0));
-      // A quarter of the budget for the selections' candidates (32 bytes each).
-      const std::size_t candidates = std::max<std::uint64_t>(budget / 4 / 32, 1024);
-      sh.plan = plan_chunks_on_disk(path, n, box, levels, candidates, pool, progress);
+      // A quarter of the budget for the selections' candidates (32 bytes each), an eighth for
+      // the digit counts (256 KiB a range and thread: 1 B points in 4,096 chunks would count
+      // 2 GB at once), a sixteenth for the reads.
+      const DiskPlanMemory memory{
+          .max_candidates = std::max<std::uint64_t>(budget / 4 / 32, 1024),
+          .histogram_bytes = budget / 8,
+          .window_points = std::clamp<std::uint64_t>(budget / 16 / sizeof(Vec3f), 1 << 16, 1 << 21)};
+      sh.plan = plan_chunks_on_disk(path, n, box, levels, memory, pool, progress);
       std::filesystem::remove(path);
     } else {
       sh.plan = plan_chunks(std::move(positions), levels, pool);

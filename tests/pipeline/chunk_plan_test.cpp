@@ -112,8 +112,35 @@ TEST(ChunkPlan, OnDiskPlanIsTheSamePlanWhateverItsCandidateBudget) {
     // All candidates at once; a few (coordinate digits); one (every index digit too).
     for (std::size_t budget : {std::size_t{1} << 20, std::size_t{400}, std::size_t{1}}) {
       SCOPED_TRACE(::testing::Message() << threads << " threads, " << budget << " candidates");
-      expect_plan(plan_chunks_on_disk(path, p.size(), box, 4, budget, pool, Progress::none()), o,
-                  p);
+      expect_plan(plan_chunks_on_disk(path, p.size(), box, 4, {.max_candidates = budget}, pool,
+                                      Progress::none()),
+                  o, p);
+    }
+  }
+}
+
+TEST(ChunkPlan, OnDiskPlanIsTheSamePlanWhenItsCountsAndReadsAreSmall) {
+  testing::TempDir dir;
+  const std::vector<Vec3f> p = tied_points(6001, 9);
+  const std::string path = write_positions(dir, p);
+  Aabb box;
+  for (const Vec3f& x : p) box.extend(x);
+  const Oracle o = brute_force(p, 4);
+  for (unsigned threads : {1u, 2u}) {
+    ThreadPool pool(threads);
+    // Counts for one range a pass (then three), reads of 97 positions (windows that end inside
+    // ranges), with many candidates and with few.
+    for (std::size_t histogram : {std::size_t{1}, std::size_t{3} * threads << 18}) {
+      for (std::size_t candidates : {std::size_t{1} << 20, std::size_t{50}}) {
+        SCOPED_TRACE(::testing::Message() << threads << " threads, histograms " << histogram
+                                          << " bytes, " << candidates << " candidates");
+        expect_plan(plan_chunks_on_disk(path, p.size(), box, 4,
+                                        {.max_candidates = candidates,
+                                         .histogram_bytes = histogram,
+                                         .window_points = 97},
+                                        pool, Progress::none()),
+                    o, p);
+      }
     }
   }
 }
@@ -126,7 +153,7 @@ TEST(ChunkPlan, OnDiskPlanSaysWhenThePositionFileIsShort) {
   for (const Vec3f& x : p) box.extend(x);
   ThreadPool pool(1);
   try {
-    plan_chunks_on_disk(path, 2000, box, 2, 100, pool, Progress::none());
+    plan_chunks_on_disk(path, 2000, box, 2, {.max_candidates = 100}, pool, Progress::none());
     FAIL() << "a short file was accepted";
   } catch (const IoError& e) {
     EXPECT_NE(std::string(e.what()).find("ends early"), std::string::npos) << e.what();
