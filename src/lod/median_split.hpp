@@ -22,8 +22,11 @@ constexpr std::size_t split_half(std::size_t n) { return n / 2; }
 // bounding box of its positions, input index), then the rest; both halves split again. Returns
 // order[k] = input index of the k-th point. Ranges larger than `grain` are split by separate
 // tasks on `pool`; the result is the same for any thread count. Positions must be finite and
-// fewer than 2^31. Advances `progress` by one unit per point once its subtree is done.
+// fewer than 2^31. Advances `progress` by one unit per point once its subtree is done. From
+// `morton_labels_from` points, the partition names points by their rank along a Morton curve
+// (faster on many points; the same result).
 std::vector<std::uint32_t> median_split_order(std::span<const Vec3f> positions, ThreadPool& pool,
-                                              std::size_t grain, Progress& progress);
+                                              std::size_t grain, Progress& progress,
+                                              std::size_t morton_labels_from);
 
 }  // namespace pointillist::lod_detail

@@ -376,17 +376,21 @@ void leaves_depth_first(const SphereTree& t, std::uint32_t node, std::vector<std
 TEST(SphereTree, EverySplitIsAMedianSplit) {
   // Children are laid out in range order, so the depth-first leaf sequence is the order the
   // recursive median splits leave the points in, at every level down to ranges of 2 and 3.
-  for (std::size_t n : {2u, 3u, 5u, 64u, 130u, 333u, 1000u}) {
-    const PointSet pts = box_points(n, 14, {1, 1.5f, 0.7f});
-    const SphereTree t = build(pts, 2, {.parallel_grain_points = 16});
-    const auto by_pos = index_by_position(pts);
-    std::vector<std::uint32_t> leaves, got, expected;
-    leaves_depth_first(t, 0, leaves);
-    for (std::uint32_t leaf : leaves) got.push_back(input_index(by_pos, t.nodes[leaf].center));
-    std::vector<std::uint32_t> all(n);
-    std::iota(all.begin(), all.end(), 0u);
-    expected_leaf_order(pts, all, expected);
-    EXPECT_EQ(got, expected) << "n = " << n;
+  // Points named by input index and (as from 8 M points) by Morton rank.
+  for (std::size_t labels_from : {std::size_t{1} << 23, std::size_t{0}}) {
+    for (std::size_t n : {2u, 3u, 5u, 64u, 130u, 333u, 1000u}) {
+      const PointSet pts = box_points(n, 14, {1, 1.5f, 0.7f});
+      const SphereTree t =
+          build(pts, 2, {.parallel_grain_points = 16, .morton_labels_from = labels_from});
+      const auto by_pos = index_by_position(pts);
+      std::vector<std::uint32_t> leaves, got, expected;
+      leaves_depth_first(t, 0, leaves);
+      for (std::uint32_t leaf : leaves) got.push_back(input_index(by_pos, t.nodes[leaf].center));
+      std::vector<std::uint32_t> all(n);
+      std::iota(all.begin(), all.end(), 0u);
+      expected_leaf_order(pts, all, expected);
+      EXPECT_EQ(got, expected) << "n = " << n << ", Morton labels from " << labels_from;
+    }
   }
 }
 
@@ -394,10 +398,32 @@ TEST(SphereTree, MedianTiesGoToTheLowerIndex) {
   // x takes only 3 values (many ties) and is the longest axis; y, z are distinct and small.
   PointSet pts = box_points(100, 9, {0, 0.5f, 0.5f});
   for (std::size_t i = 0; i < pts.size(); ++i) pts.positions[i].x = float((i * 7) % 3);
-  const SphereTree t = build(pts);
-  std::vector<std::uint32_t> all(pts.size());
+  for (std::size_t labels_from : {std::size_t{1} << 23, std::size_t{0}}) {
+    const SphereTree t = build(pts, 2, {.morton_labels_from = labels_from});
+    std::vector<std::uint32_t> all(pts.size());
+    std::iota(all.begin(), all.end(), 0u);
+    expect_median_splits_below(pts, t, 0, all);
+  }
+}
+
+TEST(SphereTree, TiesInEveryRangeGoToTheLowerIndexWithMortonLabels) {
+  // Coordinates on a coarse grid tie at every level, down to the three-point ranges, whose
+  // split compares input indices; the Morton ranks would order the tied points otherwise.
+  PointSet pts = box_points(1000, 21, {1, 1, 1});
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const std::size_t j = (i * 7919) % pts.size();
+    pts.positions[i] = {float(j % 4), float(j / 4 % 5), float(j / 20 % 3)};
+  }
+  std::vector<std::uint32_t> all(pts.size()), expected;
   std::iota(all.begin(), all.end(), 0u);
-  expect_median_splits_below(pts, t, 0, all);
+  expected_leaf_order(pts, all, expected);
+  for (unsigned threads : {1u, 2u}) {
+    ThreadPool pool(threads);
+    std::vector<std::uint32_t> split_order;
+    build_sphere_tree(pts, pool, Progress::none(),
+                      {.parallel_grain_points = 16, .morton_labels_from = 0}, &split_order);
+    EXPECT_EQ(split_order, expected) << threads << " threads";
+  }
 }
 
 TEST(SphereTree, SameBitsForAnyThreadCount) {

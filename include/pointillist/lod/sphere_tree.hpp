@@ -69,6 +69,10 @@ struct SphereTreeOptions {
   // Subtrees smaller than this many points are built by one task; larger ones split in parallel.
   // Only changes speed, never the result.
   std::size_t parallel_grain_points = 1 << 15;
+  // From this many points the partition names points by their rank along a Morton curve, so the
+  // flags it reads by point stay in cache (20 M points: 0.6-0.7x its time; below about 8 M the
+  // ordering costs more than it saves). Only changes speed, never the result.
+  std::size_t morton_labels_from = std::size_t{1} << 23;
   // The points are already in the order the median splits put them in (a build's `split_order`
   // applied to its points): the partition is skipped, and the tree is the one that build made.
   bool presorted = false;
