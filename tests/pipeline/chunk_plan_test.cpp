@@ -100,7 +100,7 @@ TEST(ChunkPlan, InMemoryPlanIsTheHierarchysMedianSplits) {
   expect_plan(plan_chunks(p, 4, pool), brute_force(p, 4), p);
 }
 
-TEST(ChunkPlan, OnDiskPlanIsTheSamePlanWhateverItsCandidateBudget) {
+TEST(ChunkPlan, OnDiskPlanIsTheSamePlanWhateverItsMemory) {
   testing::TempDir dir;
   const std::vector<Vec3f> p = tied_points(6001, 5);
   const std::string path = write_positions(dir, p);
@@ -109,38 +109,20 @@ TEST(ChunkPlan, OnDiskPlanIsTheSamePlanWhateverItsCandidateBudget) {
   const Oracle o = brute_force(p, 4);
   for (unsigned threads : {1u, 2u}) {
     ThreadPool pool(threads);
-    // All candidates at once; a few (coordinate digits); one (every index digit too).
-    for (std::size_t budget : {std::size_t{1} << 20, std::size_t{400}, std::size_t{1}}) {
-      SCOPED_TRACE(::testing::Message() << threads << " threads, " << budget << " candidates");
-      expect_plan(plan_chunks_on_disk(path, p.size(), box, 4, {.max_candidates = budget}, pool,
-                                      Progress::none()),
-                  o, p);
-    }
-  }
-}
-
-TEST(ChunkPlan, OnDiskPlanIsTheSamePlanWhenItsCountsAndReadsAreSmall) {
-  testing::TempDir dir;
-  const std::vector<Vec3f> p = tied_points(6001, 9);
-  const std::string path = write_positions(dir, p);
-  Aabb box;
-  for (const Vec3f& x : p) box.extend(x);
-  const Oracle o = brute_force(p, 4);
-  for (unsigned threads : {1u, 2u}) {
-    ThreadPool pool(threads);
-    // Counts for one range a pass (then three), reads of 97 positions (windows that end inside
-    // ranges), with many candidates and with few.
-    for (std::size_t histogram : {std::size_t{1}, std::size_t{3} * threads << 18}) {
-      for (std::size_t candidates : {std::size_t{1} << 20, std::size_t{50}}) {
-        SCOPED_TRACE(::testing::Message() << threads << " threads, histograms " << histogram
-                                          << " bytes, " << candidates << " candidates");
-        expect_plan(plan_chunks_on_disk(path, p.size(), box, 4,
-                                        {.max_candidates = candidates,
-                                         .histogram_bytes = histogram,
-                                         .window_points = 97},
-                                        pool, Progress::none()),
-                    o, p);
-      }
+    const std::size_t range_counts = std::size_t{threads} << 18;  // 256 KiB a thread
+    const std::vector<DiskPlanMemory> memories = {
+        // All candidates at once; a few (coordinate digits); one (every index digit too).
+        {.max_candidates = 1 << 20}, {.max_candidates = 400}, {.max_candidates = 1},
+        // Counts for one range a pass, then for three, with reads of 97 positions (windows
+        // that end inside ranges), with many candidates and with few.
+        {.max_candidates = 1 << 20, .histogram_bytes = 1, .window_points = 97},
+        {.max_candidates = 50, .histogram_bytes = 1, .window_points = 97},
+        {.max_candidates = 50, .histogram_bytes = 3 * range_counts, .window_points = 97}};
+    for (const DiskPlanMemory& m : memories) {
+      SCOPED_TRACE(::testing::Message() << threads << " threads, " << m.max_candidates
+                                        << " candidates, counts of " << m.histogram_bytes
+                                        << " bytes, reads of " << m.window_points);
+      expect_plan(plan_chunks_on_disk(path, p.size(), box, 4, m, pool, Progress::none()), o, p);
     }
   }
 }
