@@ -136,16 +136,12 @@ Command add_convert_command(CLI::App& app) {
             if (*with_features) o->convert.features = *features;
             if (!memory->empty()) {
               o->convert.memory_budget = parse_bytes(*memory, "--memory");
-              // Below this the program, its threads' heaps and its smallest buffers alone come
-              // near the budget (measured: 5 M points under 24M peaked at 29 MB, 1 M points
-              // under 32M at 32-33 MB; under 40M, 1 M and 5 M points and a 7 M-vertex mesh
-              // took 33-34 MB).
-              constexpr std::uint64_t kLeastBudget = std::uint64_t{40} << 20;
-              if (o->convert.memory_budget < kLeastBudget) {
-                throw OptionError("convert: --memory " + *memory +
-                                  " is below 40M, the least a conversion can hold itself to "
-                                  "(the program and its smallest buffers take 30-35 MB); give "
-                                  "--memory 40M or more");
+              if (o->convert.memory_budget < kLeastMemoryBudget) {
+                const std::string least = std::to_string(kLeastMemoryBudget >> 20) + "M";
+                throw OptionError("convert: --memory " + *memory + " is below " + least +
+                                  ", the least a conversion can hold itself to (the program and "
+                                  "its smallest buffers take 30-35 MB); give --memory " + least +
+                                  " or more");
               }
             }
             return run_convert(*o);

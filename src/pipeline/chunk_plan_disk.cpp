@@ -116,11 +116,17 @@ ChunkPlan plan_chunks_on_disk(const std::string& path, std::uint64_t n, const Aa
     for (std::size_t active = ranges; active > 0;) {
       // Candidates kept in one pass, shared among the ranges still open.
       const std::size_t limit = std::max<std::size_t>(max_candidates / active, 1);
-      // This pass counts the next digit of the first open ranges that fit the histograms'
-      // memory; the others that still count wait for a later pass (skipped below).
-      std::vector<std::uint8_t> counting(ranges, 0);
-      for (std::size_t j = 0, taken = 0; j < ranges && taken < counted_at_once; ++j) {
-        if (!r[j].done && !r[j].collecting) counting[j] = 1, ++taken;
+      // The ranges this pass serves: every one collecting, and the first ones counting that
+      // fit the histograms' memory; the others wait for a later pass.
+      std::vector<std::uint8_t> in_pass(ranges, 0);
+      for (std::size_t j = 0, counting = 0; j < ranges; ++j) {
+        if (r[j].done) continue;
+        if (r[j].collecting) {
+          in_pass[j] = 1;
+        } else if (counting < counted_at_once) {
+          in_pass[j] = 1;
+          ++counting;
+        }
       }
       std::vector<Gathered> g(threads);
       for (Gathered& t : g) {
@@ -128,7 +134,7 @@ ChunkPlan plan_chunks_on_disk(const std::string& path, std::uint64_t n, const Aa
         t.candidates.resize(ranges);
         t.side.resize(ranges);
         for (std::size_t j = 0; j < ranges; ++j) {
-          if (counting[j]) t.histogram[j].assign(kBuckets, 0);
+          if (in_pass[j] && !r[j].collecting) t.histogram[j].assign(kBuckets, 0);
         }
       }
       file.rewind();
@@ -148,8 +154,8 @@ ChunkPlan plan_chunks_on_disk(const std::string& path, std::uint64_t n, const Aa
               j = 2 * j + ((c < s.value || (c == s.value && index < s.index)) ? 1 : 2);
             }
             j -= first;
+            if (!in_pass[j]) continue;
             const Range& range = r[j];
-            if (range.done || !(range.collecting || counting[j])) continue;
             const std::uint32_t key = ordered(p[range.axis]);
             int side = -1;  // -1: shares the chosen digits
             for (int d = 0; d < range.depth && side < 0; ++d) {
@@ -169,8 +175,8 @@ ChunkPlan plan_chunks_on_disk(const std::string& path, std::uint64_t n, const Aa
       }
       // Merge, then choose a digit or select the split for each open range.
       for (std::size_t j = 0; j < ranges; ++j) {
+        if (!in_pass[j]) continue;
         Range& range = r[j];
-        if (range.done || !(range.collecting || counting[j])) continue;
         for (Gathered& t : g) {
           range.side[0].extend(t.side[j][0]);
           range.side[1].extend(t.side[j][1]);

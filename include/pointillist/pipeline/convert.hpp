@@ -66,6 +66,13 @@ struct ConvertResult {
 // Half of the physical memory: the default ConvertOptions::memory_budget.
 std::uint64_t default_memory_budget();
 
+// The smallest budget a conversion holds itself to: below it the program, its threads' heaps
+// and its smallest buffers alone come near the budget (measured: 5 M points under 24M peaked at
+// 29 MB, 1 M points under 32M at 32-33 MB; under 40M, 1 M and 5 M points and a 7 M-vertex mesh
+// took 33-34 MB). `convert --memory` refuses less; the library takes smaller budgets (tests use
+// them to force chunks on small inputs).
+inline constexpr std::uint64_t kLeastMemoryBudget = std::uint64_t{40} << 20;
+
 // Converts `inputs` (scans, merged in the first one's frame: see merge_inputs) to `output`,
 // chosen by its extension: .ptl, .qs (a mesh gives the bytes QSplat's qsplat_make writes) or
 // .ply. The output is written atomically. Throws OptionError for an unknown output extension or
