@@ -191,6 +191,46 @@ TEST(CloudRadii, IsolatedPointsAreCappedAtTheirNeighboursRadiusTimesTheOutlierRa
   }
 }
 
+TEST(CloudRadii, OutlierCapMatchesBruteForceMediansOnRandomPointsWithStrays) {
+  // Random samples of a torus and a few clusters of strays above it: every radius is
+  // min(mean, ratio × median of the 15 nearest neighbours' means), each found by brute force.
+  SurfaceSamples s = sample_scene(torus_scene(), 1200, 21);
+  std::vector<Vec3f> p = s.points.positions;
+  for (int c = 0; c < 6; ++c) {  // pairs, far from each other
+    const float x = 3.0f * float(c % 3) - 3.0f, y = c < 3 ? -2.0f : 2.0f;
+    p.push_back({x, y, 1.5f});
+    p.push_back({x + 0.05f, y, 1.5f});
+  }
+  const std::size_t n = p.size(), k = 5, m = kOutlierNeighbours;
+  const float ratio = 1.3f;  // low, so that surface points are capped too
+  std::vector<std::vector<std::size_t>> nearest(n);
+  std::vector<float> mean(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    std::vector<std::pair<float, std::size_t>> d;
+    for (std::size_t j = 0; j < n; ++j) {
+      if (j != i) d.push_back({distance(p[i], p[j]), j});
+    }
+    std::sort(d.begin(), d.end());
+    float sum = 0.0f;
+    for (std::size_t t = 0; t < k; ++t) sum += d[t].first;
+    mean[i] = sum / float(k);
+    for (std::size_t t = 0; t < m; ++t) nearest[i].push_back(d[t].second);
+  }
+  ThreadPool pool(2);
+  const std::vector<float> r =
+      cloud_radii(p, pool, Progress::none(), {.coverage = 1.0f, .outlier_ratio = ratio});
+  std::size_t capped = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    std::vector<float> theirs;
+    for (const std::size_t j : nearest[i]) theirs.push_back(mean[j]);
+    std::sort(theirs.begin(), theirs.end());
+    const float cap = ratio * theirs[m / 2];
+    capped += cap < mean[i];
+    EXPECT_NEAR(r[i], std::min(mean[i], cap), 1e-6f) << "point " << i;
+  }
+  EXPECT_GT(capped, 30u);  // the strays and some surface points: the cap is exercised
+}
+
 TEST(CloudRadii, UniformlySparseRegionsAreNotCapped) {
   // Two grids side by side, one 4× sparser than the other: interior points of the sparse grid
   // (away from the border) keep their full mean distance although it is 4× the dense grid's.
