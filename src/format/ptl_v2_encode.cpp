@@ -248,12 +248,12 @@ EncodedTree encode_tree(std::span<const SphereNode> nodes, std::span<const std::
 
   // Normals and colours, then cones bottom-up around the decoded normals: each holds the true
   // cone and the decoded cones (leaves: decoded normals) of the children.
-  out.normal_code.resize(n);
-  out.cone_angle.resize(n);
+  std::vector<std::uint32_t> normal_code(n);  // QSplat normal codes
+  std::vector<double> cone_angle(n);          // decoded cone half-angles (leaves 0)
   for_chunks(pool, 0, n, [&](std::size_t, std::size_t first, std::size_t last) {
     for (std::size_t i = first; i < last; ++i) {
-      out.normal_code[i] = encode_normal_nearest(normalized(nodes[i].normal));
-      out.record[i] |= std::uint64_t{out.normal_code[i]} << kNormalShift;
+      normal_code[i] = encode_normal_nearest(normalized(nodes[i].normal));
+      out.record[i] |= std::uint64_t{normal_code[i]} << kNormalShift;
       if (colors) {
         out.record[i] |= std::uint64_t{encode_rgb565_nearest(nodes[i].color)} << kColorShift;
       }
@@ -262,11 +262,11 @@ EncodedTree encode_tree(std::span<const SphereNode> nodes, std::span<const std::
   each_level(true, [&](std::size_t c, std::size_t first, std::size_t last) {
     for (std::size_t i = first; i < last; ++i) {
       const SphereNode& nd = nodes[i];
-      out.cone_angle[i] = 0.0;
+      cone_angle[i] = 0.0;
       if (nd.child_count == 0) continue;
       const std::uint32_t cone = encode_cone(
-          nd, out.normal_code[i], {&out.normal_code[nd.first_child], nd.child_count},
-          {&out.cone_angle[nd.first_child], nd.child_count}, out.cone_angle[i]);
+          nd, normal_code[i], {&normal_code[nd.first_child], nd.child_count},
+          {&cone_angle[nd.first_child], nd.child_count}, cone_angle[i]);
       ++chunk_stats[c].cone_codes[cone];
       out.record[i] |= std::uint64_t{cone} << kConeShift;
     }

@@ -58,8 +58,6 @@ std::uint32_t encode_cone(const SphereNode& node, std::uint32_t axis_code,
 struct EncodedTree {
   std::vector<std::uint64_t> record;       // record bits; colour in bits 32-47
   std::vector<Sphere> decoded;             // decoded spheres
-  std::vector<std::uint32_t> normal_code;  // QSplat normal codes
-  std::vector<double> cone_angle;          // decoded cone half-angles (leaves 0)
   Sphere root_parent;                      // what node 0 was encoded against
 };
 

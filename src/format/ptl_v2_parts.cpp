@@ -124,8 +124,8 @@ PtlV2PartWriter::PtlV2PartWriter(const std::string& path,
   enc.root_parent = count == 1 && top.nodes[0].child_count == 0 ? target[0] : grown(target[0]);
   enc.decoded.resize(top_count);
   enc.record.assign(top_count, 0);
-  enc.normal_code.resize(top_count);
-  enc.cone_angle.assign(top_count, 0.0);
+  std::vector<std::uint32_t> normal_code(top_count);
+  std::vector<double> cone_angle(top_count, 0.0);
   for (std::size_t i = 0; i < top_count; ++i) {
     const Sphere& p = i == 0 ? enc.root_parent : enc.decoded[parent[i]];
     std::uint64_t fallbacks = st.stats.parent_fallbacks;
@@ -134,8 +134,8 @@ PtlV2PartWriter::PtlV2PartWriter(const std::string& path,
     if (i == 0) st.stats.parent_fallbacks = fallbacks;
     enc.decoded[i] = code.decoded;
     enc.record[i] = code.bits;
-    enc.normal_code[i] = encode_normal_nearest(normalized(top.nodes[i].normal));
-    enc.record[i] |= std::uint64_t{enc.normal_code[i]} << kNormalShift;
+    normal_code[i] = encode_normal_nearest(normalized(top.nodes[i].normal));
+    enc.record[i] |= std::uint64_t{normal_code[i]} << kNormalShift;
   }
   for (std::size_t i = top_count; i-- > 0;) {
     const SphereNode& nd = top.nodes[i];
@@ -143,10 +143,10 @@ PtlV2PartWriter::PtlV2PartWriter(const std::string& path,
     std::uint32_t cone = 0;
     if (i >= st.first_root) {
       cone = st.subtrees[i - st.first_root].cone_code;
-      enc.cone_angle[i] = cone < 3 ? cone_half_angle(cone) : 1e9;
+      cone_angle[i] = cone < 3 ? cone_half_angle(cone) : 1e9;
     } else {
-      cone = encode_cone(nd, enc.normal_code[i], {&enc.normal_code[nd.first_child], nd.child_count},
-                         {&enc.cone_angle[nd.first_child], nd.child_count}, enc.cone_angle[i]);
+      cone = encode_cone(nd, normal_code[i], {&normal_code[nd.first_child], nd.child_count},
+                         {&cone_angle[nd.first_child], nd.child_count}, cone_angle[i]);
     }
     ++st.stats.cone_codes[cone];
     enc.record[i] |= std::uint64_t{cone} << kConeShift;

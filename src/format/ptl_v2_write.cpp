@@ -36,15 +36,6 @@ PtlV2WriteReport write_ptl_v2(const std::string& path, const SphereTree& tree,
   const bool colors = options.write_colors && tree.has_colors;
   const std::uint32_t record_size = colors ? 6 : 4;
 
-  EncodeStats stats;
-  const EncodedTree enc =
-      encode_tree(nodes, parent, nullptr, nullptr, options.leaf_trim, colors, pool, stats);
-  report.spheres_enlarged = stats.spheres_enlarged;
-  report.parent_fallbacks = stats.parent_fallbacks;
-  report.mean_leaf_radius_ratio =
-      stats.leaf_ratio_count ? stats.leaf_ratio_sum / double(stats.leaf_ratio_count) : 1;
-  for (int c = 0; c < 4; ++c) report.cone_codes[c] = stats.cone_codes[c];
-
   const std::vector<PagePlan> pages = plan_pages(nodes, record_size, options.page_bytes);
   if (pages.size() >= kPtlNoPage) throw Error("cannot write " + path + ": too many pages");
 
@@ -71,6 +62,16 @@ PtlV2WriteReport write_ptl_v2(const std::string& path, const SphereTree& tree,
     }
     mesh_bytes = encode_mesh(nodes, options.triangles, page_nodes, pool);
   }
+  // Encoded last: the mesh's working arrays are gone by then, so the peak holds one or the other.
+  EncodeStats stats;
+  const EncodedTree enc =
+      encode_tree(nodes, parent, nullptr, nullptr, options.leaf_trim, colors, pool, stats);
+  report.spheres_enlarged = stats.spheres_enlarged;
+  report.parent_fallbacks = stats.parent_fallbacks;
+  report.mean_leaf_radius_ratio =
+      stats.leaf_ratio_count ? stats.leaf_ratio_sum / double(stats.leaf_ratio_count) : 1;
+  for (int c = 0; c < 4; ++c) report.cone_codes[c] = stats.cone_codes[c];
+
   HeaderFields fields;
   fields.colors = colors;
   fields.record_size = record_size;
