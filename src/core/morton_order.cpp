@@ -5,6 +5,8 @@
 #include <cassert>
 #include <cmath>
 #include <cstdint>
+#include <span>
+#include <vector>
 
 #include "pointillist/core/morton.hpp"
 
@@ -24,6 +26,37 @@ struct Keyed {
 // Equal codes keep index order, so the permutation depends only on the points.
 inline bool operator<(const Keyed& a, const Keyed& b) {
   return a.code < b.code || (a.code == b.code && a.index < b.index);
+}
+
+// Sorts one bucket (its codes share the top kBucketBits bits; its entries in index order) by
+// code, equal codes in index order: least significant digit first, each pass stable, passes
+// whose digit all entries share skipped. Small buckets are sorted by comparison.
+void sort_bucket(std::span<Keyed> keys, std::vector<Keyed>& scratch) {
+  constexpr int kDigitBits = 11;
+  constexpr std::size_t kDigits = std::size_t{1} << kDigitBits;
+  constexpr int kLowBits = 3 * kBitsPerAxis - kBucketBits;
+  const std::size_t n = keys.size();
+  if (n < 256) {
+    std::sort(keys.begin(), keys.end());
+    return;
+  }
+  scratch.resize(n);
+  std::span<Keyed> from = keys, to = scratch;
+  std::array<std::uint32_t, kDigits> count;
+  for (int shift = 0; shift < kLowBits; shift += kDigitBits) {
+    count.fill(0);
+    for (const Keyed& k : from) ++count[(k.code >> shift) & (kDigits - 1)];
+    if (count[(from[0].code >> shift) & (kDigits - 1)] == n) continue;  // one digit: in order
+    std::uint32_t total = 0;
+    for (std::uint32_t& c : count) {
+      const std::uint32_t here = c;
+      c = total;
+      total += here;
+    }
+    for (const Keyed& k : from) to[count[(k.code >> shift) & (kDigits - 1)]++] = k;
+    std::swap(from, to);
+  }
+  if (from.data() != keys.data()) std::copy(from.begin(), from.end(), keys.begin());
 }
 
 }  // namespace
@@ -108,9 +141,10 @@ std::vector<std::uint32_t> morton_order(std::span<const Vec3f> points, ThreadPoo
   }
   if (group_begin.back() != kBucketCount) group_begin.push_back(kBucketCount);
   pool.run(group_begin.size() - 1, [&](std::size_t g) {
+    std::vector<Keyed> scratch;
     for (std::size_t b = group_begin[g]; b < group_begin[g + 1]; ++b) {
-      std::sort(bucketed.begin() + static_cast<std::ptrdiff_t>(bucket_begin[b]),
-                bucketed.begin() + static_cast<std::ptrdiff_t>(bucket_begin[b + 1]));
+      sort_bucket(std::span<Keyed>(bucketed).subspan(bucket_begin[b], bucket_begin[b + 1] - bucket_begin[b]),
+                  scratch);
     }
     const std::size_t begin = bucket_begin[group_begin[g]], end = bucket_begin[group_begin[g + 1]];
     for (std::size_t i = begin; i < end; ++i) order[i] = bucketed[i].index;

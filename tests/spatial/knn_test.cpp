@@ -259,6 +259,38 @@ TEST(MortonOrder, ConsecutivePointsAreClose) {
   EXPECT_LT(ordered_sum / double(n), 0.06);
 }
 
+TEST(MortonOrder, LargeBucketsWithManyTiesSortByCodeThenIndex) {
+  // 300,000 points on 9,096 distinct positions: 5,000 random ones, and a 16^3 grid of steps of
+  // about 2 Morton cells (their codes differ in the lowest bits only) that most points copy, so
+  // that the sort's top-level buckets hold many points and many ties. The order is that of
+  // sorting (Morton code, index) pairs by comparison.
+  std::vector<Vec3f> distinct = random_points(5'000, 11);
+  for (int x = 0; x < 16; ++x) {
+    for (int y = 0; y < 16; ++y) {
+      for (int z = 0; z < 16; ++z) {
+        distinct.push_back(Vec3f{float(x), float(y), float(z)} * 2e-6f + Vec3f{0.1f, 0.2f, 0.3f});
+      }
+    }
+  }
+  std::vector<Vec3f> p;
+  std::uint64_t state = 12345;
+  for (std::size_t i = 0; i < 300'000; ++i) {
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    const std::size_t pick = (state >> 33) % distinct.size();
+    p.push_back(distinct[i % 10 == 0 ? pick : 5'000 + pick % 4'096]);
+  }
+  ThreadPool pool(2);
+  const MortonFrame frame = MortonFrame::of(p);
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> expected;
+  for (std::uint32_t i = 0; i < p.size(); ++i) expected.push_back({frame.code(p[i]), i});
+  std::sort(expected.begin(), expected.end());
+  const auto order = morton_order(p, pool);
+  ASSERT_EQ(order.size(), p.size());
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    ASSERT_EQ(order[i], expected[i].second) << "place " << i;
+  }
+}
+
 TEST(MortonOrder, EqualPointsKeepIndexOrderAndNanDoesNotBreakIt) {
   ThreadPool pool(2);
   std::vector<Vec3f> p(4, Vec3f{1, 1, 1});
