@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "pointillist/core/morton.hpp"
+#include "pointillist/core/radix_sort.hpp"
 
 namespace pointillist {
 namespace {
@@ -29,34 +30,14 @@ inline bool operator<(const Keyed& a, const Keyed& b) {
 }
 
 // Sorts one bucket (its codes share the top kBucketBits bits; its entries in index order) by
-// code, equal codes in index order: least significant digit first, each pass stable, passes
-// whose digit all entries share skipped. Small buckets are sorted by comparison.
+// code, equal codes in index order.
 void sort_bucket(std::span<Keyed> keys, std::vector<Keyed>& scratch) {
-  constexpr int kDigitBits = 11;
-  constexpr std::size_t kDigits = std::size_t{1} << kDigitBits;
   constexpr int kLowBits = 3 * kBitsPerAxis - kBucketBits;
-  const std::size_t n = keys.size();
-  if (n < 256) {
+  if (keys.size() < 256) {
     std::sort(keys.begin(), keys.end());
-    return;
+  } else {
+    stable_radix_sort(keys, scratch, kLowBits, [](const Keyed& k) { return k.code; });
   }
-  scratch.resize(n);
-  std::span<Keyed> from = keys, to = scratch;
-  std::array<std::uint32_t, kDigits> count;
-  for (int shift = 0; shift < kLowBits; shift += kDigitBits) {
-    count.fill(0);
-    for (const Keyed& k : from) ++count[(k.code >> shift) & (kDigits - 1)];
-    if (count[(from[0].code >> shift) & (kDigits - 1)] == n) continue;  // one digit: in order
-    std::uint32_t total = 0;
-    for (std::uint32_t& c : count) {
-      const std::uint32_t here = c;
-      c = total;
-      total += here;
-    }
-    for (const Keyed& k : from) to[count[(k.code >> shift) & (kDigits - 1)]++] = k;
-    std::swap(from, to);
-  }
-  if (from.data() != keys.data()) std::copy(from.begin(), from.end(), keys.begin());
 }
 
 }  // namespace

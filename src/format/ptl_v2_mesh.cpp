@@ -9,11 +9,13 @@
 #include "ptl_v2_mesh.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cassert>
 #include <cstring>
 
 #include "ptl_v2_layout.hpp"
 #include "pointillist/core/error.hpp"
+#include "pointillist/core/radix_sort.hpp"
 #include "pointillist/core/thread_pool.hpp"
 
 namespace pointillist::ptl2 {
@@ -74,7 +76,15 @@ std::vector<std::uint8_t> encode_mesh(std::span<const SphereNode> nodes,
   pool.run(pages.size(), [&](std::size_t p) {
     const auto first = keyed.begin() + std::ptrdiff_t(page_begin[p]);
     const auto last = keyed.begin() + std::ptrdiff_t(page_begin[p + 1]);
-    std::sort(first, last);
+    if (first == last) return;
+    // By first corner; the scatter above left each page in input order, which the stable sort
+    // keeps among equal corners.
+    const auto [low, high] = std::minmax_element(
+        first, last, [](const auto& a, const auto& b) { return a.first < b.first; });
+    const std::uint32_t base = low->first;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> scratch;
+    stable_radix_sort(std::span(first, last), scratch, std::bit_width(high->first - base),
+                      [base](const auto& k) { return std::uint64_t{k.first - base}; });
     std::vector<std::uint8_t>& block = blocks[p];
     block.reserve(6 * std::size_t(last - first));
     std::int64_t previous = 0;
