@@ -174,6 +174,8 @@ void grid_queries(const CellGrid& g, std::size_t cell_begin, std::size_t cell_en
   std::vector<float> cx, cy, cz;
   std::vector<std::uint32_t> cj;
   std::vector<Neighbour> near, row;
+  std::vector<float> kd;
+  std::vector<std::uint32_t> ki;
   const auto original = [&](std::uint32_t j) { return order ? order[j] : j; };
   const std::uint32_t side = MortonFrame::kMaxCell >> g.level;  // the last cell on each axis
   const double cell_units = double(1u << g.level);
@@ -256,16 +258,25 @@ void grid_queries(const CellGrid& g, std::size_t cell_begin, std::size_t cell_en
         if (count >= k || !(limit < std::numeric_limits<float>::max())) break;
         if (!(limit > 0)) limit = std::numeric_limits<float>::min();
       }
-      // In order of distance, then index (insertion sort: a few dozen entries).
+      // In order of distance, then index: each entry's place is the number of entries before
+      // it (a few dozen entries; counted without branches, in vectors).
+      // Padded to whole vectors by entries that come after every real one.
+      const std::size_t padded = (count + 7) & ~std::size_t{7};
+      kd.resize(padded), ki.resize(padded);
       for (std::size_t t = 0; t < count; ++t) {
-        Neighbour x{near[t].d2, original(cj[near[t].index])};
-        std::size_t at = t;
-        for (; at > 0 && (near[at - 1].d2 > x.d2 ||
-                          (near[at - 1].d2 == x.d2 && near[at - 1].index > x.index));
-             --at) {
-          near[at] = near[at - 1];
+        kd[t] = near[t].d2;
+        ki[t] = original(cj[near[t].index]);
+      }
+      std::fill(kd.begin() + std::ptrdiff_t(count), kd.end(), std::numeric_limits<float>::infinity());
+      std::fill(ki.begin() + std::ptrdiff_t(count), ki.end(), std::numeric_limits<std::uint32_t>::max());
+      for (std::size_t t = 0; t < count; ++t) {
+        const float d = kd[t];
+        const std::uint32_t i = ki[t];
+        std::uint32_t place = 0;
+        for (std::size_t u = 0; u < padded; ++u) {
+          place += (kd[u] < d) | ((kd[u] == d) & (ki[u] < i));
         }
-        near[at] = x;
+        near[place] = Neighbour{d, i};
       }
       const float cut = near[k - 1].d2;
       guess = cut;
