@@ -174,7 +174,7 @@ void grid_queries(const CellGrid& g, std::size_t cell_begin, std::size_t cell_en
   std::vector<float> cx, cy, cz;
   std::vector<std::uint32_t> cj;
   std::vector<Neighbour> near, row;
-  std::vector<float> kd;
+  std::vector<float> cd, kd;  // candidates' and entries' squared distances
   std::vector<std::uint32_t> ki;
   const auto original = [&](std::uint32_t j) { return order ? order[j] : j; };
   const std::uint32_t side = MortonFrame::kMaxCell >> g.level;  // the last cell on each axis
@@ -218,6 +218,7 @@ void grid_queries(const CellGrid& g, std::size_t cell_begin, std::size_t cell_en
       continue;
     }
     near.resize(m);
+    cd.resize(m);
     const double scale = g.frame.scale;
     for (std::uint32_t j = g.begin[c]; j < g.begin[c + 1]; ++j) {
       const Vec3f q = tree_points[j];
@@ -243,6 +244,10 @@ void grid_queries(const CellGrid& g, std::size_t cell_begin, std::size_t cell_en
       // The candidates within a limit (the last query's k-th distance, grown), but the point
       // itself: when they are k or more, they hold the k nearest and all tied with the k-th.
       // Else the limit grows until they do (all m - 1 of them at the end).
+      // Every candidate's distance first (in vectors); the point itself gets NaN, which no
+      // limit admits (its cell is gathered first, so it is candidate j - begin).
+      for (std::size_t i = 0; i < m; ++i) cd[i] = squared_distance(q, cx[i], cy[i], cz[i]);
+      cd[j - g.begin[c]] = std::numeric_limits<float>::quiet_NaN();
       std::size_t count = 0;
       for (float limit = guess > 0 ? guess * 1.5f : std::numeric_limits<float>::infinity();;
            limit = limit * 4) {
@@ -250,9 +255,8 @@ void grid_queries(const CellGrid& g, std::size_t cell_begin, std::size_t cell_en
         for (const Run& r : runs) {
           if (r.gap2 > double(limit)) continue;
           for (std::uint32_t i = r.begin; i < r.end; ++i) {
-            const float d = squared_distance(q, cx[i], cy[i], cz[i]);
-            near[count] = Neighbour{d, i};
-            count += (d <= limit) & (cj[i] != j);
+            near[count] = Neighbour{cd[i], i};
+            count += cd[i] <= limit;
           }
         }
         if (count >= k || !(limit < std::numeric_limits<float>::max())) break;
