@@ -39,18 +39,6 @@ PtlV2SubtreeSummary summarize_ptl_v2_subtree(const SphereTree& tree,
   s.leaf_count = leaves;
   s.depth = depth;
   if (nodes[0].child_count > 0) {
-    // The root's cone holds its children's decoded cones, which hold theirs: bottom-up.
-    std::vector<std::uint32_t> normal_code(n);
-    for (std::size_t i = 0; i < n; ++i) normal_code[i] = encode_normal_nearest(normalized(nodes[i].normal));
-    std::vector<double> angle(n, 0.0);
-    for (std::size_t i = n; i-- > 0;) {
-      const SphereNode& nd = nodes[i];
-      if (nd.child_count == 0) continue;
-      const std::uint32_t cone =
-          encode_cone(nd, normal_code[i], {&normal_code[nd.first_child], nd.child_count},
-                      {&angle[nd.first_child], nd.child_count}, angle[i]);
-      if (i == 0) s.cone_code = cone;
-    }
     const std::uint32_t record_size = record_size_for(tree.has_colors, options);
     const std::vector<PagePlan> plan = plan_pages(nodes, record_size, options.page_bytes, true);
     std::uint64_t offset = 0;
@@ -70,7 +58,8 @@ struct PtlV2PartWriter::State {
   std::vector<PtlV2SubtreeSummary> subtrees;
   SphereTree top;
   std::size_t first_root = 0;  // index of subtree 0's root in the top (its last level)
-  EncodedTree top_codes;
+  EncodedTree top_codes;                    // the top's cones are added by finish
+  std::vector<std::uint32_t> root_cone;     // each subtree's root's cone code, once written
   std::vector<PtlV2PageInfo> table;         // the whole file's
   std::vector<std::uint32_t> first_page;    // table index of each subtree's first page
   std::vector<std::uint8_t> written;  // bytes, not bits: subtrees are written concurrently
@@ -111,8 +100,8 @@ PtlV2PartWriter::PtlV2PartWriter(const std::string& path,
   st.first_root = top_count - count;
 
   // The top's records, top-down against decoded parents (its last level: the subtrees' roots,
-  // encoded as interior nodes when they have children), then normals, then cones bottom-up
-  // (the roots' cones come with the summaries).
+  // encoded as interior nodes when they have children), then normals; cones wait for finish
+  // (an interior root's cone holds its children's decoded cones: its subtree's encoding finds it).
   std::vector<std::uint32_t> parent(top_count, 0);
   for (std::size_t i = 0; i < st.first_root; ++i) {
     for (std::uint32_t k = 0; k < top.nodes[i].child_count; ++k)
@@ -124,8 +113,6 @@ PtlV2PartWriter::PtlV2PartWriter(const std::string& path,
   enc.root_parent = count == 1 && top.nodes[0].child_count == 0 ? target[0] : grown(target[0]);
   enc.decoded.resize(top_count);
   enc.record.assign(top_count, 0);
-  std::vector<std::uint32_t> normal_code(top_count);
-  std::vector<double> cone_angle(top_count, 0.0);
   for (std::size_t i = 0; i < top_count; ++i) {
     const Sphere& p = i == 0 ? enc.root_parent : enc.decoded[parent[i]];
     std::uint64_t fallbacks = st.stats.parent_fallbacks;
@@ -134,22 +121,8 @@ PtlV2PartWriter::PtlV2PartWriter(const std::string& path,
     if (i == 0) st.stats.parent_fallbacks = fallbacks;
     enc.decoded[i] = code.decoded;
     enc.record[i] = code.bits;
-    normal_code[i] = encode_normal_nearest(normalized(top.nodes[i].normal));
-    enc.record[i] |= std::uint64_t{normal_code[i]} << kNormalShift;
-  }
-  for (std::size_t i = top_count; i-- > 0;) {
-    const SphereNode& nd = top.nodes[i];
-    if (nd.child_count == 0) continue;
-    std::uint32_t cone = 0;
-    if (i >= st.first_root) {
-      cone = st.subtrees[i - st.first_root].cone_code;
-      cone_angle[i] = cone < 3 ? cone_half_angle(cone) : 1e9;
-    } else {
-      cone = encode_cone(nd, normal_code[i], {&normal_code[nd.first_child], nd.child_count},
-                         {&cone_angle[nd.first_child], nd.child_count}, cone_angle[i]);
-    }
-    ++st.stats.cone_codes[cone];
-    enc.record[i] |= std::uint64_t{cone} << kConeShift;
+    enc.record[i] |= std::uint64_t{encode_normal_nearest(normalized(top.nodes[i].normal))}
+                     << kNormalShift;
   }
   if (st.colors) {
     for (std::size_t i = 0; i < top_count; ++i)
@@ -199,6 +172,7 @@ PtlV2PartWriter::PtlV2PartWriter(const std::string& path,
   if (st.node_count > 0xfffffffeu) throw Error("cannot write " + path + ": more than 2^32 - 2 nodes");
   st.metadata_offset = offset;
   st.written.assign(count, 0);
+  st.root_cone.assign(count, 0);
   st.subtree_stats.resize(count);
   st.file.emplace(path);
 }
@@ -224,7 +198,9 @@ void PtlV2PartWriter::write_subtree(std::size_t k, const SphereTree& tree, Threa
   EncodeStats& stats = st.subtree_stats[k];
   const EncodedTree enc = encode_tree(tree.nodes, parent, nullptr, &decoded_root,
                                       st.options.leaf_trim, st.colors, pool, stats);
-  --stats.cone_codes[s.cone_code];  // the root's cone is counted with the top
+  // The root's record lives in the top page: its cone is kept for finish and counted there.
+  st.root_cone[k] = std::uint32_t(enc.record[0] >> kConeShift) & ((1u << kConeBits) - 1);
+  --stats.cone_codes[st.root_cone[k]];
   const std::vector<PagePlan> plan =
       plan_pages(tree.nodes, st.record_size, st.options.page_bytes, true);
   std::vector<std::uint8_t> bytes;
@@ -293,6 +269,28 @@ PtlV2WriteReport PtlV2PartWriter::finish_uncommitted(const Aabb& bounds,
     st.stats.leaf_ratio_sum += t.leaf_ratio_sum;
     st.stats.leaf_ratio_count += t.leaf_ratio_count;
     for (int c = 0; c < 4; ++c) st.stats.cone_codes[c] += t.cone_codes[c];
+  }
+  // The top's cones, bottom-up around its decoded normals.
+  const SphereTree& top = st.top;
+  EncodedTree& enc = st.top_codes;
+  std::vector<std::uint32_t> normal_code(top.nodes.size());
+  std::vector<double> cone_angle(top.nodes.size(), 0.0);
+  for (std::size_t i = 0; i < top.nodes.size(); ++i) {
+    normal_code[i] = std::uint32_t(enc.record[i] >> kNormalShift) & ((1u << kNormalBits) - 1);
+  }
+  for (std::size_t i = top.nodes.size(); i-- > 0;) {
+    const SphereNode& nd = top.nodes[i];
+    if (nd.child_count == 0) continue;
+    std::uint32_t cone = 0;
+    if (i >= st.first_root) {
+      cone = st.root_cone[i - st.first_root];
+      cone_angle[i] = cone < 3 ? cone_half_angle(cone) : 1e9;
+    } else {
+      cone = encode_cone(nd, normal_code[i], {&normal_code[nd.first_child], nd.child_count},
+                         {&cone_angle[nd.first_child], nd.child_count}, cone_angle[i]);
+    }
+    ++st.stats.cone_codes[cone];
+    enc.record[i] |= std::uint64_t{cone} << kConeShift;
   }
   HeaderFields f;
   f.colors = st.colors;

@@ -350,7 +350,6 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
       w.put(std::uint64_t(c));
       w.put(boxes[c]);
       w.put(t.root);
-      w.put(t.cone_code);
       w.put(t.node_count);
       w.put(t.leaf_count);
       w.put(t.depth);
@@ -366,7 +365,6 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
           PtlV2SubtreeSummary& t = summaries[c];
           boxes[c] = m.get<Aabb>();
           t.root = m.get<SphereNode>();
-          t.cone_code = m.get<std::uint32_t>();
           t.node_count = m.get<std::uint64_t>();
           t.leaf_count = m.get<std::uint64_t>();
           t.depth = m.get<std::uint32_t>();

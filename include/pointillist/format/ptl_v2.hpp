@@ -120,12 +120,12 @@ PtlV2WriteReport write_ptl_v2(const std::string& path, const SphereTree& tree,
 //   3. write_subtree(k, tree) encodes subtree k below its root's decoded sphere and writes its
 //      pages in place; subtrees may come in any order, different subtrees on several threads at
 //      once.
-//   4. finish() writes the header, the table, the top page and the metadata, and renames the
-//      file into place.
+//   4. finish() encodes the top's cones (an interior root's comes from its subtree's encoding),
+//      writes the header, the table, the top page and the metadata, and renames the file into
+//      place.
 // The file is an ordinary version 2 file; the same subtrees give the same bytes.
 struct PtlV2SubtreeSummary {
   SphereNode root;                    // as built: true sphere, normal, cone, colour, children
-  std::uint32_t cone_code = 0;        // of an interior root, over its decoded children
   std::uint64_t node_count = 0;       // nodes of the subtree, its root included
   std::uint64_t leaf_count = 0;
   std::uint32_t depth = 0;            // levels below its root
