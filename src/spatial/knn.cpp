@@ -262,25 +262,37 @@ void grid_queries(const CellGrid& g, std::size_t cell_begin, std::size_t cell_en
         if (count >= k || !(limit < std::numeric_limits<float>::max())) break;
         if (!(limit > 0)) limit = std::numeric_limits<float>::min();
       }
-      // In order of distance, then index: each entry's place is the number of entries before
-      // it (a few dozen entries; counted without branches, in vectors).
-      // Padded to whole vectors by entries that come after every real one.
-      const std::size_t padded = (count + 7) & ~std::size_t{7};
-      kd.resize(padded), ki.resize(padded);
-      for (std::size_t t = 0; t < count; ++t) {
-        kd[t] = near[t].d2;
-        ki[t] = original(cj[near[t].index]);
-      }
-      std::fill(kd.begin() + std::ptrdiff_t(count), kd.end(), std::numeric_limits<float>::infinity());
-      std::fill(ki.begin() + std::ptrdiff_t(count), ki.end(), std::numeric_limits<std::uint32_t>::max());
-      for (std::size_t t = 0; t < count; ++t) {
-        const float d = kd[t];
-        const std::uint32_t i = ki[t];
-        std::uint32_t place = 0;
-        for (std::size_t u = 0; u < padded; ++u) {
-          place += (kd[u] < d) | ((kd[u] == d) & (ki[u] < i));
+      // In order of distance, then index. Usually a few dozen entries: each entry's place is
+      // the number of entries before it, counted without branches, in vectors (padded to whole
+      // vectors by entries that come after every real one). Many (the limit grew, or piles of
+      // copies): a comparison sort.
+      constexpr std::size_t kMostRanked = 128;
+      if (count > kMostRanked) {
+        for (std::size_t t = 0; t < count; ++t) near[t].index = original(cj[near[t].index]);
+        std::sort(near.begin(), near.begin() + std::ptrdiff_t(count),
+                  [](const Neighbour& x, const Neighbour& y) {
+                    return x.d2 < y.d2 || (x.d2 == y.d2 && x.index < y.index);
+                  });
+      } else {
+        const std::size_t padded = (count + 7) & ~std::size_t{7};
+        kd.resize(padded), ki.resize(padded);
+        for (std::size_t t = 0; t < count; ++t) {
+          kd[t] = near[t].d2;
+          ki[t] = original(cj[near[t].index]);
         }
-        near[place] = Neighbour{d, i};
+        std::fill(kd.begin() + std::ptrdiff_t(count), kd.end(),
+                  std::numeric_limits<float>::infinity());
+        std::fill(ki.begin() + std::ptrdiff_t(count), ki.end(),
+                  std::numeric_limits<std::uint32_t>::max());
+        for (std::size_t t = 0; t < count; ++t) {
+          const float d = kd[t];
+          const std::uint32_t i = ki[t];
+          std::uint32_t place = 0;
+          for (std::size_t e = 0; e < padded; ++e) {
+            place += (kd[e] < d) | ((kd[e] == d) & (ki[e] < i));
+          }
+          near[place] = Neighbour{d, i};
+        }
       }
       const float cut = near[k - 1].d2;
       guess = cut;

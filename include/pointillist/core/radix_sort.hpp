@@ -6,20 +6,24 @@
 
 #include <algorithm>
 #include <array>
+#include <cassert>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <utility>
 #include <vector>
 
 namespace pointillist {
 
-// Sorts `items` by key(item) (a std::uint64_t below 2^key_bits), stably; `scratch` is working
-// memory, kept by the caller between calls.
+// Sorts `items` by key(item) (a std::uint64_t whose bits from key_bits up are the same in every
+// item), stably; `scratch` is working memory, kept by the caller between calls. At most 2^32 - 1
+// items (the digit counters are 32-bit).
 template <class T, class Key>
 void stable_radix_sort(std::span<T> items, std::vector<T>& scratch, int key_bits, Key&& key) {
   constexpr int kDigitBits = 11;
   constexpr std::size_t kDigits = std::size_t{1} << kDigitBits;
   const std::size_t n = items.size();
+  assert(n <= std::numeric_limits<std::uint32_t>::max());
   if (n < 2) return;
   scratch.resize(n);
   std::span<T> from = items, to = scratch;

@@ -112,11 +112,11 @@ PtlV2WriteReport write_ptl_v2(const std::string& path, const SphereTree& tree,
 
 // Writing a file in parts (the chunked conversion): subtrees below a common top are encoded and
 // written one at a time, so no step holds the whole hierarchy.
-//   1. Each subtree (a tree from build_sphere_tree) is summarized: its root node, the cone code
-//      of its root over its decoded children, and the pages it will take below the root.
+//   1. Each subtree (a tree from build_sphere_tree) is summarized: its root node, its node and
+//      leaf counts, its depth and the pages it will take below the root.
 //   2. A PtlV2PartWriter over the summaries (in a spatially coherent order) builds the top over
-//      the roots (build_top_tree), encodes it and lays out the file: header, page table, the top
-//      page, then each subtree's pages in turn, then the metadata.
+//      the roots (build_top_tree), encodes its spheres and normals and lays out the file:
+//      header, page table, the top page, then each subtree's pages in turn, then the metadata.
 //   3. write_subtree(k, tree) encodes subtree k below its root's decoded sphere and writes its
 //      pages in place; subtrees may come in any order, different subtrees on several threads at
 //      once.
