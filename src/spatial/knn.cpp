@@ -166,7 +166,7 @@ void grid_queries(const CellGrid& g, std::size_t cell_begin, std::size_t cell_en
                   float* result_d2, std::vector<std::uint32_t>& missed) {
   struct Run {
     std::uint32_t begin, end;  // candidates of one cell
-    std::uint8_t offset[3];    // its place in the block: 0, 1, 2 for -1, 0, +1 on each axis
+    float cell[3];             // its coordinates at the grid's level
     double gap2 = 0;
   };
   std::vector<Run> runs;
@@ -178,7 +178,7 @@ void grid_queries(const CellGrid& g, std::size_t cell_begin, std::size_t cell_en
   std::vector<std::uint32_t> ki;
   const auto original = [&](std::uint32_t j) { return order ? order[j] : j; };
   const std::uint32_t side = MortonFrame::kMaxCell >> g.level;  // the last cell on each axis
-  const double cell_units = double(1u << g.level);
+  const float cell_units = float(1u << g.level);
   for (std::size_t c = cell_begin; c < cell_end; ++c) {
     const std::uint32_t a[3] = {compact_bits_21(g.key[c]), compact_bits_21(g.key[c] >> 1),
                                 compact_bits_21(g.key[c] >> 2)};
@@ -192,9 +192,7 @@ void grid_queries(const CellGrid& g, std::size_t cell_begin, std::size_t cell_en
         const Vec3f p = tree_points[j];
         cx.push_back(p.x), cy.push_back(p.y), cz.push_back(p.z), cj.push_back(j);
       }
-      runs.push_back({first, std::uint32_t(cj.size()),
-                      {std::uint8_t(x + 1 - a[0]), std::uint8_t(y + 1 - a[1]),
-                       std::uint8_t(z + 1 - a[2])}});
+      runs.push_back({first, std::uint32_t(cj.size()), {float(x), float(y), float(z)}});
     };
     gather(c, a[0], a[1], a[2]);
     for (int dz = -1; dz <= 1; ++dz) {
@@ -226,20 +224,15 @@ void grid_queries(const CellGrid& g, std::size_t cell_begin, std::size_t cell_en
                           (q.y - g.frame.lo.y) * g.frame.scale,
                           (q.z - g.frame.lo.z) * g.frame.scale};
       // Each run's cell lies at least this far from q (squared, in units of length; 2 Morton
-      // cells less on each axis for the rounding of both cell assignments): per axis, the gap
-      // to the cell before q's, to q's own (none) and to the one after.
-      double gap[3][3];
-      for (int axis = 0; axis < 3; ++axis) {
-        const double lo = double(a[axis]) * cell_units;
-        const double before = std::max(0.0, double(u[axis]) - lo - 2);
-        const double after = std::max(0.0, lo + cell_units - double(u[axis]) - 2);
-        gap[axis][0] = before * before;
-        gap[axis][1] = 0;
-        gap[axis][2] = after * after;
-      }
-      const double to_length = (1 - 1e-5) / (scale * scale);
+      // cells less on each axis for the rounding of both cell assignments).
       for (Run& r : runs) {
-        r.gap2 = (gap[0][r.offset[0]] + gap[1][r.offset[1]] + gap[2][r.offset[2]]) * to_length;
+        double gap2 = 0;
+        for (int axis = 0; axis < 3; ++axis) {
+          const double lo = double(r.cell[axis]) * cell_units;
+          const double gap = std::max(lo - double(u[axis]), double(u[axis]) - lo - cell_units) - 2;
+          if (gap > 0) gap2 += gap * gap;
+        }
+        r.gap2 = gap2 / (scale * scale) * (1 - 1e-5);
       }
       // The candidates within a limit (the last query's k-th distance, grown), but the point
       // itself: when they are k or more, they hold the k nearest and all tied with the k-th.
