@@ -13,7 +13,6 @@
 // The pieces do not depend on the thread count, so neither do the normals.
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <bit>
 #include <cassert>
 #include <cmath>
@@ -98,78 +97,79 @@ class FrontierHeap {
   std::vector<std::uint64_t> heap_;
 };
 
-// The k-neighbour graph is directed (j near i does not make i near j). The reverse edges j -> i
-// that the forward rows lack, in CSR form, so rows + reverse lists are the symmetric graph. The
-// order inside a list depends on thread timing; the tree does not (see FrontierHeap).
-struct ReverseEdges {
-  std::vector<std::uint32_t> begin;  // n + 1 offsets into `from`
-  std::vector<std::uint32_t> from;
-};
-
-ReverseEdges missing_reverse_edges(const OrderedCloud& cloud, std::size_t graph_k,
-                                   ThreadPool& pool) {
-  const std::size_t n = cloud.size();
-  const std::span<const Vec3f> p = cloud.positions;
-  // Row j holds every point strictly closer to j than its last entry and none farther, so
-  // comparing distances answers "does row j list i" without searching, except near equality
-  // (ties, or rounding different from the kd-tree's).
-  std::vector<float> last_d2(n);
-  parallel_for(pool, n, kGrain, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t j = begin; j < end; ++j) {
-      last_d2[j] = length_squared(p[cloud.row(j)[graph_k - 1]] - p[j]);
+// The k-neighbour graph is directed (j near i does not make i near j). Prim's algorithm inside
+// a piece needs the symmetric graph of the piece: the reverse edges j -> i that the forward rows
+// lack, for i and j both in the piece, in CSR form. Built per piece, in cache, while its tree
+// grows; a list holds its i in increasing order (the tree does not depend on it anyway, see
+// FrontierHeap).
+class PieceReverseEdges {
+ public:
+  // Rebuilds the lists for the points [lo, lo + size).
+  void build(const OrderedCloud& cloud, std::size_t graph_k, std::uint32_t lo,
+             std::uint32_t size) {
+    const std::span<const Vec3f> p = cloud.positions;
+    lo_ = lo;
+    // Row j holds every point strictly closer to j than its last entry and none farther, so
+    // comparing distances answers "does row j list i" without searching, except near equality
+    // (ties, or rounding different from the kd-tree's).
+    last_d2_.resize(size);
+    for (std::uint32_t j = 0; j < size; ++j) {
+      last_d2_[j] = length_squared(p[cloud.row(lo + j)[graph_k - 1]] - p[lo + j]);
     }
-  });
-  const auto lists = [&](std::size_t j, std::size_t i) {
-    const float d2 = length_squared(p[i] - p[j]);
-    const float last = last_d2[j];
-    if (d2 < last * (1.0f - 1e-5f)) return true;
-    if (d2 > last * (1.0f + 1e-5f)) return false;
-    const auto row = cloud.row(j).first(graph_k);
-    return std::find(row.begin(), row.end(), static_cast<std::uint32_t>(i)) != row.end();
-  };
-  // Bit t of one_way[i]: row(j = row(i)[t]) does not list i, so j needs the reverse edge. Found
-  // once and kept for the fill pass (graphs of more than 32 neighbours search again instead).
-  std::vector<std::uint32_t> one_way(graph_k <= 32 ? n : 0);
-  const auto needs_reverse = [&](std::size_t i, std::size_t t) {
-    if (!one_way.empty()) return ((one_way[i] >> t) & 1) != 0;
-    const std::uint32_t j = cloud.row(i)[t];
-    return j != i && !lists(j, i);
-  };
-  ReverseEdges r;
-  r.begin.assign(n + 1, 0);
-  parallel_for(pool, n, kGrain, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
+    const auto lists = [&](std::uint32_t j, std::uint32_t i) {
+      const float d2 = length_squared(p[i] - p[j]);
+      const float last = last_d2_[j - lo];
+      if (d2 < last * (1.0f - 1e-5f)) return true;
+      if (d2 > last * (1.0f + 1e-5f)) return false;
+      const auto row = cloud.row(j).first(graph_k);
+      return std::find(row.begin(), row.end(), i) != row.end();
+    };
+    // Bit t of one_way[i - lo]: j = row(i)[t] is in the piece and its row does not list i.
+    // Found once and kept for the fill pass (graphs of more than 32 neighbours search again).
+    const bool keep_bits = graph_k <= 32;
+    one_way_.assign(keep_bits ? size : 0, 0);
+    const auto needs_reverse = [&](std::uint32_t i, std::size_t t) {
+      if (keep_bits) return ((one_way_[i - lo] >> t) & 1) != 0;
+      const std::uint32_t j = cloud.row(i)[t];
+      return j - lo < size && j != i && !lists(j, i);
+    };
+    begin_.assign(std::size_t{size} + 1, 0);
+    for (std::uint32_t i = lo; i < lo + size; ++i) {
       const auto row = cloud.row(i);
       std::uint32_t bits = 0;
       for (std::size_t t = 0; t < graph_k; ++t) {
         const std::uint32_t j = row[t];
-        if (j != i && !lists(j, i)) {
+        if (j - lo < size && j != i && !lists(j, i)) {
           bits |= std::uint32_t{1} << (t & 31);
-          std::atomic_ref<std::uint32_t>(r.begin[j + 1]).fetch_add(1, std::memory_order_relaxed);
+          ++begin_[j - lo + 1];
         }
       }
-      if (!one_way.empty()) one_way[i] = bits;
+      if (keep_bits) one_way_[i - lo] = bits;
     }
-  });
-  last_d2 = {};
-  for (std::size_t j = 0; j < n; ++j) r.begin[j + 1] += r.begin[j];
-  r.from.resize(r.begin[n]);
-  // Fill with begin[j] as the cursor; afterwards begin[j] holds the old begin[j + 1].
-  parallel_for(pool, n, kGrain, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
+    for (std::uint32_t j = 0; j < size; ++j) begin_[j + 1] += begin_[j];
+    from_.resize(begin_[size]);
+    // Fill with begin_[j] as the cursor; afterwards begin_[j] holds the old begin_[j + 1].
+    for (std::uint32_t i = lo; i < lo + size; ++i) {
       for (std::size_t t = 0; t < graph_k; ++t) {
-        if (!needs_reverse(i, t)) continue;
-        const std::uint32_t j = cloud.row(i)[t];
-        const std::uint32_t slot =
-            std::atomic_ref<std::uint32_t>(r.begin[j]).fetch_add(1, std::memory_order_relaxed);
-        r.from[slot] = static_cast<std::uint32_t>(i);
+        if (needs_reverse(i, t)) from_[begin_[cloud.row(i)[t] - lo]++] = i;
       }
     }
-  });
-  for (std::size_t j = n; j > 0; --j) r.begin[j] = r.begin[j - 1];
-  r.begin[0] = 0;
-  return r;
-}
+    for (std::uint32_t j = size; j > 0; --j) begin_[j] = begin_[j - 1];
+    begin_[0] = 0;
+  }
+  // The points i of the piece whose rows list the piece's point j but j's row does not list.
+  std::span<const std::uint32_t> of(std::uint32_t j) const {
+    return std::span<const std::uint32_t>(from_).subspan(begin_[j - lo_],
+                                                         begin_[j - lo_ + 1] - begin_[j - lo_]);
+  }
+
+ private:
+  std::uint32_t lo_ = 0;
+  std::vector<float> last_d2_;
+  std::vector<std::uint32_t> one_way_;
+  std::vector<std::uint32_t> begin_;  // size + 1 offsets into from_
+  std::vector<std::uint32_t> from_;
+};
 
 Vec3f centroid(std::span<const Vec3f> positions, ThreadPool& pool) {
   const std::size_t n = positions.size();
@@ -270,7 +270,6 @@ void orient_normals_ordered(const OrderedCloud& cloud, std::uint32_t graph_k,
   ProgressPhase phase(progress, "orientation", n);
   if (n == 0) return;
   const std::span<const Vec3f> p = cloud.positions;
-  const ReverseEdges reverse = m > 0 ? missing_reverse_edges(cloud, m, pool) : ReverseEdges{};
   const Vec3f c = centre ? *centre : centroid(p, pool);
 
   // 1. Each piece (a run of kPiece points in Morton order, a compact block of space) grows
@@ -283,6 +282,8 @@ void orient_normals_ordered(const OrderedCloud& cloud, std::uint32_t graph_k,
     const auto lo = static_cast<std::uint32_t>(piece * kPiece);
     const auto size = static_cast<std::uint32_t>(std::min(kPiece, n - lo));
     std::vector<Node> nodes(size);  // indexed from lo
+    PieceReverseEdges reverse;
+    if (m > 0) reverse.build(cloud, m, lo, size);
     FrontierHeap heap(nodes);
     const auto relax = [&](std::uint32_t u, std::uint32_t v) {
       const std::uint32_t local = v - lo;
@@ -314,8 +315,8 @@ void orient_normals_ordered(const OrderedCloud& cloud, std::uint32_t graph_k,
         component[u] = id;
         sum += double(dot(normals[u], p[u] - c));
         for (const std::uint32_t v : cloud.row(u).first(m)) relax(u, v);
-        for (std::uint32_t e = reverse.begin[u]; e < reverse.begin[u + 1]; ++e) {
-          relax(u, reverse.from[e]);
+        if (m > 0) {
+          for (const std::uint32_t v : reverse.of(u)) relax(u, v);
         }
       }
       vote.push_back(sum);
