@@ -12,6 +12,9 @@
 #include <cmath>
 #include <limits>
 #include <nanoflann.hpp>
+#if defined(__AVX2__)
+#include <immintrin.h>
+#endif
 
 namespace pointillist {
 namespace {
@@ -158,18 +161,54 @@ bool build_grid(std::span<const Vec3f> points, CellGrid& g) {
   return true;
 }
 
+// Lanes of the vector filter; the outputs of within_limit need this much room past m.
+constexpr std::size_t kLanes = 8;
+
+// Writes the distances d[i] <= limit (NaN never) and their i to out_d, out_i, in order of i;
+// returns their count. out_d and out_i have room for m + kLanes entries.
+std::size_t within_limit(const float* d, std::size_t m, float limit, float* out_d,
+                         std::uint32_t* out_i) {
+  std::size_t count = 0, i = 0;
+#if defined(__AVX2__)
+  // Eight at a time: the lanes that pass, moved to the front by a permutation looked up from
+  // their mask (three bits a lane), stored whole; the count advances by the lanes that passed.
+  static constexpr auto kPack = [] {
+    std::array<std::uint64_t, 256> t{};
+    for (std::uint32_t mask = 0; mask < 256; ++mask) {
+      std::uint64_t packed = 0;
+      int at = 0;
+      for (int lane = 0; lane < 8; ++lane) {
+        if (mask >> lane & 1) packed |= std::uint64_t(lane) << (8 * at++);
+      }
+      t[mask] = packed;
+    }
+    return t;
+  }();
+  const __m256 lim = _mm256_set1_ps(limit);
+  for (; i + kLanes <= m; i += kLanes) {
+    const __m256 v = _mm256_loadu_ps(d + i);
+    const auto mask = unsigned(_mm256_movemask_ps(_mm256_cmp_ps(v, lim, _CMP_LE_OQ)));
+    const __m256i lanes = _mm256_cvtepu8_epi32(_mm_cvtsi64_si128(std::int64_t(kPack[mask])));
+    _mm256_storeu_ps(out_d + count, _mm256_permutevar8x32_ps(v, lanes));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out_i + count),
+                        _mm256_add_epi32(lanes, _mm256_set1_epi32(int(i))));
+    count += std::size_t(std::popcount(mask));
+  }
+#endif
+  for (; i < m; ++i) {
+    out_d[count] = d[i];
+    out_i[count] = std::uint32_t(i);
+    count += d[i] <= limit;
+  }
+  return count;
+}
+
 // Answers the queries of cells [cell_begin, cell_end) from their blocks; queries whose answer
 // the block cannot vouch for go to `missed`.
 void grid_queries(const CellGrid& g, std::size_t cell_begin, std::size_t cell_end,
                   std::span<const Vec3f> tree_points, std::span<const Vec3f> points,
                   const std::uint32_t* order, std::size_t k, std::uint32_t* result,
                   float* result_d2, std::vector<std::uint32_t>& missed) {
-  struct Run {
-    std::uint32_t begin, end;  // candidates of one cell
-    float cell[3];             // its coordinates at the grid's level
-    double gap2 = 0;
-  };
-  std::vector<Run> runs;
   float guess = 0;  // a squared distance that k candidates are expected to be within
   std::vector<float> cx, cy, cz;
   std::vector<std::uint32_t> cj;
@@ -182,19 +221,11 @@ void grid_queries(const CellGrid& g, std::size_t cell_begin, std::size_t cell_en
   for (std::size_t c = cell_begin; c < cell_end; ++c) {
     const std::uint32_t a[3] = {compact_bits_21(g.key[c]), compact_bits_21(g.key[c] >> 1),
                                 compact_bits_21(g.key[c] >> 2)};
-    // Gather the block: the cell itself first (its points are the likeliest neighbours), each
-    // cell's candidates a run with the cell's coordinates.
-    cx.clear(), cy.clear(), cz.clear(), cj.clear();
-    runs.clear();
-    const auto gather = [&](std::size_t cell, std::int64_t x, std::int64_t y, std::int64_t z) {
-      const auto first = std::uint32_t(cj.size());
-      for (std::uint32_t j = g.begin[cell]; j < g.begin[cell + 1]; ++j) {
-        const Vec3f p = tree_points[j];
-        cx.push_back(p.x), cy.push_back(p.y), cz.push_back(p.z), cj.push_back(j);
-      }
-      runs.push_back({first, std::uint32_t(cj.size()), {float(x), float(y), float(z)}});
-    };
-    gather(c, a[0], a[1], a[2]);
+    // Gather the block: the cell itself first (its points are the likeliest neighbours).
+    std::array<std::uint32_t, 27> block;
+    std::size_t block_cells = 0;
+    const auto gather = [&](std::size_t cell) { block[block_cells++] = std::uint32_t(cell); };
+    gather(c);
     for (int dz = -1; dz <= 1; ++dz) {
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
@@ -206,34 +237,32 @@ void grid_queries(const CellGrid& g, std::size_t cell_begin, std::size_t cell_en
           }
           const std::uint32_t found = g.find(
               morton_code(std::uint32_t(b[0]), std::uint32_t(b[1]), std::uint32_t(b[2])));
-          if (found) gather(found - 1, b[0], b[1], b[2]);
+          if (found) gather(found - 1);
         }
       }
     }
-    const std::size_t m = cj.size();
+    std::size_t m = 0;
+    for (std::size_t b = 0; b < block_cells; ++b) m += g.begin[block[b] + 1] - g.begin[block[b]];
     if (m > kMaxCandidates || m <= k) {
       for (std::uint32_t j = g.begin[c]; j < g.begin[c + 1]; ++j) missed.push_back(j);
       continue;
     }
+    cx.resize(m), cy.resize(m), cz.resize(m), cj.resize(m);
+    for (std::size_t b = 0, at = 0; b < block_cells; ++b) {
+      for (std::uint32_t j = g.begin[block[b]]; j < g.begin[block[b] + 1]; ++j, ++at) {
+        const Vec3f p = tree_points[j];
+        cx[at] = p.x, cy[at] = p.y, cz[at] = p.z, cj[at] = j;
+      }
+    }
     near.resize(m);
     cd.resize(m);
+    kd.resize(m + kLanes), ki.resize(m + kLanes);
     const double scale = g.frame.scale;
     for (std::uint32_t j = g.begin[c]; j < g.begin[c + 1]; ++j) {
       const Vec3f q = tree_points[j];
       const float u[3] = {(q.x - g.frame.lo.x) * g.frame.scale,
                           (q.y - g.frame.lo.y) * g.frame.scale,
                           (q.z - g.frame.lo.z) * g.frame.scale};
-      // Each run's cell lies at least this far from q (squared, in units of length; 2 Morton
-      // cells less on each axis for the rounding of both cell assignments).
-      for (Run& r : runs) {
-        double gap2 = 0;
-        for (int axis = 0; axis < 3; ++axis) {
-          const double lo = double(r.cell[axis]) * cell_units;
-          const double gap = std::max(lo - double(u[axis]), double(u[axis]) - lo - cell_units) - 2;
-          if (gap > 0) gap2 += gap * gap;
-        }
-        r.gap2 = gap2 / (scale * scale) * (1 - 1e-5);
-      }
       // The candidates within a limit (the last query's k-th distance, grown), but the point
       // itself: when they are k or more, they hold the k nearest and all tied with the k-th.
       // Else the limit grows until they do (all m - 1 of them at the end).
@@ -244,38 +273,27 @@ void grid_queries(const CellGrid& g, std::size_t cell_begin, std::size_t cell_en
       std::size_t count = 0;
       for (float limit = guess > 0 ? guess * 1.5f : std::numeric_limits<float>::infinity();;
            limit = limit * 4) {
-        count = 0;
-        for (const Run& r : runs) {
-          if (r.gap2 > double(limit)) continue;
-          for (std::uint32_t i = r.begin; i < r.end; ++i) {
-            near[count] = Neighbour{cd[i], i};
-            count += cd[i] <= limit;
-          }
-        }
+        count = within_limit(cd.data(), m, limit, kd.data(), ki.data());
         if (count >= k || !(limit < std::numeric_limits<float>::max())) break;
         if (!(limit > 0)) limit = std::numeric_limits<float>::min();
       }
+      for (std::size_t t = 0; t < count; ++t) ki[t] = original(cj[ki[t]]);
       // In order of distance, then index. Usually a few dozen entries: each entry's place is
       // the number of entries before it, counted without branches, in vectors (padded to whole
       // vectors by entries that come after every real one). Many (the limit grew, or piles of
       // copies): a comparison sort.
       constexpr std::size_t kMostRanked = 128;
       if (count > kMostRanked) {
-        for (std::size_t t = 0; t < count; ++t) near[t].index = original(cj[near[t].index]);
+        for (std::size_t t = 0; t < count; ++t) near[t] = Neighbour{kd[t], ki[t]};
         std::sort(near.begin(), near.begin() + std::ptrdiff_t(count),
                   [](const Neighbour& x, const Neighbour& y) {
                     return x.d2 < y.d2 || (x.d2 == y.d2 && x.index < y.index);
                   });
       } else {
         const std::size_t padded = (count + 7) & ~std::size_t{7};
-        kd.resize(padded), ki.resize(padded);
-        for (std::size_t t = 0; t < count; ++t) {
-          kd[t] = near[t].d2;
-          ki[t] = original(cj[near[t].index]);
-        }
-        std::fill(kd.begin() + std::ptrdiff_t(count), kd.end(),
+        std::fill(kd.begin() + std::ptrdiff_t(count), kd.begin() + std::ptrdiff_t(padded),
                   std::numeric_limits<float>::infinity());
-        std::fill(ki.begin() + std::ptrdiff_t(count), ki.end(),
+        std::fill(ki.begin() + std::ptrdiff_t(count), ki.begin() + std::ptrdiff_t(padded),
                   std::numeric_limits<std::uint32_t>::max());
         for (std::size_t t = 0; t < count; ++t) {
           const float d = kd[t];
