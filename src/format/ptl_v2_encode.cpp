@@ -116,20 +116,26 @@ SphereCode encode_sphere(const Sphere& parent, const Sphere& target, std::uint8_
   return out;
 }
 
-std::uint32_t encode_cone(const SphereNode& node, std::uint32_t axis_code,
-                          std::span<const std::uint32_t> child_normal_codes,
-                          std::span<const double> child_cone_angles, double& angle) {
+std::uint32_t encode_cone(std::span<const SphereNode> nodes, std::span<const std::uint64_t> record,
+                          std::size_t i) {
   const auto normal_table = qs_detail::normal_table();
-  const Vec3f axis = normal_table[axis_code];
+  const auto normal_of = [&](std::size_t j) {
+    return normal_table[quant::bits(std::uint32_t(record[j]), kNormalShift, kNormalBits)];
+  };
+  const SphereNode& node = nodes[i];
+  const Vec3f axis = normal_of(i);
   double theta = node.cone_sin < 1 ? std::asin(double(node.cone_sin)) : 1e9;
   theta += angle_between(axis, node.normal);
-  for (std::size_t k = 0; k < child_normal_codes.size(); ++k) {
-    theta = std::max(theta, angle_between(axis, normal_table[child_normal_codes[k]]) +
-                                child_cone_angles[k]);
+  for (std::uint32_t k = 0; k < node.child_count; ++k) {
+    const std::size_t ch = node.first_child + k;
+    double child_angle = 0.0;  // a leaf: its normal alone (its cone bits hold its radius trim)
+    if (nodes[ch].child_count > 0) {
+      const std::uint32_t cone = quant::bits(std::uint32_t(record[ch]), kConeShift, kConeBits);
+      child_angle = cone < 3 ? cone_half_angle(cone) : 1e9;
+    }
+    theta = std::max(theta, angle_between(axis, normal_of(ch)) + child_angle);
   }
-  const std::uint32_t cone = encode_cone_at_least(theta);
-  angle = cone < 3 ? cone_half_angle(cone) : 1e9;
-  return cone;
+  return encode_cone_at_least(theta);
 }
 
 namespace {
@@ -244,16 +250,15 @@ EncodedTree encode_tree(std::span<const SphereNode> nodes, std::span<const std::
     }
   });
 
-  target_radius = {};  // its memory serves the arrays below
+  target_radius = {};
 
   // Normals and colours, then cones bottom-up around the decoded normals: each holds the true
-  // cone and the decoded cones (leaves: decoded normals) of the children.
-  std::vector<std::uint32_t> normal_code(n);  // QSplat normal codes
-  std::vector<double> cone_angle(n);          // decoded cone half-angles (leaves 0)
+  // cone and the decoded cones (leaves: decoded normals) of the children, read back from their
+  // records.
   for_chunks(pool, 0, n, [&](std::size_t, std::size_t first, std::size_t last) {
     for (std::size_t i = first; i < last; ++i) {
-      normal_code[i] = encode_normal_nearest(normalized(nodes[i].normal));
-      out.record[i] |= std::uint64_t{normal_code[i]} << kNormalShift;
+      out.record[i] |= std::uint64_t{encode_normal_nearest(normalized(nodes[i].normal))}
+                       << kNormalShift;
       if (colors) {
         out.record[i] |= std::uint64_t{encode_rgb565_nearest(nodes[i].color)} << kColorShift;
       }
@@ -261,12 +266,8 @@ EncodedTree encode_tree(std::span<const SphereNode> nodes, std::span<const std::
   });
   each_level(true, [&](std::size_t c, std::size_t first, std::size_t last) {
     for (std::size_t i = first; i < last; ++i) {
-      const SphereNode& nd = nodes[i];
-      cone_angle[i] = 0.0;
-      if (nd.child_count == 0) continue;
-      const std::uint32_t cone = encode_cone(
-          nd, normal_code[i], {&normal_code[nd.first_child], nd.child_count},
-          {&cone_angle[nd.first_child], nd.child_count}, cone_angle[i]);
+      if (nodes[i].child_count == 0) continue;
+      const std::uint32_t cone = encode_cone(nodes, out.record, i);
       ++chunk_stats[c].cone_codes[cone];
       out.record[i] |= std::uint64_t{cone} << kConeShift;
     }

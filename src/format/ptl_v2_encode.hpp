@@ -47,12 +47,12 @@ struct SphereCode {
 SphereCode encode_sphere(const Sphere& parent, const Sphere& target, std::uint8_t child_count,
                          quant::LeafTrim mode, EncodeStats& stats);
 
-// The cone code of an interior node around its decoded normal `axis_code`: it holds the node's
-// true cone and its children's decoded normals and cones. Sets `angle` to the decoded half-angle
-// (1e9 for no bound).
-std::uint32_t encode_cone(const SphereNode& node, std::uint32_t axis_code,
-                          std::span<const std::uint32_t> child_normal_codes,
-                          std::span<const double> child_cone_angles, double& angle);
+// The cone code of interior node i around its decoded normal: it holds the node's true cone and
+// its children's decoded normals and cones, all read back from the records (normal bits; cone
+// bits of interior children, a leaf's cone being its normal alone). The node's normal bits and
+// its children's records must be complete.
+std::uint32_t encode_cone(std::span<const SphereNode> nodes, std::span<const std::uint64_t> record,
+                          std::size_t i);
 
 // Every node of a breadth-first tree, encoded.
 struct EncodedTree {

@@ -273,22 +273,10 @@ PtlV2WriteReport PtlV2PartWriter::finish_uncommitted(const Aabb& bounds,
   // The top's cones, bottom-up around its decoded normals.
   const SphereTree& top = st.top;
   EncodedTree& enc = st.top_codes;
-  std::vector<std::uint32_t> normal_code(top.nodes.size());
-  std::vector<double> cone_angle(top.nodes.size(), 0.0);
-  for (std::size_t i = 0; i < top.nodes.size(); ++i) {
-    normal_code[i] = std::uint32_t(enc.record[i] >> kNormalShift) & ((1u << kNormalBits) - 1);
-  }
   for (std::size_t i = top.nodes.size(); i-- > 0;) {
-    const SphereNode& nd = top.nodes[i];
-    if (nd.child_count == 0) continue;
-    std::uint32_t cone = 0;
-    if (i >= st.first_root) {
-      cone = st.root_cone[i - st.first_root];
-      cone_angle[i] = cone < 3 ? cone_half_angle(cone) : 1e9;
-    } else {
-      cone = encode_cone(nd, normal_code[i], {&normal_code[nd.first_child], nd.child_count},
-                         {&cone_angle[nd.first_child], nd.child_count}, cone_angle[i]);
-    }
+    if (top.nodes[i].child_count == 0) continue;
+    const std::uint32_t cone = i >= st.first_root ? st.root_cone[i - st.first_root]
+                                                  : encode_cone(top.nodes, enc.record, i);
     ++st.stats.cone_codes[cone];
     enc.record[i] |= std::uint64_t{cone} << kConeShift;
   }
