@@ -262,7 +262,7 @@ LeafCode encode_enclosing_leaf(const Sphere& parent, const Sphere& target, LeafT
 }
 
 std::uint32_t encode_normal_nearest(Vec3f n) {
-  const std::uint32_t q = qs_detail::encode_normal(n);
+  const std::uint32_t q = qs_detail::encode_normal_by_bounds(n);
   const auto table = qs_detail::normal_table();
   const int face = int(q / (kNormalGrid * kNormalGrid));
   const int u = int(q / kNormalGrid) % kNormalGrid, v = int(q % kNormalGrid);

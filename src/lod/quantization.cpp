@@ -4,7 +4,10 @@
 #include "pointillist/lod/quantization.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstring>
+#include <limits>
 #include <numbers>
 #include <vector>
 
@@ -100,6 +103,43 @@ int normal_cell(float t) {
   return clamped_floor((w + 1.0f) * 0.5f * float(kNormalGrid), 0, kNormalGrid - 1);
 }
 
+// The least float of each cell 1..51 of normal_cell (bisection over the floats' order, from
+// -infinity to +infinity), then NaN to pad to whole vectors (no comparison with NaN holds).
+using CellBounds = std::array<float, 56>;
+CellBounds make_cell_bounds() {
+  // Floats as integers of the same order: negative floats reversed below the positive ones.
+  const auto key = [](float f) {
+    std::uint32_t b;
+    std::memcpy(&b, &f, sizeof b);
+    return (b & 0x80000000u) ? ~b : b | 0x80000000u;
+  };
+  const auto value = [](std::uint32_t k) {
+    const std::uint32_t b = (k & 0x80000000u) ? k & 0x7fffffffu : ~k;
+    float f;
+    std::memcpy(&f, &b, sizeof f);
+    return f;
+  };
+  CellBounds bounds;
+  bounds.fill(std::numeric_limits<float>::quiet_NaN());
+  for (int cell = 1; cell < kNormalGrid; ++cell) {
+    // normal_cell(value(lo)) < cell <= normal_cell(value(hi))
+    std::uint32_t lo = key(-std::numeric_limits<float>::infinity());
+    std::uint32_t hi = key(std::numeric_limits<float>::infinity());
+    while (hi - lo > 1) {
+      const std::uint32_t mid = lo + (hi - lo) / 2;
+      (normal_cell(value(mid)) >= cell ? hi : lo) = mid;
+    }
+    bounds[std::size_t(cell - 1)] = value(hi);
+  }
+  return bounds;
+}
+
+std::uint32_t cell_by_bounds(const CellBounds& bounds, float t) {
+  std::uint32_t cell = 0;
+  for (const float b : bounds) cell += t >= b;
+  return cell;
+}
+
 }  // namespace
 
 std::span<const std::int16_t> sphere_code_table() { return sphere_tables().code; }
@@ -120,7 +160,14 @@ std::span<const Vec3f, kNormalCodeCount> normal_table() {
   return std::span<const Vec3f, kNormalCodeCount>(table.data(), kNormalCodeCount);
 }
 
-std::uint32_t encode_normal(Vec3f n) {
+namespace {
+
+// The face of n and its two components on it, as QSplat 1.0 picks them.
+struct FaceComponents {
+  std::uint32_t face;
+  float u, v;
+};
+FaceComponents face_components(Vec3f n) {
   const float ax = std::fabs(n.x), ay = std::fabs(n.y), az = std::fabs(n.z);
   // Ties go to the later axis (y over x, z over either), as QSplat 1.0 decides.
   std::uint32_t face;
@@ -129,16 +176,24 @@ std::uint32_t encode_normal(Vec3f n) {
   } else {
     face = (ay > az) ? (n.y > 0 ? 2 : 3) : (n.z > 0 ? 4 : 5);
   }
-  float u, v;
-  if (face < 2) {
-    u = n.y, v = n.z;
-  } else if (face < 4) {
-    u = n.z, v = n.x;
-  } else {
-    u = n.x, v = n.y;
-  }
-  return (face * kNormalGrid + std::uint32_t(normal_cell(u))) * kNormalGrid +
-         std::uint32_t(normal_cell(v));
+  if (face < 2) return {face, n.y, n.z};
+  if (face < 4) return {face, n.z, n.x};
+  return {face, n.x, n.y};
+}
+
+}  // namespace
+
+std::uint32_t encode_normal(Vec3f n) {
+  const FaceComponents f = face_components(n);
+  return (f.face * kNormalGrid + std::uint32_t(normal_cell(f.u))) * kNormalGrid +
+         std::uint32_t(normal_cell(f.v));
+}
+
+std::uint32_t encode_normal_by_bounds(Vec3f n) {
+  static const CellBounds bounds = make_cell_bounds();
+  const FaceComponents f = face_components(n);
+  return (f.face * kNormalGrid + cell_by_bounds(bounds, f.u)) * kNormalGrid +
+         cell_by_bounds(bounds, f.v);
 }
 
 }  // namespace pointillist::quant

@@ -62,6 +62,11 @@ std::span<const Vec3f, kNormalCodeCount> normal_table();
 
 // Code of a unit normal (the cube-face grid on atan of the components, spec §5.2; no dither).
 std::uint32_t encode_normal(Vec3f n);
+// The same code without atan: each component's cell is the number of cell boundaries at or
+// below it, the boundaries (the least value of each cell 1..51) found once by bisection over
+// encode_normal's own cell function. That function is non-decreasing in its input (checked over
+// every float with this C library's atanf), so the codes are the same.
+std::uint32_t encode_normal_by_bounds(Vec3f n);
 
 // ---- 2-bit normal cone codes (spec §6) ----
 
