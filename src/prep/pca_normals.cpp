@@ -88,7 +88,8 @@ std::vector<Vec3f> pca_normals(std::span<const Vec3f> positions, ThreadPool& poo
   const prep_detail::OrderedCloud cloud =
       prep_detail::order_cloud(positions, options.k - 1, pool, progress);
   std::vector<Vec3f> normals = prep_detail::pca_normals_ordered(cloud, options.k, pool, progress);
-  prep_detail::orient_normals_ordered(cloud, prep_detail::orientation_graph_k(options.k), normals, pool, progress);
+  prep_detail::orient_normals_ordered(cloud, prep_detail::orientation_graph_k(options.k), normals,
+                                      pool, progress);
   return prep_detail::to_caller_order<Vec3f>(cloud, normals, pool);
 }
 

@@ -161,11 +161,12 @@ bool build_grid(std::span<const Vec3f> points, CellGrid& g) {
   return true;
 }
 
-// Lanes of the vector filter; the outputs of within_limit need this much room past m.
+// Lanes of the vector filter and of the rank count's padding.
 constexpr std::size_t kLanes = 8;
 
 // Writes the distances d[i] <= limit (NaN never) and their i to out_d, out_i, in order of i;
-// returns their count. out_d and out_i have room for m + kLanes entries.
+// returns their count. out_d and out_i have room for m entries (a vector step stores whole
+// vectors, but at out + count <= i with i + kLanes <= m).
 std::size_t within_limit(const float* d, std::size_t m, float limit, float* out_d,
                          std::uint32_t* out_i) {
   std::size_t count = 0, i = 0;
@@ -290,7 +291,9 @@ void grid_queries(const CellGrid& g, std::size_t cell_begin, std::size_t cell_en
                     return x.d2 < y.d2 || (x.d2 == y.d2 && x.index < y.index);
                   });
       } else {
-        const std::size_t padded = (count + 7) & ~std::size_t{7};
+        // kd and ki have room for m + kLanes entries: count + 7 of them fit.
+        const std::size_t padded = (count + kLanes - 1) & ~(kLanes - 1);
+        assert(padded <= kd.size());
         std::fill(kd.begin() + std::ptrdiff_t(count), kd.begin() + std::ptrdiff_t(padded),
                   std::numeric_limits<float>::infinity());
         std::fill(ki.begin() + std::ptrdiff_t(count), ki.begin() + std::ptrdiff_t(padded),
