@@ -128,11 +128,12 @@ std::uint32_t encode_cone(std::span<const SphereNode> nodes, std::span<const std
   theta += angle_between(axis, node.normal);
   for (std::uint32_t k = 0; k < node.child_count; ++k) {
     const std::size_t ch = node.first_child + k;
-    double child_angle = 0.0;  // a leaf: its normal alone (its cone bits hold its radius trim)
-    if (nodes[ch].child_count > 0) {
-      const std::uint32_t cone = quant::bits(std::uint32_t(record[ch]), kConeShift, kConeBits);
-      child_angle = cone < 3 ? cone_half_angle(cone) : 1e9;
-    }
+    // A leaf's cone is its normal alone (its cone bits hold its radius trim); code 3, no bound,
+    // decodes to an infinite angle.
+    const double child_angle =
+        nodes[ch].child_count > 0
+            ? cone_half_angle(quant::bits(std::uint32_t(record[ch]), kConeShift, kConeBits))
+            : 0.0;
     theta = std::max(theta, angle_between(axis, normal_of(ch)) + child_angle);
   }
   return encode_cone_at_least(theta);

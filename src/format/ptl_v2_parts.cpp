@@ -199,7 +199,7 @@ void PtlV2PartWriter::write_subtree(std::size_t k, const SphereTree& tree, Threa
   const EncodedTree enc = encode_tree(tree.nodes, parent, nullptr, &decoded_root,
                                       st.options.leaf_trim, st.colors, pool, stats);
   // The root's record lives in the top page: its cone is kept for finish and counted there.
-  st.root_cone[k] = std::uint32_t(enc.record[0] >> kConeShift) & ((1u << kConeBits) - 1);
+  st.root_cone[k] = quant::bits(std::uint32_t(enc.record[0]), kConeShift, kConeBits);
   --stats.cone_codes[st.root_cone[k]];
   const std::vector<PagePlan> plan =
       plan_pages(tree.nodes, st.record_size, st.options.page_bytes, true);

@@ -16,23 +16,17 @@
 // back.
 #include "median_split.hpp"
 
+#include "pointillist/core/float_order.hpp"
 #include "pointillist/core/morton.hpp"
 
 #include <array>
 #include <cmath>
-#include <cstring>
 
 namespace pointillist::lod_detail {
 namespace {
 
-// A point's coordinate as an unsigned integer of the same order (-0 counts as +0; negative
-// floats: flip all bits; others: flip the sign bit; arithmetic shift, no branch).
-std::uint32_t ordered_bits(float v) {
-  v += 0.0f;
-  std::uint32_t bits;
-  std::memcpy(&bits, &v, sizeof bits);
-  return bits ^ (static_cast<std::uint32_t>(static_cast<std::int32_t>(bits) >> 31) | 0x80000000u);
-}
+// A point's coordinate as an unsigned integer of the same order (-0 counts as +0).
+std::uint32_t ordered_bits(float v) { return ordered_key(v + 0.0f); }
 
 // An entry of a per-axis list: the point's coordinate on that axis (-0 stored as +0) and its
 // index. Keeping the coordinate in the list makes a range's box readable from the ends of its

@@ -3,10 +3,11 @@
 // spec's order of operations exactly: the .qs writer must reproduce QSplat 1.0's bits (§8.6).
 #include "pointillist/lod/quantization.hpp"
 
+#include "pointillist/core/float_order.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <numbers>
 #include <vector>
@@ -107,29 +108,17 @@ int normal_cell(float t) {
 // -infinity to +infinity), then NaN to pad to whole vectors (no comparison with NaN holds).
 using CellBounds = std::array<float, 56>;
 CellBounds make_cell_bounds() {
-  // Floats as integers of the same order: negative floats reversed below the positive ones.
-  const auto key = [](float f) {
-    std::uint32_t b;
-    std::memcpy(&b, &f, sizeof b);
-    return (b & 0x80000000u) ? ~b : b | 0x80000000u;
-  };
-  const auto value = [](std::uint32_t k) {
-    const std::uint32_t b = (k & 0x80000000u) ? k & 0x7fffffffu : ~k;
-    float f;
-    std::memcpy(&f, &b, sizeof f);
-    return f;
-  };
   CellBounds bounds;
   bounds.fill(std::numeric_limits<float>::quiet_NaN());
   for (int cell = 1; cell < kNormalGrid; ++cell) {
-    // normal_cell(value(lo)) < cell <= normal_cell(value(hi))
-    std::uint32_t lo = key(-std::numeric_limits<float>::infinity());
-    std::uint32_t hi = key(std::numeric_limits<float>::infinity());
+    // normal_cell(from_ordered_key(lo)) < cell <= normal_cell(from_ordered_key(hi))
+    std::uint32_t lo = ordered_key(-std::numeric_limits<float>::infinity());
+    std::uint32_t hi = ordered_key(std::numeric_limits<float>::infinity());
     while (hi - lo > 1) {
       const std::uint32_t mid = lo + (hi - lo) / 2;
-      (normal_cell(value(mid)) >= cell ? hi : lo) = mid;
+      (normal_cell(from_ordered_key(mid)) >= cell ? hi : lo) = mid;
     }
-    bounds[std::size_t(cell - 1)] = value(hi);
+    bounds[std::size_t(cell - 1)] = from_ordered_key(hi);
   }
   return bounds;
 }

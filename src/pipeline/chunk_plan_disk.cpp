@@ -8,13 +8,13 @@
 // they extend the box of that side, so the boxes of the next level need no pass of their own.
 #include <algorithm>
 #include <array>
-#include <bit>
 #include <cstdio>
 #include <cstring>
 #include <memory>
 
 #include "chunk_plan.hpp"
 #include "pointillist/core/error.hpp"
+#include "pointillist/core/float_order.hpp"
 
 namespace pointillist::chunking {
 namespace {
@@ -23,10 +23,7 @@ constexpr int kDigits = 6;  // 2 of the coordinate, 4 of the index
 constexpr std::size_t kBuckets = 1 << 16;
 
 // The coordinate as an unsigned integer in the same order (-0 as +0; no NaN here).
-std::uint32_t ordered(float c) {
-  const auto u = std::bit_cast<std::uint32_t>(c + 0.0f);
-  return (u & 0x80000000u) ? ~u : (u | 0x80000000u);
-}
+std::uint32_t ordered(float c) { return ordered_key(c + 0.0f); }
 
 std::uint32_t digit(std::uint32_t key, std::uint64_t index, int d) {
   if (d == 0) return key >> 16;

@@ -104,11 +104,14 @@ class FrontierHeap {
 // FrontierHeap).
 class PieceReverseEdges {
  public:
-  // Rebuilds the lists for the points [lo, lo + size).
+  // Rebuilds the lists for the points [lo, lo + size) (all empty for graph_k = 0).
   void build(const OrderedCloud& cloud, std::size_t graph_k, std::uint32_t lo,
              std::uint32_t size) {
     const std::span<const Vec3f> p = cloud.positions;
     lo_ = lo;
+    begin_.assign(std::size_t{size} + 1, 0);
+    from_.clear();
+    if (graph_k == 0) return;
     // Row j holds every point strictly closer to j than its last entry and none farther, so
     // comparing distances answers "does row j list i" without searching, except near equality
     // (ties, or rounding different from the kd-tree's).
@@ -124,24 +127,24 @@ class PieceReverseEdges {
       const auto row = cloud.row(j).first(graph_k);
       return std::find(row.begin(), row.end(), i) != row.end();
     };
-    // Bit t of one_way[i - lo]: j = row(i)[t] is in the piece and its row does not list i.
-    // Found once and kept for the fill pass (graphs of more than 32 neighbours search again).
-    const bool keep_bits = graph_k <= 32;
-    one_way_.assign(keep_bits ? size : 0, 0);
-    const auto needs_reverse = [&](std::uint32_t i, std::size_t t) {
-      if (keep_bits) return ((one_way_[i - lo] >> t) & 1) != 0;
+    // The edge i -> row(i)[t] needs its reverse: its end is in the piece and does not list i.
+    const auto one_way = [&](std::uint32_t i, std::size_t t) {
       const std::uint32_t j = cloud.row(i)[t];
       return j - lo < size && j != i && !lists(j, i);
     };
-    begin_.assign(std::size_t{size} + 1, 0);
+    // Bit t of one_way_[i - lo]: one_way(i, t), found once and kept for the fill pass (graphs of
+    // more than 32 neighbours ask again).
+    const bool keep_bits = graph_k <= 32;
+    one_way_.assign(keep_bits ? size : 0, 0);
+    const auto needs_reverse = [&](std::uint32_t i, std::size_t t) {
+      return keep_bits ? ((one_way_[i - lo] >> t) & 1) != 0 : one_way(i, t);
+    };
     for (std::uint32_t i = lo; i < lo + size; ++i) {
-      const auto row = cloud.row(i);
       std::uint32_t bits = 0;
       for (std::size_t t = 0; t < graph_k; ++t) {
-        const std::uint32_t j = row[t];
-        if (j - lo < size && j != i && !lists(j, i)) {
+        if (one_way(i, t)) {
           bits |= std::uint32_t{1} << (t & 31);
-          ++begin_[j - lo + 1];
+          ++begin_[cloud.row(i)[t] - lo + 1];
         }
       }
       if (keep_bits) one_way_[i - lo] = bits;
@@ -283,7 +286,7 @@ void orient_normals_ordered(const OrderedCloud& cloud, std::uint32_t graph_k,
     const auto size = static_cast<std::uint32_t>(std::min(kPiece, n - lo));
     std::vector<Node> nodes(size);  // indexed from lo
     PieceReverseEdges reverse;
-    if (m > 0) reverse.build(cloud, m, lo, size);
+    reverse.build(cloud, m, lo, size);
     FrontierHeap heap(nodes);
     const auto relax = [&](std::uint32_t u, std::uint32_t v) {
       const std::uint32_t local = v - lo;
@@ -315,9 +318,7 @@ void orient_normals_ordered(const OrderedCloud& cloud, std::uint32_t graph_k,
         component[u] = id;
         sum += double(dot(normals[u], p[u] - c));
         for (const std::uint32_t v : cloud.row(u).first(m)) relax(u, v);
-        if (m > 0) {
-          for (const std::uint32_t v : reverse.of(u)) relax(u, v);
-        }
+        for (const std::uint32_t v : reverse.of(u)) relax(u, v);
       }
       vote.push_back(sum);
     }

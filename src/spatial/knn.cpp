@@ -225,8 +225,7 @@ void grid_queries(const CellGrid& g, std::size_t cell_begin, std::size_t cell_en
     // Gather the block: the cell itself first (its points are the likeliest neighbours).
     std::array<std::uint32_t, 27> block;
     std::size_t block_cells = 0;
-    const auto gather = [&](std::size_t cell) { block[block_cells++] = std::uint32_t(cell); };
-    gather(c);
+    block[block_cells++] = std::uint32_t(c);
     for (int dz = -1; dz <= 1; ++dz) {
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
@@ -238,7 +237,7 @@ void grid_queries(const CellGrid& g, std::size_t cell_begin, std::size_t cell_en
           }
           const std::uint32_t found = g.find(
               morton_code(std::uint32_t(b[0]), std::uint32_t(b[1]), std::uint32_t(b[2])));
-          if (found) gather(found - 1);
+          if (found) block[block_cells++] = found - 1;
         }
       }
     }
