@@ -98,69 +98,42 @@ class FrontierHeap {
 };
 
 // The k-neighbour graph is directed (j near i does not make i near j). Prim's algorithm inside
-// a piece needs the symmetric graph of the piece: the reverse edges j -> i that the forward rows
-// lack, for i and j both in the piece, in CSR form. Built per piece, in cache, while its tree
-// grows; a list holds its i in increasing order (the tree does not depend on it anyway, see
-// FrontierHeap).
-class PieceReverseEdges {
+// a piece needs the symmetric graph of the piece: besides j's own row, every i of the piece whose
+// row lists j, in CSR form, built per piece, in cache, while its tree grows. Where i and j list
+// each other, the edge is relaxed twice from the same end with the same weight; only a strictly
+// lighter key replaces a node's, so the second changes nothing and the lists need not leave those
+// out (finding them cost more than relaxing them again). A list holds its i in increasing order
+// (the tree does not depend on it anyway, see FrontierHeap).
+class PieceInEdges {
  public:
   // Rebuilds the lists for the points [lo, lo + size) (all empty for graph_k = 0).
   void build(const OrderedCloud& cloud, std::size_t graph_k, std::uint32_t lo,
              std::uint32_t size) {
-    const std::span<const Vec3f> p = cloud.positions;
     lo_ = lo;
     begin_.assign(std::size_t{size} + 1, 0);
     from_.clear();
     if (graph_k == 0) return;
-    // Row j holds every point strictly closer to j than its last entry and none farther, so
-    // comparing distances answers "does row j list i" without searching, except near equality
-    // (ties, or rounding different from the kd-tree's).
-    last_d2_.resize(size);
-    for (std::uint32_t j = 0; j < size; ++j) {
-      last_d2_[j] = length_squared(p[cloud.row(lo + j)[graph_k - 1]] - p[lo + j]);
-    }
-    const auto lists = [&](std::uint32_t j, std::uint32_t i) {
-      const float d2 = length_squared(p[i] - p[j]);
-      const float last = last_d2_[j - lo];
-      if (d2 < last * (1.0f - 1e-5f)) return true;
-      if (d2 > last * (1.0f + 1e-5f)) return false;
-      const auto row = cloud.row(j).first(graph_k);
-      return std::find(row.begin(), row.end(), i) != row.end();
-    };
-    // The edge i -> row(i)[t] needs its reverse: its end is in the piece and does not list i.
-    const auto one_way = [&](std::uint32_t i, std::size_t t) {
+    const auto in_piece = [&](std::uint32_t i, std::size_t t) {
       const std::uint32_t j = cloud.row(i)[t];
-      return j - lo < size && j != i && !lists(j, i);
-    };
-    // Bit t of one_way_[i - lo]: one_way(i, t), found once and kept for the fill pass (graphs of
-    // more than 32 neighbours ask again).
-    const bool keep_bits = graph_k <= 32;
-    one_way_.assign(keep_bits ? size : 0, 0);
-    const auto needs_reverse = [&](std::uint32_t i, std::size_t t) {
-      return keep_bits ? ((one_way_[i - lo] >> t) & 1) != 0 : one_way(i, t);
+      return j - lo < size && j != i;
     };
     for (std::uint32_t i = lo; i < lo + size; ++i) {
-      std::uint32_t bits = 0;
       for (std::size_t t = 0; t < graph_k; ++t) {
-        if (one_way(i, t)) {
-          bits |= std::uint32_t{1} << (t & 31);
-          ++begin_[cloud.row(i)[t] - lo + 1];
-        }
+        if (in_piece(i, t)) ++begin_[cloud.row(i)[t] - lo + 1];
       }
-      if (keep_bits) one_way_[i - lo] = bits;
     }
     for (std::uint32_t j = 0; j < size; ++j) begin_[j + 1] += begin_[j];
     from_.resize(begin_[size]);
     // Fill with begin_[j] as the cursor; afterwards begin_[j] holds the old begin_[j + 1].
     for (std::uint32_t i = lo; i < lo + size; ++i) {
       for (std::size_t t = 0; t < graph_k; ++t) {
-        if (needs_reverse(i, t)) from_[begin_[cloud.row(i)[t] - lo]++] = i;
+        if (in_piece(i, t)) from_[begin_[cloud.row(i)[t] - lo]++] = i;
       }
     }
     for (std::uint32_t j = size; j > 0; --j) begin_[j] = begin_[j - 1];
     begin_[0] = 0;
   }
-  // The points i of the piece whose rows list the piece's point j but j's row does not list.
+  // The points i of the piece whose rows list the piece's point j.
   std::span<const std::uint32_t> of(std::uint32_t j) const {
     return std::span<const std::uint32_t>(from_).subspan(begin_[j - lo_],
                                                          begin_[j - lo_ + 1] - begin_[j - lo_]);
@@ -168,8 +141,6 @@ class PieceReverseEdges {
 
  private:
   std::uint32_t lo_ = 0;
-  std::vector<float> last_d2_;
-  std::vector<std::uint32_t> one_way_;
   std::vector<std::uint32_t> begin_;  // size + 1 offsets into from_
   std::vector<std::uint32_t> from_;
 };
@@ -285,8 +256,8 @@ void orient_normals_ordered(const OrderedCloud& cloud, std::uint32_t graph_k,
     const auto lo = static_cast<std::uint32_t>(piece * kPiece);
     const auto size = static_cast<std::uint32_t>(std::min(kPiece, n - lo));
     std::vector<Node> nodes(size);  // indexed from lo
-    PieceReverseEdges reverse;
-    reverse.build(cloud, m, lo, size);
+    PieceInEdges in_edges;
+    in_edges.build(cloud, m, lo, size);
     FrontierHeap heap(nodes);
     const auto relax = [&](std::uint32_t u, std::uint32_t v) {
       const std::uint32_t local = v - lo;
@@ -318,7 +289,7 @@ void orient_normals_ordered(const OrderedCloud& cloud, std::uint32_t graph_k,
         component[u] = id;
         sum += double(dot(normals[u], p[u] - c));
         for (const std::uint32_t v : cloud.row(u).first(m)) relax(u, v);
-        for (const std::uint32_t v : reverse.of(u)) relax(u, v);
+        for (const std::uint32_t v : in_edges.of(u)) relax(u, v);
       }
       vote.push_back(sum);
     }
