@@ -34,14 +34,23 @@ struct ChunkPlan {
   std::size_t chunk_count() const { return counts.size(); }
   // The chunk of a point.
   std::uint32_t chunk_of(const Vec3f& p, std::uint64_t index) const {
-    std::size_t j = 0;
-    for (std::uint32_t l = 0; l < levels; ++l) {
+    return static_cast<std::uint32_t>(node_below(p, index, levels) - splits.size());
+  }
+  // The heap index of the range that the point (p, index) lies in `depth` levels of splits
+  // below the range `from` (the root: 0), which holds it. Without branches on the data: the
+  // sides are a coin toss for the branch predictor, and every point of a chunked conversion
+  // comes this way.
+  std::size_t node_below(const Vec3f& p, std::uint64_t index, std::uint32_t depth,
+                         std::size_t from = 0) const {
+    const float q[3] = {p.x + 0.0f, p.y + 0.0f, p.z + 0.0f};
+    std::size_t j = from;
+    for (std::uint32_t l = 0; l < depth; ++l) {
       const Split& s = splits[j];
-      const float c = p[s.axis] + 0.0f;
-      const bool left = c < s.value || (c == s.value && index < s.index);
-      j = 2 * j + (left ? 1 : 2);
+      const float c = q[s.axis];
+      const bool left = (c < s.value) | ((c == s.value) & (index < s.index));
+      j = 2 * j + 2 - std::size_t{left};
     }
-    return static_cast<std::uint32_t>(j - (splits.size()));
+    return j;
   }
   // Calls fn(chunk) for every chunk other than `own` whose box is nearer than `reach[chunk]`
   // to `p` (a halo point for it); `max_reach` bounds every reach.
@@ -98,6 +107,9 @@ struct DiskPlanMemory {
   // this holds are counted in further passes over the file (at least one range a pass).
   std::size_t histogram_bytes = std::size_t{1} << 30;
   std::size_t window_points = std::size_t{1} << 21;  // positions read at a time (12 bytes each)
+  // Each point's range between passes (a byte a point up to 512 chunks, two up to 2^17), when
+  // this holds them; else each pass finds the ranges again from the splits.
+  std::size_t range_id_bytes = std::size_t{1} << 30;
 };
 
 // The plan of plan_chunks without the positions in memory: `path` holds the `n` positions

@@ -79,6 +79,35 @@ class PositionFile {
   std::FILE* f_;
 };
 
+// Each point's range within the level being split (below 2^(levels - 1)), in one byte up to 9
+// levels and two up to 17; none kept (kept() false) beyond, or when n of them would take more
+// than `bytes`.
+class RangeIds {
+ public:
+  RangeIds(std::uint64_t n, std::uint32_t levels, std::size_t bytes)
+      : wide_(levels > 9) {
+    const std::uint64_t width = wide_ ? 2 : 1;
+    if (levels <= 17 && n * width <= bytes) ids_.resize(static_cast<std::size_t>(n * width), 0);
+  }
+  bool kept() const { return !ids_.empty(); }
+  std::size_t get(std::uint64_t i) const {
+    if (!wide_) return ids_[i];
+    return ids_[2 * i] | std::size_t{ids_[2 * i + 1]} << 8;
+  }
+  void set(std::uint64_t i, std::size_t id) {
+    if (!wide_) {
+      ids_[i] = static_cast<std::uint8_t>(id);
+    } else {
+      ids_[2 * i] = static_cast<std::uint8_t>(id);
+      ids_[2 * i + 1] = static_cast<std::uint8_t>(id >> 8);
+    }
+  }
+
+ private:
+  bool wide_;
+  std::vector<std::uint8_t> ids_;
+};
+
 }  // namespace
 
 ChunkPlan plan_chunks_on_disk(const std::string& path, std::uint64_t n, const Aabb& box,
@@ -100,11 +129,16 @@ ChunkPlan plan_chunks_on_disk(const std::string& path, std::uint64_t n, const Aa
   const std::size_t counted_at_once =
       std::max<std::size_t>(memory.histogram_bytes / (threads * kBuckets * 4), 1);
 
+  // Each point's range in its level, kept between passes when it fits: the descent through the
+  // splits above, a chain of dependent loads, is most of a pass's time otherwise.
+  RangeIds range_of(n, levels, memory.range_id_bytes);
   std::vector<Aabb> boxes{box};
   std::vector<std::uint64_t> counts{n};
   for (std::uint32_t level = 0; level < levels; ++level) {
     const std::size_t ranges = boxes.size();
     const std::size_t first = ranges - 1;  // heap index of the level's first range
+    // The level's first pass moves each point's range down from the level above.
+    bool ranges_known = level == 0;
     std::vector<Range> r(ranges);
     for (std::size_t j = 0; j < ranges; ++j) {
       r[j].axis = boxes[j].longest_axis();
@@ -144,16 +178,19 @@ ChunkPlan plan_chunks_on_disk(const std::string& path, std::uint64_t n, const Aa
           for (std::size_t i = b; i < e; ++i) {
             const Vec3f& p = buffer[i];
             const std::uint64_t index = at + i;
-            std::size_t j = 0;
-            for (std::uint32_t l = 0; l < level; ++l) {
-              const Split& s = plan.splits[j];
-              const float c = p[s.axis] + 0.0f;
-              j = 2 * j + ((c < s.value || (c == s.value && index < s.index)) ? 1 : 2);
+            std::size_t j;
+            if (!range_of.kept()) {
+              j = plan.node_below(p, index, level) - first;
+            } else if (ranges_known) {
+              j = range_of.get(index);
+            } else {
+              j = plan.node_below(p, index, 1, (first - 1) / 2 + range_of.get(index)) - first;
+              range_of.set(index, j);
             }
-            j -= first;
             if (!in_pass[j]) continue;
             const Range& range = r[j];
-            const std::uint32_t key = ordered(p[range.axis]);
+            const float q[3] = {p.x, p.y, p.z};  // indexed without branches on the axis
+            const std::uint32_t key = ordered(q[range.axis]);
             int side = -1;  // -1: shares the chosen digits
             for (int d = 0; d < range.depth && side < 0; ++d) {
               const std::uint32_t x = digit(key, index, d);
@@ -170,6 +207,7 @@ ChunkPlan plan_chunks_on_disk(const std::string& path, std::uint64_t n, const Aa
         });
         at += count;
       }
+      ranges_known = true;
       // Merge, then choose a digit or select the split for each open range.
       for (std::size_t j = 0; j < ranges; ++j) {
         if (!in_pass[j]) continue;

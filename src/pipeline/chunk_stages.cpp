@@ -153,11 +153,13 @@ void scan_plan_distribute(MergedInputs& in, const WorkFolder& folder, const Conv
       const std::string path = folder.file(ChunkFiles::name("positions", 0));
       // A quarter of the budget for the selections' candidates (32 bytes each), an eighth for
       // the digit counts (256 KiB a range and thread: 1 B points in 4,096 chunks would count
-      // 2 GB at once), a sixteenth for the reads.
+      // 2 GB at once), a sixteenth for the reads, an eighth for the points' ranges (a byte
+      // each up to 512 chunks, else two: 100 M points under 1G, 1 B under 16G).
       const DiskPlanMemory memory{
           .max_candidates = std::max<std::uint64_t>(budget / 4 / 32, 1024),
           .histogram_bytes = budget / 8,
-          .window_points = std::clamp<std::uint64_t>(budget / 16 / sizeof(Vec3f), 1 << 16, 1 << 21)};
+          .window_points = std::clamp<std::uint64_t>(budget / 16 / sizeof(Vec3f), 1 << 16, 1 << 21),
+          .range_id_bytes = budget / 8};
       sh.plan = plan_chunks_on_disk(path, n, box, levels, memory, pool, progress);
       std::filesystem::remove(path);
     } else {

@@ -117,11 +117,15 @@ TEST(ChunkPlan, OnDiskPlanIsTheSamePlanWhateverItsMemory) {
         // that end inside ranges), with many candidates and with few.
         {.max_candidates = 1 << 20, .histogram_bytes = 1, .window_points = 97},
         {.max_candidates = 50, .histogram_bytes = 1, .window_points = 97},
-        {.max_candidates = 50, .histogram_bytes = 3 * range_counts, .window_points = 97}};
+        {.max_candidates = 50, .histogram_bytes = 3 * range_counts, .window_points = 97},
+        // Each pass finding the points' ranges from the splits (no room to keep them).
+        {.max_candidates = 400, .range_id_bytes = 0},
+        {.max_candidates = 50, .histogram_bytes = 1, .window_points = 97, .range_id_bytes = 0}};
     for (const DiskPlanMemory& m : memories) {
       SCOPED_TRACE(::testing::Message() << threads << " threads, " << m.max_candidates
                                         << " candidates, counts of " << m.histogram_bytes
-                                        << " bytes, reads of " << m.window_points);
+                                        << " bytes, reads of " << m.window_points
+                                        << ", range ids of " << m.range_id_bytes << " bytes");
       expect_plan(plan_chunks_on_disk(path, p.size(), box, 4, m, pool, Progress::none()), o, p);
     }
   }
