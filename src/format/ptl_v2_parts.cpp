@@ -1,7 +1,11 @@
 // Writing a .ptl version 2 file in parts (see PtlV2PartWriter in ptl_v2.hpp): the top of the
 // hierarchy over the subtrees' roots lives in page 0; each subtree's pages follow, planned from
 // its shape alone, so the layout is known before any subtree is encoded.
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <optional>
@@ -68,14 +72,41 @@ struct PtlV2PartWriter::State {
   std::uint64_t node_count = 0, leaf_count = 0;
   std::uint32_t depth = 0;
   EncodeStats stats;
-  std::optional<AtomicFile> file;
+  std::optional<AtomicFile> file;  // the file's owner's
+  int join_fd = -1;                // a joining writer's: the owner's temporary file
+  std::string join_path;
   HeaderFields header;  // as finish_uncommitted wrote it
   bool finished = false;
+
+  // The file of a writer that owns it; a joining writer only writes subtrees.
+  AtomicFile& own_file() {
+    if (!file) {
+      throw Error("cannot finish " + path + " here: this process writes subtrees into the file "
+                  "of the process that owns it (MPI rank 0), which finishes it");
+    }
+    return *file;
+  }
+  void write_bytes(std::uint64_t offset, const void* data, std::size_t size) {
+    if (file) {
+      file->write_at(offset, data, size);
+      return;
+    }
+    const char* bytes = static_cast<const char*>(data);
+    while (size > 0) {
+      const ssize_t done = ::pwrite(join_fd, bytes, size, off_t(offset));
+      if (done < 0 && errno == EINTR) continue;
+      if (done <= 0) {
+        throw IoError(join_path + ": cannot write a subtree at byte " + std::to_string(offset) +
+                      " (" + std::strerror(errno) + "); check the free disk of the shared folder");
+      }
+      bytes += done, offset += std::uint64_t(done), size -= std::size_t(done);
+    }
+  }
 };
 
 PtlV2PartWriter::PtlV2PartWriter(const std::string& path,
                                  std::vector<PtlV2SubtreeSummary> subtrees, bool has_colors,
-                                 const PtlV2WriteOptions& options)
+                                 const PtlV2WriteOptions& options, const std::string& join)
     : state_(std::make_unique<State>()) {
   State& st = *state_;
   if (options.page_bytes < kMinPageBytes) {
@@ -174,10 +205,21 @@ PtlV2PartWriter::PtlV2PartWriter(const std::string& path,
   st.written.assign(count, 0);
   st.root_cone.assign(count, 0);
   st.subtree_stats.resize(count);
-  st.file.emplace(path);
+  if (join.empty()) {
+    st.file.emplace(path);
+    return;
+  }
+  st.join_path = join;
+  st.join_fd = ::open(join.c_str(), O_WRONLY | O_CLOEXEC);
+  if (st.join_fd < 0) {
+    throw IoError(join + ": cannot open the file being written (" + std::strerror(errno) +
+                  "); every rank needs the chunk folder beside the output, shared");
+  }
 }
 
-PtlV2PartWriter::~PtlV2PartWriter() = default;
+PtlV2PartWriter::~PtlV2PartWriter() {
+  if (state_ && state_->join_fd >= 0) ::close(state_->join_fd);
+}
 
 std::size_t PtlV2PartWriter::subtree_count() const { return state_->subtrees.size(); }
 
@@ -214,7 +256,7 @@ void PtlV2PartWriter::write_subtree(std::size_t k, const SphereTree& tree, Threa
       root_children.push_back(tree.nodes[r].child_count);
     }
     page_bytes(plan[p], root_spheres, root_children, enc.record, st.record_size, bytes);
-    st.file->write_at(st.table[st.first_page[k] + p].offset, bytes.data(), bytes.size());
+    st.write_bytes(st.table[st.first_page[k] + p].offset, bytes.data(), bytes.size());
   }
 }
 
@@ -222,16 +264,51 @@ PtlV2WriteReport PtlV2PartWriter::finish(const Aabb& bounds, const Sphere& view_
                                          const std::array<double, 3>& origin, Vec3f up,
                                          const std::string& metadata) {
   const PtlV2WriteReport report = finish_uncommitted(bounds, view_sphere, origin, up, metadata);
-  state_->file->commit();
+  state_->own_file().commit();
   return report;
 }
 
-const std::string& PtlV2PartWriter::temp_path() const { return state_->file->temp_path(); }
+const std::string& PtlV2PartWriter::temp_path() const {
+  return state_->file ? state_->file->temp_path() : state_->join_path;
+}
 
-void PtlV2PartWriter::sync() { state_->file->sync(); }
+void PtlV2PartWriter::sync() {
+  State& st = *state_;
+  if (st.file) {
+    st.file->sync();
+  } else if (::fdatasync(st.join_fd) != 0) {
+    throw IoError(st.join_path + ": cannot put the subtrees written on disk (" +
+                  std::strerror(errno) + "); check the shared folder");
+  }
+}
 
 void PtlV2PartWriter::write_at(std::uint64_t offset, const void* data, std::size_t size) {
-  state_->file->write_at(offset, data, size);
+  state_->own_file().write_at(offset, data, size);
+}
+
+// What the owner needs of a subtree another process wrote: its root's cone code and its
+// encoding's statistics, as bytes.
+std::vector<char> PtlV2PartWriter::written_part(std::size_t k) const {
+  const State& st = *state_;
+  if (!st.written.at(k)) {
+    throw Error("cannot pass on subtree " + std::to_string(k) + " of " + st.path +
+                ": it was not written here");
+  }
+  std::vector<char> part(sizeof(std::uint32_t) + sizeof(EncodeStats));
+  std::memcpy(part.data(), &st.root_cone[k], sizeof(std::uint32_t));
+  std::memcpy(part.data() + sizeof(std::uint32_t), &st.subtree_stats[k], sizeof(EncodeStats));
+  return part;
+}
+
+void PtlV2PartWriter::adopt_part(std::size_t k, std::span<const char> part) {
+  State& st = *state_;
+  if (k >= st.written.size() || part.size() != sizeof(std::uint32_t) + sizeof(EncodeStats)) {
+    throw Error("cannot write " + st.path + ": another process passed on a subtree out of range "
+                "or of the wrong size");
+  }
+  std::memcpy(&st.root_cone[k], part.data(), sizeof(std::uint32_t));
+  std::memcpy(&st.subtree_stats[k], part.data() + sizeof(std::uint32_t), sizeof(EncodeStats));
+  st.written[k] = 1;
 }
 
 void PtlV2PartWriter::commit_with_features(
@@ -246,10 +323,11 @@ void PtlV2PartWriter::commit_with_features(
   f.features_offset = f.metadata_offset + metadata.size();
   f.features_size = write_section(f.features_offset);
   if (f.features_size == 0) f.features_offset = 0;
-  st.file->write_at(f.metadata_offset, metadata.data(), metadata.size());
+  AtomicFile& file = st.own_file();
+  file.write_at(f.metadata_offset, metadata.data(), metadata.size());
   const std::vector<std::uint8_t> head = header_and_table(f, st.table);
-  st.file->write_at(0, head.data(), head.size());
-  st.file->commit();
+  file.write_at(0, head.data(), head.size());
+  file.commit();
 }
 
 PtlV2WriteReport PtlV2PartWriter::finish_uncommitted(const Aabb& bounds,
@@ -257,6 +335,7 @@ PtlV2WriteReport PtlV2PartWriter::finish_uncommitted(const Aabb& bounds,
                                                      const std::array<double, 3>& origin,
                                                      Vec3f up, const std::string& metadata) {
   State& st = *state_;
+  AtomicFile& file = st.own_file();
   for (std::size_t k = 0; k < st.written.size(); ++k) {
     if (!st.written[k]) {
       throw Error("cannot write " + st.path + ": subtree " + std::to_string(k) +
@@ -296,7 +375,7 @@ PtlV2WriteReport PtlV2PartWriter::finish_uncommitted(const Aabb& bounds,
   f.origin = origin;
   f.up = up;
   const std::vector<std::uint8_t> head = header_and_table(f, st.table);
-  st.file->write_at(0, head.data(), head.size());
+  file.write_at(0, head.data(), head.size());
   PagePlan top_page;
   top_page.byte_size = st.table[0].byte_size;
   top_page.nodes.resize(st.top.nodes.size());
@@ -305,8 +384,8 @@ PtlV2WriteReport PtlV2PartWriter::finish_uncommitted(const Aabb& bounds,
   const Sphere header_root = st.top_codes.root_parent;
   const std::uint8_t one = 1;
   page_bytes(top_page, {&header_root, 1}, {&one, 1}, st.top_codes.record, st.record_size, bytes);
-  st.file->write_at(st.table[0].offset, bytes.data(), bytes.size());
-  st.file->write_at(st.metadata_offset, metadata.data(), metadata.size());
+  file.write_at(st.table[0].offset, bytes.data(), bytes.size());
+  file.write_at(st.metadata_offset, metadata.data(), metadata.size());
   st.header = f;
   st.finished = true;
 

@@ -343,9 +343,9 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
     });
   });
   {
-    // Rank 0 learns every subtree's summary and box.
-    MessageWriter w;
-    for (const std::size_t c : mine) {
+    // Every rank learns every subtree's summary and box: rank 0 gathers them, then gives them
+    // to all, which lay out the file alike.
+    const auto put = [&](MessageWriter& w, std::size_t c) {
       const PtlV2SubtreeSummary& t = summaries[c];
       w.put(std::uint64_t(c));
       w.put(boxes[c]);
@@ -354,42 +354,72 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
       w.put(t.leaf_count);
       w.put(t.depth);
       w.put_vector(t.pages);
-    }
+    };
+    const auto get = [&](MessageReader& m) {
+      const auto c = std::size_t(m.get<std::uint64_t>());
+      if (c >= chunks) throw Error("chunked conversion: a rank sent a chunk out of range");
+      PtlV2SubtreeSummary& t = summaries[c];
+      boxes[c] = m.get<Aabb>();
+      t.root = m.get<SphereNode>();
+      t.node_count = m.get<std::uint64_t>();
+      t.leaf_count = m.get<std::uint64_t>();
+      t.depth = m.get<std::uint32_t>();
+      t.pages = m.get_vector<PtlV2PageInfo>();
+    };
+    MessageWriter w;
+    for (const std::size_t c : mine) put(w, c);
     const std::vector<std::vector<char>> all = jobs.gather(w.bytes());
     step(jobs, [&] {
       for (std::size_t r = 1; r < all.size(); ++r) {
         MessageReader m(all[r]);
-        while (!m.done()) {
-          const auto c = std::size_t(m.get<std::uint64_t>());
-          if (c >= chunks) throw Error("chunked conversion: a rank sent a chunk out of range");
-          PtlV2SubtreeSummary& t = summaries[c];
-          boxes[c] = m.get<Aabb>();
-          t.root = m.get<SphereNode>();
-          t.node_count = m.get<std::uint64_t>();
-          t.leaf_count = m.get<std::uint64_t>();
-          t.depth = m.get<std::uint32_t>();
-          t.pages = m.get_vector<PtlV2PageInfo>();
-        }
+        while (!m.done()) get(m);
       }
     });
+    if (jobs.size() > 1) {
+      MessageWriter every;
+      if (root) {
+        for (std::size_t c = 0; c < chunks; ++c) put(every, c);
+      }
+      std::vector<char> bytes = every.bytes();
+      jobs.broadcast(bytes);
+      step(jobs, [&] {
+        MessageReader m(bytes);
+        while (!root && !m.done()) get(m);
+      });
+    }
   }
 
-  // 7. Write (rank 0); with --features, the file stays unrenamed for step 8.
+  // 7. Write: rank 0 lays out the file; every rank writes its own subtrees into it (the others
+  // through the shared folder) and passes on what rank 0 needs of them; rank 0 finishes it
+  // (with --features, leaving it unrenamed for step 8).
   std::optional<PtlV2PartWriter> writer;
   std::string metadata;
+  Aabb bounds;
+  for (const Aabb& b : boxes) bounds.extend(b);
+  const Vec3f centre = bounds.center();
+  std::vector<float> far2(chunks, 0.0f);
   step(jobs, [&] {
-    if (!root) return;
-    Aabb bounds;
-    for (const Aabb& b : boxes) bounds.extend(b);
-    ProgressPhase phase(progress, "write", n);
-    writer.emplace(output, summaries, colors, v2);
-    const Vec3f centre = bounds.center();
+    if (root) writer.emplace(output, summaries, colors, v2);
+  });
+  if (jobs.size() > 1) {
+    MessageWriter w;
+    if (root) {
+      const std::string& temp = writer->temp_path();
+      w.put_vector(std::vector<char>(temp.begin(), temp.end()));
+    }
+    std::vector<char> bytes = w.bytes();
+    jobs.broadcast(bytes);
+    step(jobs, [&] {
+      if (root) return;
+      const std::vector<char> temp = MessageReader(bytes).get_vector<char>();
+      writer.emplace(output, summaries, colors, v2, std::string(temp.begin(), temp.end()));
+    });
+  }
+  step(jobs, [&] {
+    ProgressPhase phase(progress, "write", my_points);
     // Subtrees are encoded and written in place a few at a time (as many as the chunks
     // prepared at once).
-    std::vector<float> far2(chunks, 0.0f);
-    std::vector<std::size_t> all(chunks);
-    for (std::size_t c = 0; c < chunks; ++c) all[c] = c;
-    for_each_chunk(all, pool, [&](std::size_t c, ThreadPool& chunk_pool) {
+    for_each_chunk(mine, pool, [&](std::size_t c, ThreadPool& chunk_pool) {
       const std::string path = folder->file(ChunkFiles::name("chunk", c) + ".splats");
       const Splats s = read_splats(path, summaries[c].leaf_count, colors, false, false);
       std::filesystem::remove(path);
@@ -401,6 +431,33 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
       writer->write_subtree(c, tree, chunk_pool);
       phase.advance(plan.counts[c]);
     });
+    if (!root) writer->sync();
+  });
+  {
+    MessageWriter w;
+    if (!root) {
+      for (const std::size_t c : mine) {
+        w.put(std::uint64_t(c));
+        w.put(far2[c]);
+        w.put_vector(writer->written_part(c));
+      }
+    }
+    const std::vector<std::vector<char>> all = jobs.gather(w.bytes());
+    step(jobs, [&] {
+      for (std::size_t r = 1; r < all.size(); ++r) {
+        MessageReader m(all[r]);
+        while (!m.done()) {
+          const auto c = std::size_t(m.get<std::uint64_t>());
+          if (c >= chunks) throw Error("chunked conversion: a rank sent a chunk out of range");
+          far2[c] = m.get<float>();
+          const std::vector<char> part = m.get_vector<char>();
+          writer->adopt_part(c, part);
+        }
+      }
+    });
+  }
+  step(jobs, [&] {
+    if (!root) return;
     const float view_radius = std::sqrt(*std::max_element(far2.begin(), far2.end()));
     std::ostringstream meta;
     meta << metadata_head;

@@ -191,5 +191,46 @@ TEST(PtlV2Parts, RefusesAWrongSubtreeAndAnUnfinishedFile) {
   }
 }
 
+// What an MPI job does: a second writer joins the owner's temporary file and writes half of the
+// subtrees; the owner adopts what it needs of them and finishes. The file is the one a single
+// writer makes.
+TEST(PtlV2Parts, AJoiningWriterWritesSubtreesIntoTheOwnersFile) {
+  TempDir dir;
+  ThreadPool pool(2);
+  const PointSet points = testing::sphere_points(6000, 4);
+  const PtlV2WriteOptions o{.page_bytes = 2048};
+  const std::string whole = write_in_parts(dir, points, o).path;
+  std::vector<SphereTree> trees;
+  std::vector<PtlV2SubtreeSummary> summaries;
+  for (int octant = 0; octant < 8; ++octant) {
+    trees.push_back(build_sphere_tree(octant_points(points, octant), pool));
+    summaries.push_back(summarize_ptl_v2_subtree(trees.back(), o));
+  }
+  PointSet lone;
+  lone.positions = {{3, 3, 3}};
+  lone.normals = {{0, 0, 1}};
+  lone.radii = {0.05f};
+  trees.push_back(build_sphere_tree(lone, pool));
+  summaries.push_back(summarize_ptl_v2_subtree(trees.back(), o));
+  const std::string path = dir.file("joined.ptl");
+  PtlV2PartWriter owner(path, summaries, false, o);
+  {
+    PtlV2PartWriter joiner(path, summaries, false, o, owner.temp_path());
+    for (std::size_t k = 1; k < trees.size(); k += 2) joiner.write_subtree(k, trees[k], pool);
+    joiner.sync();
+    EXPECT_THROW(joiner.written_part(0), Error);  // not written there
+    EXPECT_THROW(joiner.finish({}, {}, {}, {0, 1, 0}, ""), Error);  // the owner's to finish
+    for (std::size_t k = 1; k < trees.size(); k += 2) owner.adopt_part(k, joiner.written_part(k));
+  }
+  EXPECT_THROW(owner.adopt_part(0, std::vector<char>(3)), Error);  // wrong size
+  for (std::size_t k = 0; k < trees.size(); k += 2) owner.write_subtree(k, trees[k], pool);
+  Aabb box = bounding_box(points.positions);
+  box.lo = min(box.lo, Vec3f{3, 3, 3});
+  box.hi = max(box.hi, Vec3f{3, 3, 3});
+  owner.finish(box, {box.center(), length(box.hi - box.center())}, {}, {0, 1, 0}, "parts\n");
+  EXPECT_TRUE(format_test::read_bytes(path) == format_test::read_bytes(whole))
+      << "the joined file differs from the one a single writer makes";
+}
+
 }  // namespace
 }  // namespace pointillist

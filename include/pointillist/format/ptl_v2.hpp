@@ -144,8 +144,13 @@ class PtlV2PartWriter {
   // Lays out `path` (written to a temporary file beside it) for the summarized subtrees. Throws
   // Error for no subtrees, more than 2^20 or more than 2^32 - 2 nodes; OptionError for
   // page_bytes < 1024 or features (not written in parts); IoError naming the file.
+  // With `join`, the temporary file of the writer that owns the output (its temp_path(), in
+  // another process, e.g. MPI rank 0, over the same subtrees and options): this writer only
+  // writes subtrees into it (write_subtree, sync, written_part); the owner adopts what it needs
+  // of them (adopt_part) and finishes the file.
   PtlV2PartWriter(const std::string& path, std::vector<PtlV2SubtreeSummary> subtrees,
-                  bool has_colors, const PtlV2WriteOptions& options = {});
+                  bool has_colors, const PtlV2WriteOptions& options = {},
+                  const std::string& join = {});
   ~PtlV2PartWriter();
   PtlV2PartWriter(const PtlV2PartWriter&) = delete;
   PtlV2PartWriter& operator=(const PtlV2PartWriter&) = delete;
@@ -154,6 +159,12 @@ class PtlV2PartWriter {
   // Encodes and writes subtree `k`, which must be the tree summarized as subtree k (checked: its
   // root and node count). Throws Error when it is not, IoError when writing fails.
   void write_subtree(std::size_t k, const SphereTree& tree, ThreadPool& pool);
+  // What the owner needs of subtree k once this writer wrote it (its root's cone code and its
+  // encoding's statistics), as bytes for adopt_part. Throws Error when k was not written here.
+  std::vector<char> written_part(std::size_t k) const;
+  // Subtree k as written by a joining writer, from its written_part. Throws Error for a k out
+  // of range or bytes of the wrong size.
+  void adopt_part(std::size_t k, std::span<const char> part);
   // Writes the rest and renames the file into place. `bounds` and `view_sphere` are those of all
   // the leaves; origin and up the model's frame. Throws Error when a subtree was not written,
   // IoError when writing fails.
@@ -170,7 +181,7 @@ class PtlV2PartWriter {
                                       const std::array<double, 3>& origin, Vec3f up,
                                       const std::string& metadata);
   const std::string& temp_path() const;
-  void sync();  // for other processes reading temp_path() (AtomicFile::sync)
+  void sync();  // for other processes reading temp_path() (AtomicFile::sync; a joiner's too)
   void write_at(std::uint64_t offset, const void* data, std::size_t size);
   void commit_with_features(const std::string& metadata,
                             const std::function<std::uint64_t(std::uint64_t)>& write_section);
