@@ -157,16 +157,24 @@ void AtomicFile::write(const void* data, std::size_t size) {
   used_ += size;
 }
 
-void AtomicFile::write_at(std::uint64_t offset, const void* data, std::size_t size) {
-  if (used_ > 0) flush();
+bool write_all_at(int fd, std::uint64_t offset, const void* data, std::size_t size) {
   const char* bytes = static_cast<const char*>(data);
   while (size > 0) {
-    const ssize_t n = ::pwrite(fd_, bytes, size, static_cast<off_t>(offset));
+    const ssize_t n = ::pwrite(fd, bytes, size, static_cast<off_t>(offset));
     if (n < 0 && errno == EINTR) continue;
-    if (n < 0) throw IoError(errno_message("cannot write " + path_ + " (its temporary file " + temp_path_ + ")"));
+    if (n == 0) errno = ENOSPC;
+    if (n <= 0) return false;
     bytes += n;
     offset += static_cast<std::uint64_t>(n);
     size -= static_cast<std::size_t>(n);
+  }
+  return true;
+}
+
+void AtomicFile::write_at(std::uint64_t offset, const void* data, std::size_t size) {
+  if (used_ > 0) flush();
+  if (!write_all_at(fd_, offset, data, size)) {
+    throw IoError(errno_message("cannot write " + path_ + " (its temporary file " + temp_path_ + ")"));
   }
 }
 

@@ -5,7 +5,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <optional>
@@ -91,15 +90,10 @@ struct PtlV2PartWriter::State {
       file->write_at(offset, data, size);
       return;
     }
-    const char* bytes = static_cast<const char*>(data);
-    while (size > 0) {
-      const ssize_t done = ::pwrite(join_fd, bytes, size, off_t(offset));
-      if (done < 0 && errno == EINTR) continue;
-      if (done <= 0) {
-        throw IoError(join_path + ": cannot write a subtree at byte " + std::to_string(offset) +
-                      " (" + std::strerror(errno) + "); check the free disk of the shared folder");
-      }
-      bytes += done, offset += std::uint64_t(done), size -= std::size_t(done);
+    if (!write_all_at(join_fd, offset, data, size)) {
+      throw IoError(errno_message(join_path + ": cannot write a subtree at byte " +
+                                  std::to_string(offset)) +
+                    "; check the free disk of the output's folder");
     }
   }
 };
@@ -212,8 +206,8 @@ PtlV2PartWriter::PtlV2PartWriter(const std::string& path,
   st.join_path = join;
   st.join_fd = ::open(join.c_str(), O_WRONLY | O_CLOEXEC);
   if (st.join_fd < 0) {
-    throw IoError(join + ": cannot open the file being written (" + std::strerror(errno) +
-                  "); every rank needs the chunk folder beside the output, shared");
+    throw IoError(errno_message(join + ": cannot open the file being written") +
+                  "; every rank needs the output's folder, shared (NFS, Lustre, ...)");
   }
 }
 
@@ -277,8 +271,8 @@ void PtlV2PartWriter::sync() {
   if (st.file) {
     st.file->sync();
   } else if (::fdatasync(st.join_fd) != 0) {
-    throw IoError(st.join_path + ": cannot put the subtrees written on disk (" +
-                  std::strerror(errno) + "); check the shared folder");
+    throw IoError(errno_message(st.join_path + ": cannot put the subtrees written on disk") +
+                  "; check the output's folder");
   }
 }
 
@@ -290,9 +284,10 @@ void PtlV2PartWriter::write_at(std::uint64_t offset, const void* data, std::size
 // encoding's statistics, as bytes.
 std::vector<char> PtlV2PartWriter::written_part(std::size_t k) const {
   const State& st = *state_;
-  if (!st.written.at(k)) {
+  if (k >= st.written.size() || !st.written[k]) {
     throw Error("cannot pass on subtree " + std::to_string(k) + " of " + st.path +
-                ": it was not written here");
+                ": it was not written by this process (" + std::to_string(st.written.size()) +
+                " subtrees)");
   }
   std::vector<char> part(sizeof(std::uint32_t) + sizeof(EncodeStats));
   std::memcpy(part.data(), &st.root_cone[k], sizeof(std::uint32_t));
@@ -302,9 +297,12 @@ std::vector<char> PtlV2PartWriter::written_part(std::size_t k) const {
 
 void PtlV2PartWriter::adopt_part(std::size_t k, std::span<const char> part) {
   State& st = *state_;
-  if (k >= st.written.size() || part.size() != sizeof(std::uint32_t) + sizeof(EncodeStats)) {
-    throw Error("cannot write " + st.path + ": another process passed on a subtree out of range "
-                "or of the wrong size");
+  const std::size_t expected = sizeof(std::uint32_t) + sizeof(EncodeStats);
+  if (k >= st.written.size() || part.size() != expected) {
+    throw Error("cannot write " + st.path + ": another process passed on subtree " +
+                std::to_string(k) + " of " + std::to_string(st.written.size()) + " in " +
+                std::to_string(part.size()) + " bytes, where " + std::to_string(expected) +
+                " were expected; every rank must run the same pointillist build");
   }
   std::memcpy(&st.root_cone[k], part.data(), sizeof(std::uint32_t));
   std::memcpy(&st.subtree_stats[k], part.data() + sizeof(std::uint32_t), sizeof(EncodeStats));

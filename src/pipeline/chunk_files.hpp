@@ -40,6 +40,7 @@ class ChunkFiles {
   ChunkFiles(const WorkFolder& folder, std::size_t chunks, const char* kind,
              std::size_t buffer_bytes);
   static std::string name(const char* kind, std::size_t c);
+  // Threads may append at once to different chunks.
   void append(std::size_t c, const void* data, std::size_t size);
   void flush_all();
 

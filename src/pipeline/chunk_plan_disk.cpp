@@ -80,14 +80,14 @@ class PositionFile {
 };
 
 // Each point's range within the level being split (below 2^(levels - 1)), in one byte up to 9
-// levels and two up to 17; none kept (kept() false) beyond, or when n of them would take more
-// than `bytes`.
+// levels and two up to 17; none kept (kept() false) beyond, for one level (its range is the
+// root) or when n of them would take more than `bytes`.
 class RangeIds {
  public:
   RangeIds(std::uint64_t n, std::uint32_t levels, std::size_t bytes)
       : wide_(levels > 9) {
     const std::uint64_t width = wide_ ? 2 : 1;
-    if (levels <= 17 && n * width <= bytes) ids_.resize(static_cast<std::size_t>(n * width), 0);
+    if (levels >= 2 && levels <= 17 && n * width <= bytes) ids_.resize(static_cast<std::size_t>(n * width), 0);
   }
   bool kept() const { return !ids_.empty(); }
   std::size_t get(std::uint64_t i) const {

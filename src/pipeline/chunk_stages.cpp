@@ -191,7 +191,8 @@ void scan_plan_distribute(MergedInputs& in, const WorkFolder& folder, const Conv
   // On every thread, in two steps a slice of a batch at a time: each thread finds the chunks of
   // a part of the slice and encodes their records; then each appends the records of its own
   // chunks (c % threads), the parts in order, so that a chunk file holds its points in input
-  // order whatever the thread count. Staged, a slice takes about 1.6 MB.
+  // order whatever the thread count. A slice's records and their chunks (size + 4 bytes each,
+  // halo copies too) take about a 400th of the budget, at most 64 K points' (4-6 MB).
   ProgressPhase phase(progress, "distribute", n);
   const std::size_t threads = pool.thread_count(), size = sh.layout.size();
   struct Staged {
@@ -200,16 +201,17 @@ void scan_plan_distribute(MergedInputs& in, const WorkFolder& folder, const Conv
     std::uint64_t halo = 0;
   };
   std::vector<Staged> staged(threads);
-  constexpr std::size_t kSlice = 1 << 16;
+  const auto slice = static_cast<std::size_t>(
+      std::clamp<std::uint64_t>(budget / 512 / (size + 4), 4096, std::size_t{1} << 16));
   in.for_each_batch(progress, [&](const PointSet& b, std::uint64_t first) {
-    for (std::size_t lo = 0; lo < b.size(); lo += kSlice) {
-      const std::size_t count = std::min(kSlice, b.size() - lo);
+    for (std::size_t lo = 0; lo < b.size(); lo += slice) {
+      const std::size_t count = std::min(slice, b.size() - lo);
       pool.run(threads, [&](std::size_t t) {
         Staged& s = staged[t];
         s.chunk.clear();
         s.records.clear();
         const std::size_t begin = lo + count * t / threads, end = lo + count * (t + 1) / threads;
-        s.records.reserve(2 * (end - begin) * size);  // kept from slice to slice
+        s.records.reserve((end - begin) * size);  // kept from slice to slice
         const auto add = [&](std::uint32_t c) {  // the new record's offset
           s.chunk.push_back(c);
           s.records.resize(s.records.size() + size);

@@ -306,6 +306,16 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
     }
   }
 
+  // A chunk number in a rank's message.
+  const auto chunk_in = [&](MessageReader& m) {
+    const auto c = std::size_t(m.get<std::uint64_t>());
+    if (c >= chunks) {
+      throw Error("chunked conversion: a rank sent chunk " + std::to_string(c) + " of " +
+                  std::to_string(chunks) + "; every rank must run the same pointillist build");
+    }
+    return c;
+  };
+
   // 6. Each chunk's subtree and summary; its splats kept in split order.
   std::vector<PtlV2SubtreeSummary> summaries(chunks);
   std::vector<Aabb> boxes(chunks);
@@ -356,8 +366,7 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
       w.put_vector(t.pages);
     };
     const auto get = [&](MessageReader& m) {
-      const auto c = std::size_t(m.get<std::uint64_t>());
-      if (c >= chunks) throw Error("chunked conversion: a rank sent a chunk out of range");
+      const std::size_t c = chunk_in(m);
       PtlV2SubtreeSummary& t = summaries[c];
       boxes[c] = m.get<Aabb>();
       t.root = m.get<SphereNode>();
@@ -435,23 +444,22 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
   });
   {
     MessageWriter w;
-    if (!root) {
+    step(jobs, [&] {  // (a rank that failed here must still reach the gather)
+      if (root) return;
       for (const std::size_t c : mine) {
         w.put(std::uint64_t(c));
         w.put(far2[c]);
         w.put_vector(writer->written_part(c));
       }
-    }
+    });
     const std::vector<std::vector<char>> all = jobs.gather(w.bytes());
     step(jobs, [&] {
       for (std::size_t r = 1; r < all.size(); ++r) {
         MessageReader m(all[r]);
         while (!m.done()) {
-          const auto c = std::size_t(m.get<std::uint64_t>());
-          if (c >= chunks) throw Error("chunked conversion: a rank sent a chunk out of range");
+          const std::size_t c = chunk_in(m);
           far2[c] = m.get<float>();
-          const std::vector<char> part = m.get_vector<char>();
-          writer->adopt_part(c, part);
+          writer->adopt_part(c, m.get_vector<char>());
         }
       }
     });

@@ -18,6 +18,7 @@
 #include <optional>
 #include <vector>
 
+#include "pointillist/core/atomic_file.hpp"
 #include "pointillist/core/error.hpp"
 #include "pointillist/io/ply.hpp"
 #include "pointillist/io/point_stream.hpp"
@@ -50,15 +51,9 @@ class ScratchFile {
   ScratchFile& operator=(const ScratchFile&) = delete;
 
   void write(std::uint64_t offset, const void* data, std::size_t size) {
-    const char* p = static_cast<const char*>(data);
-    while (size > 0) {
-      const ssize_t n = ::pwrite(fd_, p, size, static_cast<off_t>(offset));
-      if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) {
-        throw IoError(path_ + ": cannot write the mesh's scratch file (is the disk full?); the "
-                              "output was not written and the input is untouched");
-      }
-      p += n, size -= std::size_t(n), offset += std::uint64_t(n);
+    if (!write_all_at(fd_, offset, data, size)) {
+      throw IoError(path_ + ": cannot write the mesh's scratch file (is the disk full?); the "
+                            "output was not written and the input is untouched");
     }
   }
   void read(std::uint64_t offset, void* data, std::size_t size) {

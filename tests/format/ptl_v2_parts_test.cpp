@@ -47,13 +47,17 @@ PointSet octant_points(const PointSet& all, int octant) {
 struct Written {
   std::string path;
   std::vector<PointSet> parts;
+  PtlV2WriteReport report;
 };
 
 // Writes `points` cut into octants (in octant order, so the top groups neighbours), plus one
-// subtree of a single point, through a PtlV2PartWriter.
-Written write_in_parts(const TempDir& dir, const PointSet& points, const PtlV2WriteOptions& o) {
+// subtree of a single point, through a PtlV2PartWriter, to `name` in `dir`. With `joined`, as
+// an MPI job does: a second writer joins the first's temporary file and writes the odd subtrees
+// and the single point's, and the first adopts what it needs of them.
+Written write_in_parts(const TempDir& dir, const PointSet& points, const PtlV2WriteOptions& o,
+                       bool joined = false, const std::string& name = "parts.ptl") {
   ThreadPool pool(2);
-  Written w{dir.file("parts.ptl"), {}};
+  Written w{dir.file(name), {}, {}};
   for (int octant = 0; octant < 8; ++octant) w.parts.push_back(octant_points(points, octant));
   PointSet lone;
   lone.positions = {{3, 3, 3}};
@@ -68,12 +72,29 @@ Written write_in_parts(const TempDir& dir, const PointSet& points, const PtlV2Wr
     summaries.push_back(summarize_ptl_v2_subtree(trees.back(), o));
   }
   PtlV2PartWriter writer(w.path, summaries, points.has_colors(), o);
+  const auto joiners = [&](std::size_t k) { return joined && (k % 2 == 1 || k == 8); };
+  if (joined) {
+    PtlV2PartWriter joiner(w.path, summaries, points.has_colors(), o, writer.temp_path());
+    for (std::size_t k = 0; k < trees.size(); ++k) {
+      if (joiners(k)) joiner.write_subtree(k, trees[k], pool);
+    }
+    joiner.sync();
+    EXPECT_THROW(joiner.written_part(0), Error);  // not written there
+    EXPECT_THROW(joiner.finish({}, {}, {}, {0, 1, 0}, ""), Error);  // the owner's to finish
+    for (std::size_t k = 0; k < trees.size(); ++k) {
+      if (joiners(k)) writer.adopt_part(k, joiner.written_part(k));
+    }
+    EXPECT_THROW(writer.adopt_part(0, std::vector<char>(3)), Error);  // wrong size
+  }
   // Any order.
-  for (std::size_t k = trees.size(); k-- > 0;) writer.write_subtree(k, trees[k], pool);
+  for (std::size_t k = trees.size(); k-- > 0;) {
+    if (!joiners(k)) writer.write_subtree(k, trees[k], pool);
+  }
   Aabb box = bounding_box(points.positions);
   box.lo = min(box.lo, Vec3f{3, 3, 3});
   box.hi = max(box.hi, Vec3f{3, 3, 3});
-  writer.finish(box, {box.center(), length(box.hi - box.center())}, {}, {0, 1, 0}, "parts\n");
+  w.report =
+      writer.finish(box, {box.center(), length(box.hi - box.center())}, {}, {0, 1, 0}, "parts\n");
   return w;
 }
 
@@ -191,45 +212,20 @@ TEST(PtlV2Parts, RefusesAWrongSubtreeAndAnUnfinishedFile) {
   }
 }
 
-// What an MPI job does: a second writer joins the owner's temporary file and writes half of the
-// subtrees; the owner adopts what it needs of them and finishes. The file is the one a single
-// writer makes.
+// What an MPI job does (write_in_parts, joined): the file and the report of a single writer.
 TEST(PtlV2Parts, AJoiningWriterWritesSubtreesIntoTheOwnersFile) {
   TempDir dir;
-  ThreadPool pool(2);
   const PointSet points = testing::sphere_points(6000, 4);
   const PtlV2WriteOptions o{.page_bytes = 2048};
-  const std::string whole = write_in_parts(dir, points, o).path;
-  std::vector<SphereTree> trees;
-  std::vector<PtlV2SubtreeSummary> summaries;
-  for (int octant = 0; octant < 8; ++octant) {
-    trees.push_back(build_sphere_tree(octant_points(points, octant), pool));
-    summaries.push_back(summarize_ptl_v2_subtree(trees.back(), o));
-  }
-  PointSet lone;
-  lone.positions = {{3, 3, 3}};
-  lone.normals = {{0, 0, 1}};
-  lone.radii = {0.05f};
-  trees.push_back(build_sphere_tree(lone, pool));
-  summaries.push_back(summarize_ptl_v2_subtree(trees.back(), o));
-  const std::string path = dir.file("joined.ptl");
-  PtlV2PartWriter owner(path, summaries, false, o);
-  {
-    PtlV2PartWriter joiner(path, summaries, false, o, owner.temp_path());
-    for (std::size_t k = 1; k < trees.size(); k += 2) joiner.write_subtree(k, trees[k], pool);
-    joiner.sync();
-    EXPECT_THROW(joiner.written_part(0), Error);  // not written there
-    EXPECT_THROW(joiner.finish({}, {}, {}, {0, 1, 0}, ""), Error);  // the owner's to finish
-    for (std::size_t k = 1; k < trees.size(); k += 2) owner.adopt_part(k, joiner.written_part(k));
-  }
-  EXPECT_THROW(owner.adopt_part(0, std::vector<char>(3)), Error);  // wrong size
-  for (std::size_t k = 0; k < trees.size(); k += 2) owner.write_subtree(k, trees[k], pool);
-  Aabb box = bounding_box(points.positions);
-  box.lo = min(box.lo, Vec3f{3, 3, 3});
-  box.hi = max(box.hi, Vec3f{3, 3, 3});
-  owner.finish(box, {box.center(), length(box.hi - box.center())}, {}, {0, 1, 0}, "parts\n");
-  EXPECT_TRUE(format_test::read_bytes(path) == format_test::read_bytes(whole))
+  const Written one = write_in_parts(dir, points, o);
+  const Written two = write_in_parts(dir, points, o, true, "joined.ptl");
+  EXPECT_TRUE(format_test::read_bytes(one.path) == format_test::read_bytes(two.path))
       << "the joined file differs from the one a single writer makes";
+  // The statistics travel with the subtrees (written_part, adopt_part).
+  EXPECT_EQ(two.report.parent_fallbacks, one.report.parent_fallbacks);
+  EXPECT_EQ(two.report.mean_leaf_radius_ratio, one.report.mean_leaf_radius_ratio);
+  for (int c = 0; c < 4; ++c) EXPECT_EQ(two.report.cone_codes[c], one.report.cone_codes[c]) << c;
+  EXPECT_GT(two.report.mean_leaf_radius_ratio, 1.0);
 }
 
 }  // namespace

@@ -131,6 +131,24 @@ TEST(ChunkPlan, OnDiskPlanIsTheSamePlanWhateverItsMemory) {
   }
 }
 
+// Ten levels (1,024 chunks): each point's range takes two bytes between passes.
+TEST(ChunkPlan, OnDiskPlanOfManyLevelsIsTheSamePlan) {
+  testing::TempDir dir;
+  const std::vector<Vec3f> p = tied_points(6001, 9);
+  const std::string path = write_positions(dir, p);
+  Aabb box;
+  for (const Vec3f& x : p) box.extend(x);
+  ThreadPool pool(2);
+  const Oracle o = brute_force(p, 10);
+  for (const std::size_t id_bytes : {std::size_t{1} << 20, std::size_t{0}}) {
+    SCOPED_TRACE(::testing::Message() << "range ids of " << id_bytes << " bytes");
+    expect_plan(plan_chunks_on_disk(path, p.size(), box, 10,
+                                    {.max_candidates = 400, .range_id_bytes = id_bytes}, pool,
+                                    Progress::none()),
+                o, p);
+  }
+}
+
 TEST(ChunkPlan, OnDiskPlanSaysWhenThePositionFileIsShort) {
   testing::TempDir dir;
   const std::vector<Vec3f> p = tied_points(1000, 7);

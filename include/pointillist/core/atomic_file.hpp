@@ -49,6 +49,11 @@ class AtomicFile {
   int slot_ = -1;  // in the registry the signal handler reads
 };
 
+// Writes all `size` bytes at byte `offset` of the open file `fd`, again after an interruption or
+// a short write. False when the system refuses (errno says why; ENOSPC for a write that makes
+// no progress).
+bool write_all_at(int fd, std::uint64_t offset, const void* data, std::size_t size);
+
 // Installs handlers for SIGINT, SIGTERM and SIGHUP that remove the temporary files of every live
 // AtomicFile, then let the signal end the process as it would have. Call once, early (main).
 void remove_temporary_files_on_signals();

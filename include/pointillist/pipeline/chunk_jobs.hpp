@@ -1,8 +1,9 @@
 // The processes that share a chunked conversion (see convert.hpp, ConvertOptions::jobs): this
 // process alone, or the ranks of an MPI job (`mpirun -n N pointillist convert ...`). Rank 0
-// reads the inputs, plans the chunks, writes the chunk files and, at the end, the output; every
-// rank prepares and builds the subtrees of the chunks c with c % size == rank. The ranks share the
-// chunk folder beside the output (on a cluster it must be on a file system every rank sees) and
+// reads the inputs, plans the chunks, writes the chunk files and lays out and finishes the
+// output; every rank prepares, builds and writes into the output the subtrees of the chunks c
+// with c % size == rank. The ranks share the output's folder, with the chunk folder and the
+// output's temporary file (on a cluster it must be on a file system every rank sees), and
 // exchange only small messages: the plan, orientation votes and flips, subtree summaries.
 #pragma once
 

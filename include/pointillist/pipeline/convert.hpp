@@ -42,8 +42,9 @@ struct ConvertOptions {
   std::uint64_t chunk_points = 0;
   // The processes sharing a chunked conversion (chunk_jobs.hpp): null for this process alone.
   // With more than one, a .ptl v2 output is always converted in chunks (the same file bytes as
-  // one process converting with the same options in chunks) and only rank 0 writes it; other
-  // outputs are converted by rank 0 alone.
+  // one process converting with the same options in chunks): rank 0 lays it out and finishes
+  // it, every rank writes its own chunks' subtrees into it; other outputs are converted by
+  // rank 0 alone.
   ChunkJobs* jobs = nullptr;
   // In one piece, touch most of the memory the conversion will need on every thread before
   // reading (prefault_heap, core/heap.hpp): for processes that keep freed memory (the CLI).
