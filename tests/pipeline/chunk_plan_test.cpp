@@ -10,6 +10,7 @@
 
 #include "chunk_plan.hpp"
 #include "pointillist/core/error.hpp"
+#include "pointillist/core/point_set.hpp"
 #include "testing/testing.hpp"
 
 namespace pointillist::chunking {
@@ -104,8 +105,7 @@ TEST(ChunkPlan, OnDiskPlanIsTheSamePlanWhateverItsMemory) {
   testing::TempDir dir;
   const std::vector<Vec3f> p = tied_points(6001, 5);
   const std::string path = write_positions(dir, p);
-  Aabb box;
-  for (const Vec3f& x : p) box.extend(x);
+  const Aabb box = bounding_box(p);
   const Oracle o = brute_force(p, 4);
   for (unsigned threads : {1u, 2u}) {
     ThreadPool pool(threads);
@@ -136,8 +136,7 @@ TEST(ChunkPlan, OnDiskPlanOfManyLevelsIsTheSamePlan) {
   testing::TempDir dir;
   const std::vector<Vec3f> p = tied_points(6001, 9);
   const std::string path = write_positions(dir, p);
-  Aabb box;
-  for (const Vec3f& x : p) box.extend(x);
+  const Aabb box = bounding_box(p);
   ThreadPool pool(2);
   const Oracle o = brute_force(p, 10);
   for (const std::size_t id_bytes : {std::size_t{1} << 20, std::size_t{0}}) {
@@ -153,8 +152,7 @@ TEST(ChunkPlan, OnDiskPlanSaysWhenThePositionFileIsShort) {
   testing::TempDir dir;
   const std::vector<Vec3f> p = tied_points(1000, 7);
   const std::string path = write_positions(dir, p);
-  Aabb box;
-  for (const Vec3f& x : p) box.extend(x);
+  const Aabb box = bounding_box(p);
   ThreadPool pool(1);
   try {
     plan_chunks_on_disk(path, 2000, box, 2, {.max_candidates = 100}, pool, Progress::none());
