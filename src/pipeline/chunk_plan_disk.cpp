@@ -87,7 +87,9 @@ class RangeIds {
   RangeIds(std::uint64_t n, std::uint32_t levels, std::size_t bytes)
       : wide_(levels > 9) {
     const std::uint64_t width = wide_ ? 2 : 1;
-    if (levels >= 2 && levels <= 17 && n * width <= bytes) ids_.resize(static_cast<std::size_t>(n * width), 0);
+    if (levels >= 2 && levels <= 17 && n * width <= bytes) {
+      ids_.resize(static_cast<std::size_t>(n * width), 0);
+    }
   }
   bool kept() const { return !ids_.empty(); }
   std::size_t get(std::uint64_t i) const {

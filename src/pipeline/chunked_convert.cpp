@@ -173,6 +173,15 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
   const RankChunks own_chunks = rank_chunks(jobs, plan);
   const std::vector<std::size_t>& mine = own_chunks.chunks;
   const std::uint64_t my_points = own_chunks.points;
+  // A chunk number in a rank's message.
+  const auto chunk_in = [&](MessageReader& m) {
+    const auto c = std::size_t(m.get<std::uint64_t>());
+    if (c >= chunks) {
+      throw Error("chunked conversion: a rank sent chunk " + std::to_string(c) + " of " +
+                  std::to_string(chunks) + "; every rank must run the same pointillist build");
+    }
+    return c;
+  };
 
   // 4. Prepare each chunk with its halo; keep its own splats, their input indices and
   // orientation pieces; tell each halo point's owner how this chunk oriented it.
@@ -245,8 +254,7 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
         MessageReader m(all[r]);
         if (m.get<bool>()) pieces = true;
         while (!m.done()) {
-          const auto c = std::size_t(m.get<std::uint64_t>());
-          if (c >= chunks) throw Error("chunked conversion: a rank sent a chunk out of range");
+          const std::size_t c = chunk_in(m);
           own_count[c] = m.get<std::uint64_t>();
           votes[c] = m.get_vector<double>();
         }
@@ -305,16 +313,6 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
       for (auto& f : flips) f = m.get_vector<std::uint8_t>();
     }
   }
-
-  // A chunk number in a rank's message.
-  const auto chunk_in = [&](MessageReader& m) {
-    const auto c = std::size_t(m.get<std::uint64_t>());
-    if (c >= chunks) {
-      throw Error("chunked conversion: a rank sent chunk " + std::to_string(c) + " of " +
-                  std::to_string(chunks) + "; every rank must run the same pointillist build");
-    }
-    return c;
-  };
 
   // 6. Each chunk's subtree and summary; its splats kept in split order.
   std::vector<PtlV2SubtreeSummary> summaries(chunks);
