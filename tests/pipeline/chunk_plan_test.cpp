@@ -95,6 +95,16 @@ std::string write_positions(const testing::TempDir& dir, const std::vector<Vec3f
   return path;
 }
 
+// tied_points(n, seed) in a file of positions, as the chunked conversion writes it, and their box.
+struct PositionsOnDisk {
+  PositionsOnDisk(std::size_t n, unsigned seed)
+      : p(tied_points(n, seed)), path(write_positions(dir, p)), box(bounding_box(p)) {}
+  testing::TempDir dir;
+  std::vector<Vec3f> p;
+  std::string path;
+  Aabb box;
+};
+
 TEST(ChunkPlan, InMemoryPlanIsTheHierarchysMedianSplits) {
   const std::vector<Vec3f> p = tied_points(6001, 3);
   ThreadPool pool(2);
@@ -102,10 +112,8 @@ TEST(ChunkPlan, InMemoryPlanIsTheHierarchysMedianSplits) {
 }
 
 TEST(ChunkPlan, OnDiskPlanIsTheSamePlanWhateverItsMemory) {
-  testing::TempDir dir;
-  const std::vector<Vec3f> p = tied_points(6001, 5);
-  const std::string path = write_positions(dir, p);
-  const Aabb box = bounding_box(p);
+  const PositionsOnDisk file(6001, 5);
+  const auto& [dir, p, path, box] = file;
   const Oracle o = brute_force(p, 4);
   for (unsigned threads : {1u, 2u}) {
     ThreadPool pool(threads);
@@ -133,10 +141,8 @@ TEST(ChunkPlan, OnDiskPlanIsTheSamePlanWhateverItsMemory) {
 
 // Ten levels (1,024 chunks): each point's range takes two bytes between passes.
 TEST(ChunkPlan, OnDiskPlanOfManyLevelsIsTheSamePlan) {
-  testing::TempDir dir;
-  const std::vector<Vec3f> p = tied_points(6001, 9);
-  const std::string path = write_positions(dir, p);
-  const Aabb box = bounding_box(p);
+  const PositionsOnDisk file(6001, 9);
+  const auto& [dir, p, path, box] = file;
   ThreadPool pool(2);
   const Oracle o = brute_force(p, 10);
   for (const std::size_t id_bytes : {std::size_t{1} << 20, std::size_t{0}}) {
@@ -149,10 +155,8 @@ TEST(ChunkPlan, OnDiskPlanOfManyLevelsIsTheSamePlan) {
 }
 
 TEST(ChunkPlan, OnDiskPlanSaysWhenThePositionFileIsShort) {
-  testing::TempDir dir;
-  const std::vector<Vec3f> p = tied_points(1000, 7);
-  const std::string path = write_positions(dir, p);
-  const Aabb box = bounding_box(p);
+  const PositionsOnDisk file(1000, 7);
+  const auto& [dir, p, path, box] = file;
   ThreadPool pool(1);
   try {
     plan_chunks_on_disk(path, 2000, box, 2, {.max_candidates = 100}, pool, Progress::none());
