@@ -74,14 +74,13 @@ namespace {
 // which returns false to stop; so
 // does `go_on(m, radius)` before each size (radius m/13 in parent units, double). Within
 // one size the cell nearest the target comes first, then the others in code order, so offers
-// keep the least (value, code) explicitly. Only
-// centres within `max_distance()` of the target's (parent units; asked at each size) are
-// considered, and codes for which `wanted(distance, radius)` (the candidate's centre distance
-// to the target's and its radius, parent units, double) is false are skipped undecoded;
-// `wanted` must turn down every larger distance once it turns one down.
-template <class GoOn, class MaxDistance, class Wanted, class Offer>
-void search_enclosing(const Sphere& parent, const Sphere& target, GoOn&& go_on,
-                      MaxDistance&& max_distance, Wanted&& wanted, Offer&& offer) {
+// keep the least (value, code) explicitly. Only centres within `reach(radius)` of the
+// target's (parent units, double; asked at each size and after each offer, negative when no
+// code of that size is wanted) are decoded; the distance compared is the lattice estimate, so
+// `reach` must allow for its difference from the decoded floats (estimate_margin).
+template <class GoOn, class Reach, class Offer>
+void search_enclosing(const Sphere& parent, const Sphere& target, GoOn&& go_on, Reach&& reach,
+                      Offer&& offer) {
   const double rho = parent.radius;
   // Target in parent units; a candidate of size m has radius R = m/13 and centre coordinates
   // X = (m + 2x)/13 - 1 (spec §4.1). It can only qualify when every |X - t| <= R - s (encloses)
@@ -111,17 +110,19 @@ void search_enclosing(const Sphere& parent, const Sphere& target, GoOn&& go_on,
   for (int m = m_first; m <= kSphereGrid; ++m) {
     const double radius = double(m) / kSphereGrid;
     if (!go_on(m, radius)) return;
-    const double reach = std::min(radius - s, max_distance()) + slack;
-    const double room = 1 - radius + slack;
-    if (reach < 0) continue;
     // No cell of this size is nearer the target than the nearest point of its lattice (centres
-    // at (m + 2x)/13 - 1: the lattice depends only on m's parity); when `wanted` turns that
-    // down, it turns down every cell of the box, which is then not worth computing.
-    if (!wanted(lattice_distance[m & 1], radius)) continue;
+    // at (m + 2x)/13 - 1: the lattice depends only on m's parity); when that is out of reach,
+    // the box is not worth computing. Cells are compared squared (the margins dwarf a rounding).
+    double wanted = reach(radius);
+    if (!(lattice_distance[m & 1] <= wanted)) continue;
+    double wanted2 = wanted * wanted;
+    const double box = std::min(radius - s, wanted) + slack;
+    const double room = 1 - radius + slack;
+    if (box < 0) continue;
     int lo[3], hi[3];
     bool empty = false;
     for (int a = 0; a < 3 && !empty; ++a) {
-      const double x_lo = std::max(t[a] - reach, -room), x_hi = std::min(t[a] + reach, room);
+      const double x_lo = std::max(t[a] - box, -room), x_hi = std::min(t[a] + box, room);
       // x = (13 (X + 1) - m) / 2
       lo[a] = std::max(0, int(std::ceil((kSphereGrid * (x_lo + 1) - m) / 2)));
       hi[a] = std::min(kSphereGrid - m, int(std::floor((kSphereGrid * (x_hi + 1) - m) / 2)));
@@ -133,7 +134,7 @@ void search_enclosing(const Sphere& parent, const Sphere& target, GoOn&& go_on,
       return (m + 2.0 * cell) * kCell - 1 - t[a];
     };
     const auto visit = [&](int x, int y, int z, double ex, double ey, double ez) {
-      if (!wanted(std::sqrt(ex * ex + ey * ey + ez * ez), radius)) return true;
+      if (!(ex * ex + ey * ey + ez * ez <= wanted2)) return true;
       // x, y, z lie in the box, within 0..13 - m: sphere_code without its range checks
       const int code = codes[((m * kSphereGrid + x) * kSphereGrid + y) * kSphereGrid + z];
       if (code < 0) return true;
@@ -142,10 +143,13 @@ void search_enclosing(const Sphere& parent, const Sphere& target, GoOn&& go_on,
       const double dist2 = distance_squared(d.center, target.center);
       if (!(std::sqrt(dist2) + double(target.radius) <= double(d.radius))) return true;
       if (!encloses(parent, d)) return true;
-      return offer(std::uint32_t(code), d, m, dist2);
+      if (!offer(std::uint32_t(code), d, m, dist2)) return false;
+      wanted = reach(radius);
+      wanted2 = wanted * wanted;
+      return true;
     };
     // The cell nearest the target first: it is usually the answer, and the bounds it sets let
-    // `wanted` skip most of the box undecoded.
+    // `reach` skip most of the box undecoded.
     int near[3];
     for (int a = 0; a < 3; ++a) {
       // (either of two equally near cells will do)
@@ -153,8 +157,8 @@ void search_enclosing(const Sphere& parent, const Sphere& target, GoOn&& go_on,
                            hi[a]);
     }
     const double nx = offset(0, near[0]), ny = offset(1, near[1]), nz = offset(2, near[2]);
-    // No cell of the box is nearer, so when `wanted` turns it down it turns them all down.
-    if (!wanted(std::sqrt(nx * nx + ny * ny + nz * nz), radius)) continue;
+    // No cell of the box is nearer: when it is out of reach, they all are.
+    if (!(nx * nx + ny * ny + nz * nz <= wanted2)) continue;
     if (!visit(near[0], near[1], near[2], nx, ny, nz)) return;
     for (int x = lo[0]; x <= hi[0]; ++x) {
       const double ex = offset(0, x);
@@ -184,11 +188,10 @@ std::uint32_t encode_enclosing_sphere(const Sphere& parent, const Sphere& target
   // distance in double differs from the decoded floats' by their rounding (parent units).
   const double margin = estimate_margin(parent);
   double near_enough = std::numeric_limits<double>::infinity();
-  const auto nearer = [&](double distance, double) { return distance <= near_enough; };
   const auto go_on = [&](int m, double) { return best < 0 || m <= best_m; };
-  const auto reach = [&] { return near_enough; };
-  search_enclosing(parent, target, go_on, reach, nearer, [&](std::uint32_t code, const Sphere&,
-                                                             int m, double dist) {
+  const auto reach = [&](double) { return near_enough; };
+  search_enclosing(parent, target, go_on, reach, [&](std::uint32_t code, const Sphere&, int m,
+                                                    double dist) {
     if (best >= 0 && m > best_m) return false;
     if (dist < best_distance || (dist == best_distance && int(code) < best)) {
       best = int(code), best_m = m, best_distance = dist;
@@ -226,30 +229,27 @@ LeafCode encode_enclosing_leaf(const Sphere& parent, const Sphere& target, LeafT
   // of it; none can once even its largest trim is above the best.
   LeafCode best{kParentCode, 0, std::numeric_limits<float>::infinity(), false};
   const float most_trimmed = trimmed_leaf_radius(1.0f, max_leaf_trim(mode), mode);
-  // A candidate whose drawn radius, estimated in double, is clearly above the best so far is not
-  // decoded: its centre distance is taken as short as the decoded floats could make it
-  // (estimate_margin), and radii get a relative margin of 1e-5 for their float rounding.
+  // A candidate that cannot draw at or below the best so far is not decoded. A size of radius R
+  // draws at most the best (radii with a relative margin of 1e-5 for their float rounding) from
+  // its least such trim t on, which holds the target only when the centre distance is at most
+  // R (1 - t step) - s: more by that margin and by what the decoded floats may differ from the
+  // lattice estimate (estimate_margin).
   const double s = double(target.radius) / parent.radius;
   const double margin = estimate_margin(parent);
   const double step = 1.0 - double(trimmed_leaf_radius(1.0f, 1, mode));
-  const auto promising = [&](double distance, double radius) {
-    const double need = distance - margin + s;
-    if (need > radius * (1 + 1e-5)) return false;
-    const double t = std::min(double(max_leaf_trim(mode)),
-                              std::floor(std::max(0.0, 1.0 - need / radius) / step));
-    return radius * (1.0 - t * step) * parent.radius <= double(best.radius) * (1 + 1e-5);
-  };
-  // The target's centre lies within best - s of any code that could draw it at best or less.
-  const auto within = [&] {
-    return double(best.radius) / parent.radius * (1 + 1e-5) - s + margin;
+  const double most_trim = max_leaf_trim(mode);
+  const auto reach = [&](double radius) {
+    const double bound = double(best.radius) * (1 + 1e-5);
+    double t = 0;
+    while (t <= most_trim && radius * (1.0 - t * step) * parent.radius > bound) ++t;
+    return t > most_trim ? -1.0 : radius * (1.0 - t * step) * (1 + 1e-5) - s + margin;
   };
   // A size whose most trimmed radius is clearly above the best cannot win, nor can larger ones.
   const auto go_on = [&](int, double radius) {
     return radius * most_trimmed * parent.radius <= double(best.radius) * (1 + 1e-5);
   };
-  search_enclosing(parent, target, go_on, within, promising, [&](std::uint32_t code,
-                                                                 const Sphere& d, int,
-                                                                 double dist2) {
+  search_enclosing(parent, target, go_on, reach, [&](std::uint32_t code, const Sphere& d, int,
+                                                    double dist2) {
     if (d.radius * most_trimmed > best.radius) return false;
     const LeafCode c = trimmed(code, d, dist2);
     if (c.radius < best.radius || (c.radius == best.radius && c.code < best.code)) best = c;
