@@ -21,6 +21,13 @@ using qs_detail::kSphereGrid;
 // rounds to exactly 1.0f in the table, so it decodes to the parent's bits).
 constexpr std::uint32_t kParentCode = kSphereCodeCount - 1;
 
+// 1 / (m / 13) for the cube sizes m = 1..13.
+constexpr auto kInverseRadius = [] {
+  std::array<double, kSphereGrid + 1> r{};
+  for (int m = 1; m <= kSphereGrid; ++m) r[std::size_t(m)] = double(kSphereGrid) / m;
+  return r;
+}();
+
 double distance_squared(Vec3f a, Vec3f b) {
   const double dx = double(a.x) - b.x, dy = double(a.y) - b.y, dz = double(a.z) - b.z;
   return dx * dx + dy * dy + dz * dz;
@@ -74,7 +81,7 @@ namespace {
 // which returns false to stop; so
 // does `go_on(m, radius)` before each size (radius m/13 in parent units, double). Within
 // one size the cell nearest the target comes first, then the others in code order, so offers
-// keep the least (value, code) explicitly. Only centres within `reach(radius)` of the
+// keep the least (value, code) explicitly. Only centres within `reach(m, radius)` of the
 // target's (parent units, double; asked at each size and after each offer, negative when no
 // code of that size is wanted) are decoded; the distance compared is the lattice estimate, so
 // `reach` must allow for its difference from the decoded floats (estimate_margin).
@@ -113,7 +120,7 @@ void search_enclosing(const Sphere& parent, const Sphere& target, GoOn&& go_on, 
     // No cell of this size is nearer the target than the nearest point of its lattice (centres
     // at (m + 2x)/13 - 1: the lattice depends only on m's parity); when that is out of reach,
     // the box is not worth computing. Cells are compared squared (the margins dwarf a rounding).
-    double wanted = reach(radius);
+    double wanted = reach(m, radius);
     if (!(lattice_distance[m & 1] <= wanted)) continue;
     double wanted2 = wanted * wanted;
     const double box = std::min(radius - s, wanted) + slack;
@@ -144,7 +151,7 @@ void search_enclosing(const Sphere& parent, const Sphere& target, GoOn&& go_on, 
       if (!(std::sqrt(dist2) + double(target.radius) <= double(d.radius))) return true;
       if (!encloses(parent, d)) return true;
       if (!offer(std::uint32_t(code), d, m, dist2)) return false;
-      wanted = reach(radius);
+      wanted = reach(m, radius);
       wanted2 = wanted * wanted;
       return true;
     };
@@ -189,7 +196,7 @@ std::uint32_t encode_enclosing_sphere(const Sphere& parent, const Sphere& target
   const double margin = estimate_margin(parent);
   double near_enough = std::numeric_limits<double>::infinity();
   const auto go_on = [&](int m, double) { return best < 0 || m <= best_m; };
-  const auto reach = [&](double) { return near_enough; };
+  const auto reach = [&](int, double) { return near_enough; };
   search_enclosing(parent, target, go_on, reach, [&](std::uint32_t code, const Sphere&, int m,
                                                     double dist) {
     if (best >= 0 && m > best_m) return false;
@@ -237,22 +244,25 @@ LeafCode encode_enclosing_leaf(const Sphere& parent, const Sphere& target, LeafT
   const double s = double(target.radius) / parent.radius;
   const double margin = estimate_margin(parent);
   const double step = 1.0 - double(trimmed_leaf_radius(1.0f, 1, mode));
-  const double most_trim = max_leaf_trim(mode);
-  const auto reach = [&](double radius) {
-    const double bound = double(best.radius) * (1 + 1e-5);
-    double t = 0;
-    while (t <= most_trim && radius * (1.0 - t * step) * parent.radius > bound) ++t;
+  const double most_trim = max_leaf_trim(mode), steps = 1.0 / step;  // step: a power of 2
+  // The best radius with its margin, in parent units (kept as the best changes).
+  double bound = std::numeric_limits<double>::infinity();
+  const auto reach = [&](int m, double radius) {
+    // The least trim t with R (1 - t step) <= bound, rounded down a little so as never to
+    // exceed it (a smaller t only widens the reach).
+    const double t = std::max(0.0, std::ceil((1.0 - bound * kInverseRadius[m]) * steps - 1e-6));
     return t > most_trim ? -1.0 : radius * (1.0 - t * step) * (1 + 1e-5) - s + margin;
   };
   // A size whose most trimmed radius is clearly above the best cannot win, nor can larger ones.
-  const auto go_on = [&](int, double radius) {
-    return radius * most_trimmed * parent.radius <= double(best.radius) * (1 + 1e-5);
-  };
+  const auto go_on = [&](int, double radius) { return radius * most_trimmed <= bound; };
   search_enclosing(parent, target, go_on, reach, [&](std::uint32_t code, const Sphere& d, int,
                                                     double dist2) {
     if (d.radius * most_trimmed > best.radius) return false;
     const LeafCode c = trimmed(code, d, dist2);
-    if (c.radius < best.radius || (c.radius == best.radius && c.code < best.code)) best = c;
+    if (c.radius < best.radius || (c.radius == best.radius && c.code < best.code)) {
+      best = c;
+      bound = double(best.radius) * (1 + 1e-5) / parent.radius;
+    }
     return true;
   });
   if (best.exact) return best;
