@@ -187,8 +187,8 @@ EncodedTree encode_tree(std::span<const SphereNode> nodes, std::span<const std::
   std::vector<EncodeStats> chunk_stats;
   // fn(stats, first, last) for each chunk of each level; a chunk counts into its own stats on
   // the stack of the thread that runs it, which shares no cache line with another thread's
-  // (counting straight into chunk_stats, whose neighbours other threads were counting into,
-  // cost a tenth of a mesh's encoding time).
+  // (counting straight into chunk_stats, whose neighbours the other thread was counting into,
+  // cost up to 7 % of a mesh's conversion, as the vector happened to be aligned).
   const auto each_level = [&](bool bottom_up, auto&& fn) {
     for (std::size_t l = 0; l < level_count; ++l) {
       const std::size_t k = bottom_up ? level_count - 1 - l : l;
