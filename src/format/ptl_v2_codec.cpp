@@ -244,14 +244,14 @@ LeafCode encode_enclosing_leaf(const Sphere& parent, const Sphere& target, LeafT
   const double s = double(target.radius) / parent.radius;
   const double margin = estimate_margin(parent);
   const double step = 1.0 - double(trimmed_leaf_radius(1.0f, 1, mode));
-  const double most_trim = max_leaf_trim(mode), steps = 1.0 / step;  // step: a power of 2
+  const double max_trim = max_leaf_trim(mode), steps = 1.0 / step;  // step: a power of 2
   // The best radius with its margin, in parent units (kept as the best changes).
   double bound = std::numeric_limits<double>::infinity();
   const auto reach = [&](int m, double radius) {
     // The least trim t with R (1 - t step) <= bound, rounded down a little so as never to
     // exceed it (a smaller t only widens the reach).
     const double t = std::max(0.0, std::ceil((1.0 - bound * kInverseRadius[m]) * steps - 1e-6));
-    return t > most_trim ? -1.0 : radius * (1.0 - t * step) * (1 + 1e-5) - s + margin;
+    return t > max_trim ? -1.0 : radius * (1.0 - t * step) * (1 + 1e-5) - s + margin;
   };
   // A size whose most trimmed radius is clearly above the best cannot win, nor can larger ones.
   const auto go_on = [&](int, double radius) { return radius * most_trimmed <= bound; };

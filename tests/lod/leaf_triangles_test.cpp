@@ -2,6 +2,7 @@
 // of a renumbered face must be the leaf at the point the input face names.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 #include <string>
 
@@ -25,17 +26,15 @@ std::vector<std::array<std::uint32_t, 3>> random_faces(std::size_t count, std::u
 // order differs from their depth-first order.
 bool leaves_at_several_depths(const SphereTree& tree) {
   std::vector<std::uint32_t> depth(tree.nodes.size(), 0);
-  std::uint32_t leaf_depth = 0;
-  bool several = false, seen = false;
+  std::uint32_t shallowest = ~0u, deepest = 0;
   for (std::size_t i = 0; i < tree.nodes.size(); ++i) {
     const SphereNode& node = tree.nodes[i];
     for (std::uint32_t c = 0; c < node.child_count; ++c) depth[node.first_child + c] = depth[i] + 1;
     if (node.child_count != 0) continue;
-    several = several || (seen && depth[i] != leaf_depth);
-    leaf_depth = depth[i];
-    seen = true;
+    shallowest = std::min(shallowest, depth[i]);
+    deepest = std::max(deepest, depth[i]);
   }
-  return several;
+  return shallowest < deepest;
 }
 
 // Leaves at two depths (150,000 points give them), so that the depth-first order of the split
