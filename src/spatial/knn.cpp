@@ -271,8 +271,10 @@ void grid_queries(const CellGrid& g, std::size_t cell_begin, std::size_t cell_en
       for (std::size_t i = 0; i < m; ++i) cd[i] = squared_distance(q, cx[i], cy[i], cz[i]);
       cd[j - g.begin[c]] = std::numeric_limits<float>::quiet_NaN();
       std::size_t count = 0;
-      for (float limit = guess > 0 ? guess * 1.5f : std::numeric_limits<float>::infinity();;
-           limit = limit * 4) {
+      // (A 5 M cloud, k = 15: with 1.25 and 1.5, 13 % of the queries grow their limit, against
+      // 3 % with 1.5 and 4, but they rank 0.82x the entries: the search takes 0.94x the time.)
+      for (float limit = guess > 0 ? guess * 1.25f : std::numeric_limits<float>::infinity();;
+           limit = limit * 1.5f) {
         count = within_limit(cd.data(), m, limit, kd.data(), ki.data());
         if (count >= k || !(limit < std::numeric_limits<float>::max())) break;
         if (!(limit > 0)) limit = std::numeric_limits<float>::min();
@@ -297,6 +299,31 @@ void grid_queries(const CellGrid& g, std::size_t cell_begin, std::size_t cell_en
                   std::numeric_limits<float>::infinity());
         std::fill(ki.begin() + std::ptrdiff_t(count), ki.begin() + std::ptrdiff_t(padded),
                   std::numeric_limits<std::uint32_t>::max());
+#if defined(__AVX2__)
+        // Eight entries at a time, one per lane, each lane counting the entries before its
+        // own: no sum across lanes per entry. Indices compare as signed after flipping the top
+        // bit.
+        const __m256i flip = _mm256_set1_epi32(std::int32_t(0x80000000u));
+        for (std::size_t t = 0; t < count; t += kLanes) {
+          const __m256 d = _mm256_loadu_ps(&kd[t]);
+          const __m256i i = _mm256_xor_si256(
+              _mm256_loadu_si256(reinterpret_cast<const __m256i*>(&ki[t])), flip);
+          __m256i before = _mm256_setzero_si256();
+          for (std::size_t e = 0; e < count; ++e) {
+            const __m256 de = _mm256_broadcast_ss(&kd[e]);
+            const __m256i ie = _mm256_set1_epi32(std::int32_t(ki[e] ^ 0x80000000u));
+            const __m256i nearer = _mm256_castps_si256(_mm256_cmp_ps(de, d, _CMP_LT_OQ));
+            const __m256i tied = _mm256_and_si256(
+                _mm256_castps_si256(_mm256_cmp_ps(de, d, _CMP_EQ_OQ)), _mm256_cmpgt_epi32(i, ie));
+            before = _mm256_sub_epi32(before, _mm256_or_si256(nearer, tied));  // -(-1) per hit
+          }
+          alignas(32) std::uint32_t place[kLanes];
+          _mm256_store_si256(reinterpret_cast<__m256i*>(place), before);
+          for (std::size_t l = 0; l < std::min(kLanes, count - t); ++l) {
+            near[place[l]] = Neighbour{kd[t + l], ki[t + l]};
+          }
+        }
+#else
         for (std::size_t t = 0; t < count; ++t) {
           const float d = kd[t];
           const std::uint32_t i = ki[t];
@@ -306,6 +333,7 @@ void grid_queries(const CellGrid& g, std::size_t cell_begin, std::size_t cell_en
           }
           near[place] = Neighbour{d, i};
         }
+#endif
       }
       const float cut = near[k - 1].d2;
       guess = cut;
