@@ -308,12 +308,14 @@ std::uint16_t encode_rgb565_nearest(Rgb8 c) {
   return static_cast<std::uint16_t>(kNearest5[c.r] << 11 | kNearest6[c.g] << 5 | kNearest5[c.b]);
 }
 
-double angle_between(Vec3f a, Vec3f b) {
+double cosine_between(Vec3f a, Vec3f b) {
   const double la = std::sqrt(double(a.x) * a.x + double(a.y) * a.y + double(a.z) * a.z);
   const double lb = std::sqrt(double(b.x) * b.x + double(b.y) * b.y + double(b.z) * b.z);
-  if (!(la > 0) || !(lb > 0)) return 0;
+  if (!(la > 0) || !(lb > 0)) return 1;
   const double d = (double(a.x) * b.x + double(a.y) * b.y + double(a.z) * b.z) / (la * lb);
-  return std::acos(std::clamp(d, -1.0, 1.0));
+  return std::clamp(d, -1.0, 1.0);
 }
+
+double angle_between(Vec3f a, Vec3f b) { return std::acos(cosine_between(a, b)); }
 
 }  // namespace pointillist::ptl2

@@ -47,7 +47,9 @@ std::uint32_t encode_cone_at_least(double theta);
 // errors at most 4 levels in red and blue, 2 in green.
 std::uint16_t encode_rgb565_nearest(Rgb8 c);
 
-// Angle between two vectors (radians, double; 0 for a zero vector).
+// Cosine of the angle between two vectors, in double, clamped to [-1, 1]; 1 for a zero vector.
+double cosine_between(Vec3f a, Vec3f b);
+// Angle between two vectors (radians, double; 0 for a zero vector): acos(cosine_between).
 double angle_between(Vec3f a, Vec3f b);
 
 }  // namespace pointillist::ptl2

@@ -124,17 +124,31 @@ std::uint32_t encode_cone(std::span<const SphereNode> nodes, std::span<const std
   };
   const SphereNode& node = nodes[i];
   const Vec3f axis = normal_of(i);
+  // θ only grows below, so once no code below 3 holds it the code is 3 (the test is
+  // encode_cone_at_least's own, and the half-angles grow with the code).
+  static const double widest = cone_half_angle(2);
+  const auto unbounded = [&](double theta) { return !(widest >= theta + 1e-6); };
   double theta = node.cone_sin < 1 ? std::asin(double(node.cone_sin)) : 1e9;
   theta += angle_between(axis, node.normal);
+  if (unbounded(theta)) return 3;
+  // Children whose cones have the same code (leaves: their normal alone, no angle) need only
+  // the widest angle from the axis among them, the least cosine (acos decreases): one acos a
+  // code instead of one a child. A child with code 3 (no bound; an infinite angle) makes it 3.
+  double least[4] = {2, 2, 2, 2};  // by the children's cone codes 0-2; 3 for leaves
   for (std::uint32_t k = 0; k < node.child_count; ++k) {
     const std::size_t ch = node.first_child + k;
-    // A leaf's cone is its normal alone (its cone bits hold its radius trim); code 3, no bound,
-    // decodes to an infinite angle.
-    const double child_angle =
-        nodes[ch].child_count > 0
-            ? cone_half_angle(quant::bits(std::uint32_t(record[ch]), kConeShift, kConeBits))
-            : 0.0;
-    theta = std::max(theta, angle_between(axis, normal_of(ch)) + child_angle);
+    // A leaf's cone bits hold its radius trim, not a cone.
+    std::uint32_t slot = 3;
+    if (nodes[ch].child_count > 0) {
+      slot = quant::bits(std::uint32_t(record[ch]), kConeShift, kConeBits);
+      if (slot == 3) return 3;
+    }
+    least[slot] = std::min(least[slot], cosine_between(axis, normal_of(ch)));
+  }
+  for (std::uint32_t slot = 0; slot < 4; ++slot) {
+    if (least[slot] > 1) continue;
+    const double child_angle = slot < 3 ? cone_half_angle(slot) : 0.0;
+    theta = std::max(theta, std::acos(least[slot]) + child_angle);
   }
   return encode_cone_at_least(theta);
 }
