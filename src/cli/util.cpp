@@ -20,8 +20,8 @@ void use_huge_pages(char** argv) {
   if (!argv[0] || !argv[1]) return;
   const std::string_view command = argv[1];
   if (command != "convert" && command != "generate") return;
-  const char* opt_out = std::getenv("POINTILLIST_HUGE_PAGES");
-  if (opt_out && std::string_view(opt_out) == "0") return;
+  const char* asked = std::getenv("POINTILLIST_HUGE_PAGES");
+  if (!asked || std::string_view(asked) != "1") return;  // off unless asked for
   const char* tunables = std::getenv("GLIBC_TUNABLES");
   const std::string given = tunables ? tunables : "";
   if (given.find("glibc.malloc.hugetlb") != std::string::npos) return;

@@ -26,15 +26,18 @@ std::string input_names(std::span<const std::string> inputs, bool file_names = f
 // the same peak). The peak resident memory is unchanged; it is simply not given back early.
 void keep_freed_memory();
 
-// For `convert` and `generate` (argv[1]): memory in 2 MB pages where the system offers them on
-// request (transparent huge pages in "madvise" mode, glibc 2.35 or later): glibc's allocator
-// only asks for them when started with
+// For `convert` and `generate` (argv[1]), when POINTILLIST_HUGE_PAGES=1: memory in 2 MB pages
+// where the system offers them on request (transparent huge pages in "madvise" mode, glibc 2.35
+// or later): glibc's allocator only asks for them when started with
 // GLIBC_TUNABLES=glibc.malloc.hugetlb=1, so the process starts itself again once with that
-// added (same arguments, same process id). A fresh 2 MB page costs a fraction of 512 fresh
-// 4 KB pages to fault in, and the TLB covers more: the dragon converts in half the wall time.
-// Nothing happens when the tunable is already given, when POINTILLIST_HUGE_PAGES=0, when the
-// kernel's mode is "always" or "never", or when starting again fails (the command then simply
-// runs as it is).
+// added (same arguments, same process id). Off by default since 2026-11-29: on this virtual
+// machine, where the kernel compacts memory to find 2 MB pages for a process that asks (the
+// "madvise" defrag mode), they cost more than they saved in most alternating runs of one
+// sitting: 7 M mesh to .ptl 1.13x the wall time, to .qs 1.18x, 5 M cloud 1.10x, 1.21x with
+// qsplat_make's runs in between; less often they saved (20 M cloud 0.98x, the dragon 0.90x,
+// `generate` 0.93x), and in earlier sittings they halved the dragon's time. Nothing happens
+// when the tunable is already given, when the kernel's mode is "always" or "never", or when
+// starting again fails (the command then simply runs as it is).
 void use_huge_pages(char** argv);
 
 // Eight well-separated face colours (spec §4.1), so that any blending of two faces shows:

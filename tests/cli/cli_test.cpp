@@ -269,19 +269,22 @@ TEST(Cli, ChunkCullingSkipsChunksInACloseUpWithoutChangingTheImage) {
   EXPECT_EQ(read_png_rgb8(dir.file("on.png")).pixels, read_png_rgb8(dir.file("off.png")).pixels);
 }
 
-// convert restarts itself once with glibc's huge-page tunable (cli/util.hpp use_huge_pages): the
-// restart may not lose an argument or change a byte. The reference is the same conversion with
-// no restart (the opt-out, and the tunable given as off).
+// Asked to (POINTILLIST_HUGE_PAGES=1), convert restarts itself once with glibc's huge-page
+// tunable (cli/util.hpp use_huge_pages): the restart may not lose an argument or change a byte.
+// The reference is the same conversion with no restart (the default, and the tunable given as
+// off).
 TEST(Cli, MemoryTuningChangesNoByteOfTheOutput) {
   pointillist::testing::TempDir dir;
   Result r = pointillist::testing::run_cli("generate --scene demo --points 30000 --quiet -o " +
                                            dir.file("in.ply"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  r = pointillist::testing::run_cli("convert " + dir.file("in.ply") + " -o " +
-                                    dir.file("tuned.ptl") + " --quiet");
+  r = pointillist::testing::run_shell("env POINTILLIST_HUGE_PAGES=1 " +
+                                      std::string(POINTILLIST_CLI_PATH) + " convert " +
+                                      dir.file("in.ply") + " -o " + dir.file("tuned.ptl") +
+                                      " --quiet");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   r = pointillist::testing::run_shell(
-      "env POINTILLIST_HUGE_PAGES=0 GLIBC_TUNABLES=glibc.malloc.hugetlb=0 " +
+      "env -u POINTILLIST_HUGE_PAGES GLIBC_TUNABLES=glibc.malloc.hugetlb=0 " +
       std::string(POINTILLIST_CLI_PATH) + " convert " + dir.file("in.ply") + " -o " +
       dir.file("plain.ptl") + " --quiet");
   ASSERT_EQ(r.exit_code, 0) << r.output;
