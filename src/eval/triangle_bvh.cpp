@@ -10,18 +10,6 @@
 namespace pointillist::eval_detail {
 namespace {
 
-struct Vec3d {
-  double x = 0, y = 0, z = 0;
-};
-Vec3d to_double(Vec3f v) { return {v.x, v.y, v.z}; }
-Vec3d operator+(Vec3d a, Vec3d b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-Vec3d operator-(Vec3d a, Vec3d b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-Vec3d operator*(Vec3d a, double s) { return {a.x * s, a.y * s, a.z * s}; }
-double dot(Vec3d a, Vec3d b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-Vec3d cross(Vec3d a, Vec3d b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-
 Vec3d closest_on_segment(Vec3d p, Vec3d a, Vec3d b) {
   const Vec3d ab = b - a;
   const double len2 = dot(ab, ab);

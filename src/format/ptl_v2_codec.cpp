@@ -293,8 +293,11 @@ std::uint32_t encode_normal_nearest(Vec3f n) {
 }
 
 double cone_half_angle(std::uint32_t k) {
-  return k < 3 ? std::asin(double(qs_detail::cone_sin_bound(k)))
-               : std::numeric_limits<double>::infinity();
+  // Asked a few times for every interior node of a tree: computed once.
+  static const double kHalfAngle[3] = {std::asin(double(qs_detail::cone_sin_bound(0))),
+                                       std::asin(double(qs_detail::cone_sin_bound(1))),
+                                       std::asin(double(qs_detail::cone_sin_bound(2)))};
+  return k < 3 ? kHalfAngle[k] : std::numeric_limits<double>::infinity();
 }
 
 std::uint32_t encode_cone_at_least(double theta) {

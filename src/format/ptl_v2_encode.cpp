@@ -124,13 +124,9 @@ std::uint32_t encode_cone(std::span<const SphereNode> nodes, std::span<const std
   };
   const SphereNode& node = nodes[i];
   const Vec3f axis = normal_of(i);
-  // θ only grows below, so once no code below 3 holds it the code is 3 (the test is
-  // encode_cone_at_least's own, and the half-angles grow with the code).
-  static const double widest = cone_half_angle(2);
-  const auto unbounded = [&](double theta) { return !(widest >= theta + 1e-6); };
   double theta = node.cone_sin < 1 ? std::asin(double(node.cone_sin)) : 1e9;
   theta += angle_between(axis, node.normal);
-  if (unbounded(theta)) return 3;
+  if (encode_cone_at_least(theta) == 3) return 3;  // θ only grows below
   // Children whose cones have the same code (leaves: their normal alone, no angle) need only
   // the widest angle from the axis among them, the least cosine (acos decreases): one acos a
   // code instead of one a child. A child with code 3 (no bound; an infinite angle) makes it 3.

@@ -37,24 +37,15 @@ bool use_area_weights(std::span<const SphereNode> children) {
   return sum > 0 && std::isfinite(sum);
 }
 
-// Double-precision vector for the tangent-sphere solve.
-struct D3 {
-  double x = 0, y = 0, z = 0;
-};
-D3 operator+(D3 a, D3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-D3 operator*(D3 a, double s) { return {a.x * s, a.y * s, a.z * s}; }
-double dot(D3 a, D3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-D3 cross(D3 a, D3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
-
 // Candidate spheres (centre, radius R) internally tangent to the children in `subset` (2 to 4
 // of them, centre in their affine hull), passed to `consider(centre, R)`. The smallest sphere enclosing a set of balls touches at
 // most 4 of them and is this sphere for that subset, so trying every subset finds it.
 // Positions are relative to the first child of the subset, in double; `p`, `r` are all children.
 template <typename Consider>
-void tangent_spheres(const D3* p, const double* r, const int* subset, int m, Consider&& consider) {
-  const D3 o = p[subset[0]];
+void tangent_spheres(const Vec3d* p, const double* r, const int* subset, int m, Consider&& consider) {
+  const Vec3d o = p[subset[0]];
   const double r0 = r[subset[0]];
-  D3 q[3];
+  Vec3d q[3];
   double e[3], f[3];  // x·q_k = e_k + f_k·R for x = centre - o (difference of the tangency equations)
   for (int k = 1; k < m; ++k) {
     q[k - 1] = p[subset[k]] + o * -1.0;
@@ -62,7 +53,7 @@ void tangent_spheres(const D3* p, const double* r, const int* subset, int m, Con
     e[k - 1] = 0.5 * (dot(q[k - 1], q[k - 1]) - rk * rk + r0 * r0);
     f[k - 1] = rk - r0;
   }
-  D3 a, b;  // centre - o = a + b·R
+  Vec3d a, b;  // centre - o = a + b·R
   if (m == 2) {
     const double d = std::sqrt(dot(q[0], q[0]));
     if (!(d > 0)) return;
@@ -79,7 +70,7 @@ void tangent_spheres(const D3* p, const double* r, const int* subset, int m, Con
     a = q[0] * ae + q[1] * be;
     b = q[0] * af + q[1] * bf;
   } else {
-    const D3 c12 = cross(q[1], q[2]), c20 = cross(q[2], q[0]), c01 = cross(q[0], q[1]);
+    const Vec3d c12 = cross(q[1], q[2]), c20 = cross(q[2], q[0]), c01 = cross(q[0], q[1]);
     const double det = dot(q[0], c12);
     const double scale = std::sqrt(dot(q[0], q[0]) * dot(q[1], q[1]) * dot(q[2], q[2]));
     if (!(std::abs(det) > 1e-9 * scale)) return;
@@ -105,7 +96,7 @@ void tangent_spheres(const D3* p, const double* r, const int* subset, int m, Con
 }
 
 // Position of `x` relative to `origin`, as a double vector.
-D3 relative(Vec3f x, Vec3f origin) {
+Vec3d relative(Vec3f x, Vec3f origin) {
   const Vec3f d = x - origin;
   return {d.x, d.y, d.z};
 }
@@ -120,7 +111,7 @@ void bound_sphere(std::span<const SphereNode> children, SphereNode& parent) {
   // cost tightness, never containment.
   const int k = static_cast<int>(children.size());
   const Vec3f origin = children[0].center;
-  D3 p[4];
+  Vec3d p[4];
   double r[4];
   int largest = 0;
   for (int i = 0; i < k; ++i) {
@@ -139,7 +130,7 @@ void bound_sphere(std::span<const SphereNode> children, SphereNode& parent) {
   // Tries centre `x` (relative to origin) and keeps it when it is the best so far; true when the
   // sphere there with radius `bound` holds every child, which makes it optimal when `bound` is a
   // lower bound on the optimum.
-  const auto consider = [&](D3 x, double bound) {
+  const auto consider = [&](Vec3d x, double bound) {
     const Vec3f c = origin + Vec3f{static_cast<float>(x.x), static_cast<float>(x.y),
                                    static_cast<float>(x.z)};
     if (!is_finite(c)) return false;
@@ -155,7 +146,7 @@ void bound_sphere(std::span<const SphereNode> children, SphereNode& parent) {
     double span = -1;
     for (int i = 0; i < k; ++i) {
       for (int j = i + 1; j < k; ++j) {
-        const D3 d = p[j] + p[i] * -1.0;
+        const Vec3d d = p[j] + p[i] * -1.0;
         const double s = std::sqrt(dot(d, d)) + r[i] + r[j];
         if (s > span) {
           span = s;
@@ -167,15 +158,15 @@ void bound_sphere(std::span<const SphereNode> children, SphereNode& parent) {
     const double lower_bound = 0.5 * span;
     bool optimal = false;
     const int pair[2] = {pi, pj};
-    tangent_spheres(p, r, pair, 2, [&](D3 x, double radius) { optimal = consider(x, radius); });
+    tangent_spheres(p, r, pair, 2, [&](Vec3d x, double radius) { optimal = consider(x, radius); });
     if (!optimal && k >= 3) {
       struct Candidate {
-        D3 center;
+        Vec3d center;
         double radius;
       };
       Candidate candidates[10];
       int count = 0;
-      const auto collect = [&](D3 x, double radius) {
+      const auto collect = [&](Vec3d x, double radius) {
         if (radius >= lower_bound * (1 - 1e-9) && count < 10) candidates[count++] = {x, radius};
       };
       for (int mask = 7; mask < (1 << k); ++mask) {
@@ -225,20 +216,20 @@ void bound_normals(std::span<const SphereNode> children, bool area_weights, Sphe
   }
   const Vec3f n = sum / len;
   parent.normal = n;
-  const D3 nd{n.x, n.y, n.z};
+  const Vec3d nd{n.x, n.y, n.z};
   // θ = max_i (α_i + θ_i) with α_i = angle(n, n_i), without trigonometric calls:
   // sin(α + θ) = sin α cos θ + cos α sin θ and cos(α + θ) = cos α cos θ - sin α sin θ, where
   // sin α = |n × n_i| / |n_i| stays accurate for small angles. While α + θ < 90° (cos > 0) the
   // sine grows with the angle, so the largest sine is the largest angle.
   double max_sin = 0;
   for (const SphereNode& ch : children) {
-    const D3 m{ch.normal.x, ch.normal.y, ch.normal.z};
+    const Vec3d m{ch.normal.x, ch.normal.y, ch.normal.z};
     const double child_len = std::sqrt(dot(m, m));
     if (!(ch.cone_sin < 1.0f) || !(child_len > 0)) {
       parent.cone_sin = kNoConeBound;
       return;
     }
-    const D3 c = cross(nd, m);
+    const Vec3d c = cross(nd, m);
     const double sin_a = std::sqrt(dot(c, c)) / child_len;
     const double cos_a = dot(nd, m) / child_len;
     const double sin_t = ch.cone_sin;

@@ -455,18 +455,7 @@ float round_up(double x) {
   return f;
 }
 
-struct D3 {
-  double x = 0, y = 0, z = 0;
-};
-D3 to_d3(Vec3f v) { return {v.x, v.y, v.z}; }
-D3 operator-(D3 a, D3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-D3 operator*(D3 a, double s) { return {a.x * s, a.y * s, a.z * s}; }
-D3 operator+(D3 a, D3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-double dot(D3 a, D3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-D3 cross(D3 a, D3 b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-D3 unit(D3 a) { return a * (1.0 / std::sqrt(dot(a, a))); }
+Vec3d unit(Vec3d a) { return a * (1.0 / std::sqrt(dot(a, a))); }
 
 // The directions of the tangential error: angles jπ/8, j = 0..7, from t1 towards t2.
 constexpr int kTangentDirections = 8;
@@ -478,7 +467,7 @@ constexpr double kDirectionSin[kTangentDirections] = {
     1.0, 0.92387953251128674, 0.70710678118654752, 0.38268343236508977};
 
 // Half-extent of a disc of radius r and unit normal m along the unit direction u.
-double disc_half_extent(double r, D3 m, D3 u) {
+double disc_half_extent(double r, Vec3d m, Vec3d u) {
   const double c = dot(m, u);
   return r * std::sqrt(std::max(0.0, 1.0 - c * c));
 }
@@ -488,35 +477,35 @@ double disc_half_extent(double r, D3 m, D3 u) {
 SptNodeGeometry spt_combine_children(std::span<const SptDisc> children) {
   assert(!children.empty());
   const double inv = 1.0 / static_cast<double>(children.size());
-  D3 center_sum, normal_sum;
+  Vec3d center_sum, normal_sum;
   for (const SptDisc& c : children) {
-    center_sum = center_sum + to_d3(c.center);
-    normal_sum = normal_sum + to_d3(c.normal);
+    center_sum = center_sum + to_double(c.center);
+    normal_sum = normal_sum + to_double(c.normal);
   }
   SptNodeGeometry g;
-  const D3 cm = center_sum * inv;
+  const Vec3d cm = center_sum * inv;
   g.center = {float(cm.x), float(cm.y), float(cm.z)};
   const double normal_len = std::sqrt(dot(normal_sum, normal_sum));
   // Normals that cancel (a thin sheet seen from both sides) have no mean; use the first child's.
-  const D3 nm = normal_len > 1e-6 * static_cast<double>(children.size())
+  const Vec3d nm = normal_len > 1e-6 * static_cast<double>(children.size())
                     ? normal_sum * (1.0 / normal_len)
-                    : to_d3(normalized(children[0].normal));
+                    : to_double(normalized(children[0].normal));
   g.normal = normalized(Vec3f{float(nm.x), float(nm.y), float(nm.z)});
 
   // Everything below is measured from the stored (float) centre and normal.
-  const D3 c0 = to_d3(g.center), n = unit(to_d3(g.normal));
+  const Vec3d c0 = to_double(g.center), n = unit(to_double(g.normal));
   // Plane frame: t1 from the world axis least aligned with n.
   const double ax = std::abs(n.x), ay = std::abs(n.y), az = std::abs(n.z);
-  const D3 axis = ax <= ay && ax <= az ? D3{1, 0, 0} : (ay <= az ? D3{0, 1, 0} : D3{0, 0, 1});
-  const D3 t1 = unit(axis - n * dot(axis, n)), t2 = cross(n, t1);
+  const Vec3d axis = ax <= ay && ax <= az ? Vec3d{1, 0, 0} : (ay <= az ? Vec3d{0, 1, 0} : Vec3d{0, 0, 1});
+  const Vec3d t1 = unit(axis - n * dot(axis, n)), t2 = cross(n, t1);
 
   double radius = 0, top = -INFINITY, bottom = INFINITY;
   double hi[kTangentDirections], lo[kTangentDirections];
   std::fill(hi, hi + kTangentDirections, -INFINITY);
   std::fill(lo, lo + kTangentDirections, INFINITY);
   for (const SptDisc& c : children) {
-    const D3 d = to_d3(c.center) - c0;
-    const D3 m = unit(to_d3(normalized(c.normal)));
+    const Vec3d d = to_double(c.center) - c0;
+    const Vec3d m = unit(to_double(normalized(c.normal)));
     const double r = c.radius;
     radius = std::max(radius, std::sqrt(dot(d, d)) + r);
     const double h = dot(d, n), s = disc_half_extent(r, m, n);

@@ -30,9 +30,8 @@ constexpr std::size_t kPiece = 1 << 14;
 constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 // A point of a piece by its offset from the piece's first point.
 using Local = std::uint16_t;
-static_assert(kPiece <= 0xfffe);
+static_assert(kPiece < 0xffff);
 constexpr Local kNoLocal = 0xffff;
-constexpr Local kInTree = 0xfffe;
 
 // What Prim's algorithm keeps per point of a piece, together (8 bytes).
 struct Node {
@@ -40,7 +39,8 @@ struct Node {
   // an edge needs no separate test (and no branch) for it.
   float key = std::numeric_limits<float>::infinity();
   Local parent = kNoLocal;  // its tree neighbour so far
-  Local slot = kNoLocal;  // place in the heap; kNoLocal before the push, kInTree after the pop
+  Local slot = kNoLocal;  // place in the heap; kNoLocal before the push (stale once in the tree)
+  bool in_tree() const { return key < 0; }
 };
 
 // Min-heap of a piece's points ordered by (key, index), with decrease-key. The index breaks
@@ -69,8 +69,7 @@ class FrontierHeap {
     const auto top = static_cast<Local>(heap_[0]);
     const std::uint64_t last = heap_[--size_];
     if (size_ > 0) sift_down(0, last);
-    nodes_[top].slot = kInTree;
-    nodes_[top].key = -1.0f;  // below every weight: no edge relaxes it again
+    nodes_[top].key = -1.0f;  // in the tree: below every weight, no edge relaxes it again
     return top;
   }
 
@@ -311,7 +310,7 @@ void orient_normals_ordered(const OrderedCloud& cloud, std::uint32_t graph_k,
     Vec3f* const nn = normals.data() + lo;
     std::vector<double>& vote = votes[piece];
     for (std::uint32_t seed = 0; seed < size; ++seed) {
-      if (nodes[seed].slot == kInTree) continue;
+      if (nodes[seed].in_tree()) continue;
       const auto id = static_cast<std::uint32_t>(vote.size());
       double sum = 0;
       nodes[seed].key = 0.0f;

@@ -3,7 +3,6 @@
 // unorganized points", SIGGRAPH 1992, section 3.2 (tangent planes), oriented as in section 3.3
 // (see normal_orientation.cpp).
 #include <algorithm>
-#include <array>
 #include <cmath>
 
 #include "pointillist/core/error.hpp"
@@ -12,12 +11,6 @@
 
 namespace pointillist {
 namespace {
-
-using D3 = std::array<double, 3>;
-D3 cross(const D3& x, const D3& y) {
-  return {x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]};
-}
-double dot(const D3& x, const D3& y) { return x[0] * y[0] + x[1] * y[1] + x[2] * y[2]; }
 
 // The unit eigenvector of the smallest eigenvalue λ1 of the symmetric 3x3 matrix
 // {a00 a01 a02 a11 a12 a22} (positive semi-definite, not zero). λ1 is the smallest root of the
@@ -54,36 +47,36 @@ Vec3f smallest_eigenvector(const double (&c)[6]) {
     if (!(next > lambda)) break;
     lambda = next;
   }
-  const D3 rows[3] = {{a00 - lambda, a01, a02}, {a01, a11 - lambda, a12}, {a02, a12, a22 - lambda}};
-  const D3 adjugate[3] = {cross(rows[1], rows[2]), cross(rows[2], rows[0]),
-                          cross(rows[0], rows[1])};
+  const Vec3d rows[3] = {
+      {a00 - lambda, a01, a02}, {a01, a11 - lambda, a12}, {a02, a12, a22 - lambda}};
+  const Vec3d adjugate[3] = {cross(rows[1], rows[2]), cross(rows[2], rows[0]),
+                             cross(rows[0], rows[1])};
   int longest = 0;
   for (int i = 1; i < 3; ++i) {
     if (dot(adjugate[i], adjugate[i]) > dot(adjugate[longest], adjugate[longest])) longest = i;
   }
-  D3 n;
+  Vec3d n;
   // m is about λ2·λ3: below 1e-10 t², the points lie on a line (or are thinner across it than
   // their rounding), and the adjugate would be mostly rounding. Any direction across the line
   // (the longest row of A - λ1 I) will do: across the axis it leans on least.
   if (!(m > 1e-10 * t * t) || !(dot(adjugate[longest], adjugate[longest]) > 0)) {
-    const D3* line = &rows[0];
-    for (const D3& r : rows) {
+    const Vec3d* line = &rows[0];
+    for (const Vec3d& r : rows) {
       if (dot(r, r) > dot(*line, *line)) line = &r;
     }
-    const D3& l = *line;
+    const Vec3d& l = *line;
     if (!(dot(l, l) > 0)) return {0, 0, 1};
-    const int axis = std::abs(l[0]) <= std::abs(l[1]) && std::abs(l[0]) <= std::abs(l[2]) ? 0
-                     : std::abs(l[1]) <= std::abs(l[2])                             ? 1
-                                                                                    : 2;
-    D3 e{0, 0, 0};
-    e[axis] = 1;
-    n = cross(l, e);
+    const double ax = std::abs(l.x), ay = std::abs(l.y), az = std::abs(l.z);
+    const Vec3d axis = ax <= ay && ax <= az ? Vec3d{1, 0, 0}
+                       : ay <= az           ? Vec3d{0, 1, 0}
+                                            : Vec3d{0, 0, 1};
+    n = cross(l, axis);
   } else {
-    const D3& b = adjugate[longest];  // the adjugate is symmetric: rows or columns alike
+    const Vec3d& b = adjugate[longest];  // the adjugate is symmetric: rows or columns alike
     n = {dot(adjugate[0], b), dot(adjugate[1], b), dot(adjugate[2], b)};
   }
   const double k = 1.0 / std::sqrt(dot(n, n));
-  return normalized(Vec3f{float(n[0] * k), float(n[1] * k), float(n[2] * k)});
+  return normalized(Vec3f{float(n.x * k), float(n.y * k), float(n.z * k)});
 }
 
 }  // namespace

@@ -31,9 +31,6 @@ using namespace pointillist::render_test;
 
 namespace {
 
-struct Vec3d {
-  double x, y, z;
-};
 Vec3d to_d(Vec3f v) { return {v.x, v.y, v.z}; }
 double dotd(Vec3d a, Vec3d b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 Vec3d unit(Vec3d a) {

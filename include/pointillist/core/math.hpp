@@ -61,6 +61,20 @@ inline bool is_finite(Vec3f a) {
   return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z);
 }
 
+// Double-precision vector for the geometry that needs it (bounding-sphere and eigenvector
+// solves, exact distances): the same operators as Vec3f, each evaluated in the same order.
+struct Vec3d {
+  double x = 0, y = 0, z = 0;
+};
+constexpr Vec3d to_double(Vec3f v) { return {v.x, v.y, v.z}; }
+constexpr Vec3d operator+(Vec3d a, Vec3d b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+constexpr Vec3d operator-(Vec3d a, Vec3d b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+constexpr Vec3d operator*(Vec3d a, double s) { return {a.x * s, a.y * s, a.z * s}; }
+constexpr double dot(Vec3d a, Vec3d b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+constexpr Vec3d cross(Vec3d a, Vec3d b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+
 // Axis-aligned bounding box. A default box is empty (lo > hi) and grows with `extend`.
 struct Aabb {
   Vec3f lo{std::numeric_limits<float>::max(), std::numeric_limits<float>::max(),
