@@ -52,6 +52,25 @@ struct ChunkPlan {
     }
     return j;
   }
+  // chunk_of, and in the same descent whether the point lies within `max_reach` of a split on
+  // its way (else for_near_chunks with that max_reach finds no chunk: it would follow only the
+  // point's own way down).
+  std::uint32_t chunk_of(const Vec3f& p, std::uint64_t index, float max_reach,
+                         bool& near_a_split) const {
+    const float q[3] = {p.x + 0.0f, p.y + 0.0f, p.z + 0.0f};
+    std::size_t j = 0;
+    bool near = false;
+    for (std::uint32_t l = 0; l < levels; ++l) {
+      const Split& s = splits[j];
+      const float c = q[s.axis];
+      const bool left = (c < s.value) | ((c == s.value) & (index < s.index));
+      // for_near_chunks' two tests (its coordinates keep -0; equal to +0 in every comparison)
+      near |= (c - max_reach <= s.value) & (c + max_reach >= s.value);
+      j = 2 * j + 2 - std::size_t{left};
+    }
+    near_a_split = near;
+    return static_cast<std::uint32_t>(j - splits.size());
+  }
   // Calls fn(chunk) for every chunk other than `own` whose box is nearer than `reach[chunk]`
   // to `p` (a halo point for it); `max_reach` bounds every reach.
   template <class Fn>

@@ -219,9 +219,11 @@ void scan_plan_distribute(MergedInputs& in, const WorkFolder& folder, const Conv
         };
         for (std::size_t i = begin; i < end; ++i) {
           const Vec3f& p = b.positions[i];
-          const std::uint32_t own = plan.chunk_of(p, first + i);
+          bool near_a_split = false;
+          const std::uint32_t own = plan.chunk_of(p, first + i, max_reach, near_a_split);
           const std::size_t at = add(own);
           encode_record(sh.layout, b, i, first + i, false, &s.records[at]);
+          if (!near_a_split) continue;
           plan.for_near_chunks(p, own, sh.reach, max_reach, [&](std::uint32_t c) {
             const std::size_t copy = add(c);
             std::memcpy(&s.records[copy], &s.records[at], size);

@@ -29,6 +29,9 @@ constexpr double kCellPoints = 8;
 constexpr std::size_t kMaxCandidates = 4096;
 // Below this many points the kd-tree answers every query.
 constexpr std::size_t kGridMinPoints = 64;
+// Up to this many misses of the grid are asked again of wider blocks before a kd-tree is built
+// over all the points for them.
+constexpr std::size_t kWideMisses = 4096;
 
 struct CloudAdaptor {
   std::span<const Vec3f> points;
@@ -365,6 +368,76 @@ void grid_queries(const CellGrid& g, std::size_t cell_begin, std::size_t cell_en
   }
 }
 
+// A miss of grid_queries asked again of the cells within `r` (> 1) of its own, which vouch for
+// it by the same reach as the 3x3x3 block: true when answered. So a few misses (a sparse edge of
+// a chunk's halo) need no kd-tree over all the points. At most kMaxWideCandidates candidates.
+constexpr std::size_t kMaxWideCandidates = 4 * kMaxCandidates;
+bool wide_block_query(const CellGrid& g, std::uint32_t j, std::uint32_t r,
+                      std::span<const Vec3f> tree_points, std::span<const Vec3f> points,
+                      const std::uint32_t* order, std::size_t k, std::uint32_t* result,
+                      float* result_d2, std::vector<Neighbour>& near) {
+  const Vec3f q = tree_points[j];
+  const std::uint64_t key = g.level * 3 >= 64 ? 0 : g.frame.code(q) >> (3 * g.level);
+  const std::uint32_t found = g.find(key);
+  if (found == 0) return false;  // (every point's cell is in the grid)
+  const std::uint64_t cell_key = g.key[found - 1];
+  const std::uint32_t a[3] = {compact_bits_21(cell_key), compact_bits_21(cell_key >> 1),
+                              compact_bits_21(cell_key >> 2)};
+  const std::uint32_t side = MortonFrame::kMaxCell >> g.level;
+  std::uint32_t lo[3], hi[3];
+  for (int axis = 0; axis < 3; ++axis) {
+    lo[axis] = a[axis] > r ? a[axis] - r : 0;
+    hi[axis] = std::min(side, a[axis] + r);
+  }
+  const std::uint64_t cells = std::uint64_t(hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) *
+                              (hi[2] - lo[2] + 1);
+  if (cells > kMaxWideCandidates) return false;
+  const auto original = [&](std::uint32_t i) { return order ? order[i] : i; };
+  near.clear();
+  for (std::uint32_t z = lo[2]; z <= hi[2]; ++z) {
+    for (std::uint32_t y = lo[1]; y <= hi[1]; ++y) {
+      for (std::uint32_t x = lo[0]; x <= hi[0]; ++x) {
+        const std::uint32_t c = g.find(morton_code(x, y, z));
+        if (c == 0) continue;
+        if (near.size() + (g.begin[c] - g.begin[c - 1]) > kMaxWideCandidates) return false;
+        for (std::uint32_t i = g.begin[c - 1]; i < g.begin[c]; ++i) {
+          if (i == j) continue;
+          const Vec3f p = tree_points[i];
+          near.push_back({squared_distance(q, p.x, p.y, p.z), original(i)});
+        }
+      }
+    }
+  }
+  if (near.size() < k) return false;
+  const auto closer = [](const Neighbour& x, const Neighbour& y) {
+    return x.d2 < y.d2 || (x.d2 == y.d2 && x.index < y.index);
+  };
+  std::nth_element(near.begin(), near.begin() + std::ptrdiff_t(k - 1), near.end(), closer);
+  const float cut = near[k - 1].d2;
+  // As in grid_queries: every point outside the cells lies at least this far from q.
+  const float u[3] = {(q.x - g.frame.lo.x) * g.frame.scale, (q.y - g.frame.lo.y) * g.frame.scale,
+                      (q.z - g.frame.lo.z) * g.frame.scale};
+  const double cell_units = double(1u << g.level), scale = g.frame.scale;
+  double reach = std::numeric_limits<double>::infinity();
+  for (int axis = 0; axis < 3; ++axis) {
+    if (lo[axis] > 0) reach = std::min(reach, double(u[axis]) - double(lo[axis]) * cell_units);
+    if (hi[axis] < side) {
+      reach = std::min(reach, (double(hi[axis]) + 1) * cell_units - double(u[axis]));
+    }
+  }
+  reach = reach - 2;
+  if (!(reach > 0) || !(double(cut) * scale * scale < reach * reach * (1 - 1e-5))) return false;
+  // The row: every candidate within the cut, by distance then index.
+  const auto end = std::partition(near.begin(), near.end(),
+                                  [&](const Neighbour& nb) { return nb.d2 <= cut; });
+  near.erase(end, near.end());
+  std::sort(near.begin(), near.end(), closer);
+  const std::uint32_t self = original(j);
+  finish_row(near, k, points, self, &result[std::size_t(self) * k],
+             result_d2 ? &result_d2[std::size_t(self) * k] : nullptr);
+  return true;
+}
+
 }  // namespace
 
 std::vector<std::uint32_t> k_nearest_neighbours(std::span<const Vec3f> points, ThreadPool& pool,
@@ -410,11 +483,36 @@ std::vector<std::uint32_t> k_nearest_neighbours(std::span<const Vec3f> points, T
       phase.advance(grid.begin[end] - grid.begin[begin] - task_missed[t].size());
     });
     for (const auto& t : task_missed) missed.insert(missed.end(), t.begin(), t.end());
+    if (options.paths) options.paths->grid += n - missed.size();
+    // Misses asked again of wider blocks (5^3, then 9^3 cells); the kd-tree takes the rest.
+    if (!missed.empty() && missed.size() <= kWideMisses) {
+      std::vector<std::uint8_t> answered(missed.size(), 0);
+      parallel_for(pool, missed.size(), 16, [&](std::size_t begin, std::size_t end) {
+        std::vector<Neighbour> near;
+        for (std::size_t at = begin; at < end; ++at) {
+          for (const std::uint32_t r : {2u, 4u}) {
+            if (wide_block_query(grid, missed[at], r, tree_points, points, order_map, k,
+                                 result.data(), result_d2, near)) {
+              answered[at] = 1;
+              break;
+            }
+          }
+        }
+      });
+      std::size_t kept = 0;
+      for (std::size_t at = 0; at < missed.size(); ++at) {
+        if (!answered[at]) missed[kept++] = missed[at];
+      }
+      phase.advance(missed.size() - kept);
+      if (options.paths) options.paths->wide += missed.size() - kept;
+      missed.resize(kept);
+    }
   } else {
     missed.resize(n);
     for (std::size_t j = 0; j < n; ++j) missed[j] = std::uint32_t(j);
   }
   if (missed.empty()) return result;
+  if (options.paths) options.paths->tree += missed.size();
 
   const CloudAdaptor adaptor{tree_points};
   const KdTree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(kLeafSize));

@@ -46,10 +46,11 @@ std::vector<float> brute_force_d2(const std::vector<Vec3f>& p, std::size_t i, st
 
 // Checks every row against brute force: the distances match the k smallest (so equal distances
 // may swap indices), indices are distinct, not the point itself, and really at those distances.
-void expect_matches_brute_force(const std::vector<Vec3f>& p, std::uint32_t k, unsigned threads) {
+void expect_matches_brute_force(const std::vector<Vec3f>& p, std::uint32_t k, unsigned threads,
+                                KnnPaths* paths = nullptr) {
   ThreadPool pool(threads);
   std::vector<float> d2;
-  const auto nb = k_nearest_neighbours(p, pool, {.k = k}, &d2);
+  const auto nb = k_nearest_neighbours(p, pool, {.k = k, .paths = paths}, &d2);
   ASSERT_EQ(nb.size(), p.size() * k);
   ASSERT_EQ(d2.size(), p.size() * k);
   for (std::size_t i = 0; i < p.size(); ++i) {
@@ -191,6 +192,40 @@ TEST(KNearestNeighbours, MatchesBruteForceOnASurfaceWithStrayPoints) {
   for (int i = 0; i < 60; ++i) p.push_back({8 * u(rng) - 4, 8 * u(rng) - 4, 8 * u(rng) - 4});
   std::shuffle(p.begin(), p.end(), rng);
   expect_matches_brute_force(p, 16, 2);
+}
+
+// Points along a line in a random direction, jittered: the grid's cells (about 8 points each)
+// lie along it, so a query near its cell's end sees too few points in its 3x3x3 block.
+std::vector<Vec3f> jittered_line(std::size_t n, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  const Vec3f dir = normalized(Vec3f{0.8f, 0.5f, 0.3f});
+  std::vector<Vec3f> p;
+  for (std::size_t i = 0; i < n; ++i) {
+    const float t = float(i) + 0.3f * u(rng);
+    p.push_back(dir * t + Vec3f{u(rng), u(rng), u(rng)} * 0.05f);
+  }
+  std::shuffle(p.begin(), p.end(), rng);
+  return p;
+}
+
+// The queries the 3x3x3 block cannot answer are answered from wider blocks, exactly.
+TEST(KNearestNeighbours, WiderBlocksAnswerTheBlocksMissesLikeBruteForce) {
+  KnnPaths paths;
+  expect_matches_brute_force(jittered_line(3000, 21), 24, 2, &paths);
+  EXPECT_GT(paths.wide, 0u);
+  EXPECT_EQ(paths.grid + paths.wide + paths.tree, 3000u);
+}
+
+// k = 100 reaches past the 9^3 block too: those queries go to the kd-tree, also when there are
+// more misses than the wider blocks are tried for (4,096).
+TEST(KNearestNeighbours, MissesOfEveryBlockGoToTheKdTreeLikeBruteForce) {
+  for (const std::size_t n : {std::size_t(2000), std::size_t(6000)}) {
+    KnnPaths paths;
+    expect_matches_brute_force(jittered_line(n, 23), 100, 2, &paths);
+    EXPECT_GT(paths.tree, 0u) << n << " points";
+    EXPECT_EQ(paths.grid + paths.wide + paths.tree, n) << n << " points";
+  }
 }
 
 // Forty copies of one point among others: each copy's 16 neighbours are 16 other copies, those

@@ -14,11 +14,19 @@
 
 namespace pointillist {
 
+// How many queries each search answered (for tests and benchmarks).
+struct KnnPaths {
+  std::uint64_t grid = 0;  // from their cell's 3x3x3 block
+  std::uint64_t wide = 0;  // from a wider block of cells around it
+  std::uint64_t tree = 0;  // from the kd-tree
+};
+
 struct KnnOptions {
   std::uint32_t k = 16;  // neighbours per point (the point itself not counted)
   // The caller has already put the points in spatial order (e.g. by `morton_order`): skip the
   // internal reordering. Queries on shuffled points with this set run several times slower.
   bool points_are_ordered = false;
+  KnnPaths* paths = nullptr;  // when not null, receives the count each search answered
 };
 
 // For every point, the indices of its k nearest other points (itself excluded), nearest first,
@@ -31,8 +39,10 @@ struct KnnOptions {
 // positions (x, then y, then z) make the cut, so the same neighbours are found in any subset of
 // the points that holds them; within a row, equal distances are ordered by index. (Queries are
 // answered from a grid of cells over the ordered points; a query whose k nearest could reach
-// beyond its cell's 3x3x3 block, a stray point in a sparse region, goes to a kd-tree, which
-// finds up to 9 points tied at the cut and cuts more as it finds them.) Copies of a point
+// beyond its cell's 3x3x3 block, a stray point in a sparse region, is asked again of the 5^3
+// and 9^3 blocks around it, then (or when there are more than 4,096 such queries) of a kd-tree
+// over all the points, which finds up to 9 points tied at the cut and cuts more as it finds
+// them.) Copies of a point
 // (distance 0) are neighbours like any other point. Parallel over points (progress phase
 // "neighbours"); the result does not depend on the thread count. Positions must be finite.
 // Memory: the result plus about 30 bytes per point for the grid (40 more while a kd-tree lives).
