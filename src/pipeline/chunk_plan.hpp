@@ -52,24 +52,37 @@ struct ChunkPlan {
     }
     return j;
   }
-  // chunk_of, and in the same descent whether the point lies within `max_reach` of a split on
-  // its way (else for_near_chunks with that max_reach finds no chunk: it would follow only the
-  // point's own way down).
-  std::uint32_t chunk_of(const Vec3f& p, std::uint64_t index, float max_reach,
-                         bool& near_a_split) const {
-    const float q[3] = {p.x + 0.0f, p.y + 0.0f, p.z + 0.0f};
-    std::size_t j = 0;
-    bool near = false;
-    for (std::uint32_t l = 0; l < levels; ++l) {
-      const Split& s = splits[j];
-      const float c = q[s.axis];
-      const bool left = (c < s.value) | ((c == s.value) & (index < s.index));
-      // for_near_chunks' two tests (its coordinates keep -0; equal to +0 in every comparison)
-      near |= (c - max_reach <= s.value) & (c + max_reach >= s.value);
-      j = 2 * j + 2 - std::size_t{left};
+  // chunk_of for the `count` (at most kBatch) points p[0..count) with the input indices
+  // first, first + 1, ..., into chunk[]; and, in the same descent, whether each lies within
+  // `max_reach` of a split on its way, into near_a_split[] (else for_near_chunks with that
+  // max_reach finds no chunk: it would follow only the point's own way down). The points go down
+  // together, level by level, so that their chains of dependent loads overlap.
+  static constexpr std::size_t kBatch = 8;
+  void chunks_of(const Vec3f* p, std::size_t count, std::uint64_t first, float max_reach,
+                 std::uint32_t* chunk, bool* near_a_split) const {
+    float q[kBatch][3];
+    std::size_t j[kBatch];
+    bool near[kBatch];
+    for (std::size_t b = 0; b < kBatch; ++b) {
+      const Vec3f& v = p[b < count ? b : 0];
+      q[b][0] = v.x + 0.0f, q[b][1] = v.y + 0.0f, q[b][2] = v.z + 0.0f;
+      j[b] = 0;
+      near[b] = false;
     }
-    near_a_split = near;
-    return static_cast<std::uint32_t>(j - splits.size());
+    for (std::uint32_t l = 0; l < levels; ++l) {
+      for (std::size_t b = 0; b < kBatch; ++b) {
+        const Split& s = splits[j[b]];
+        const float c = q[b][s.axis];
+        const bool left = (c < s.value) | ((c == s.value) & (first + b < s.index));
+        // for_near_chunks' two tests (its coordinates keep -0, equal to +0 in every comparison)
+        near[b] |= (c - max_reach <= s.value) & (c + max_reach >= s.value);
+        j[b] = 2 * j[b] + 2 - std::size_t{left};
+      }
+    }
+    for (std::size_t b = 0; b < count; ++b) {
+      chunk[b] = static_cast<std::uint32_t>(j[b] - splits.size());
+      near_a_split[b] = near[b];
+    }
   }
   // Calls fn(chunk) for every chunk other than `own` whose box is nearer than `reach[chunk]`
   // to `p` (a halo point for it); `max_reach` bounds every reach.

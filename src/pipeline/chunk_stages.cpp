@@ -217,19 +217,23 @@ void scan_plan_distribute(MergedInputs& in, const WorkFolder& folder, const Conv
           s.records.resize(s.records.size() + size);
           return s.records.size() - size;
         };
-        for (std::size_t i = begin; i < end; ++i) {
-          const Vec3f& p = b.positions[i];
-          bool near_a_split = false;
-          const std::uint32_t own = plan.chunk_of(p, first + i, max_reach, near_a_split);
-          const std::size_t at = add(own);
-          encode_record(sh.layout, b, i, first + i, false, &s.records[at]);
-          if (!near_a_split) continue;
-          plan.for_near_chunks(p, own, sh.reach, max_reach, [&](std::uint32_t c) {
-            const std::size_t copy = add(c);
-            std::memcpy(&s.records[copy], &s.records[at], size);
-            s.records[copy + 15] = 1;  // a halo point
-            ++s.halo;
-          });
+        std::uint32_t own[ChunkPlan::kBatch];
+        bool near_a_split[ChunkPlan::kBatch];
+        for (std::size_t i0 = begin; i0 < end; i0 += ChunkPlan::kBatch) {
+          const std::size_t batch = std::min(ChunkPlan::kBatch, end - i0);
+          plan.chunks_of(&b.positions[i0], batch, first + i0, max_reach, own, near_a_split);
+          for (std::size_t e = 0; e < batch; ++e) {
+            const std::size_t i = i0 + e;
+            const std::size_t at = add(own[e]);
+            encode_record(sh.layout, b, i, first + i, false, &s.records[at]);
+            if (!near_a_split[e]) continue;
+            plan.for_near_chunks(b.positions[i], own[e], sh.reach, max_reach, [&](std::uint32_t c) {
+              const std::size_t copy = add(c);
+              std::memcpy(&s.records[copy], &s.records[at], size);
+              s.records[copy + 15] = 1;  // a halo point
+              ++s.halo;
+            });
+          }
         }
       });
       pool.run(threads, [&](std::size_t t) {
