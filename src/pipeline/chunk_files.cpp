@@ -142,29 +142,34 @@ void write_splats(const std::string& path, const Splats& s) {
   if (!out) write_failed(path);
 }
 
-Splats read_splats(const std::string& path, std::size_t n, bool colors, bool index, bool piece) {
-  const std::vector<char> bytes = read_whole(path);
-  Splats s;
-  s.points.positions.resize(n);
-  s.points.normals.resize(n);
-  s.points.radii.resize(n);
-  if (colors) s.points.colors.resize(n);
-  if (index) s.index.resize(n);
-  if (piece) s.piece.resize(n);
+Splats read_splats(const std::string& path, std::size_t n, bool colors, bool index, bool piece,
+                   bool geometry) {
+  // Each array is read straight into its vector (no copy of the whole file first); those not
+  // asked for are skipped.
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (!in) throw IoError(path + ": cannot read a chunk file back");
   const std::size_t need = n * (28 + (colors ? 3 : 0) + (index ? 8 : 0) + (piece ? 4 : 0));
-  if (bytes.size() != need) throw IoError(path + ": a chunk file changed on disk");
-  const char* at = bytes.data();
-  const auto get = [&](auto& v) {
-    if (v.empty()) return;  // (an empty vector's data() may be null, which memcpy refuses)
-    std::memcpy(v.data(), at, v.size() * sizeof(v[0]));
-    at += v.size() * sizeof(v[0]);
+  if (static_cast<std::size_t>(in.tellg()) != need) {
+    throw IoError(path + ": a chunk file changed on disk");
+  }
+  in.seekg(0);
+  Splats s;
+  const auto get = [&](auto& v, bool wanted) {
+    const auto bytes = std::streamsize(n * sizeof(v[0]));
+    if (!wanted) {
+      in.seekg(bytes, std::ios::cur);
+      return;
+    }
+    v.resize(n);
+    if (n != 0) in.read(reinterpret_cast<char*>(v.data()), bytes);
   };
-  get(s.points.positions);
-  get(s.points.normals);
-  get(s.points.radii);
-  get(s.points.colors);
-  get(s.index);
-  get(s.piece);
+  get(s.points.positions, geometry);
+  get(s.points.normals, true);
+  get(s.points.radii, geometry);
+  if (colors) get(s.points.colors, geometry);
+  if (index) get(s.index, true);
+  if (piece) get(s.piece, true);
+  if (!in) throw IoError(path + ": cannot read a chunk file back");
   return s;
 }
 

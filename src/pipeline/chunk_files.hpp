@@ -79,7 +79,10 @@ struct Splats {
 
 // Throw IoError naming the file (a full disk: the error says so).
 void write_splats(const std::string& path, const Splats& s);
-Splats read_splats(const std::string& path, std::size_t n, bool colors, bool index, bool piece);
+// A file of write_splats with n splats, and colours, indices and pieces as said; without
+// `geometry`, only the normals (and the indices and pieces asked for) are read.
+Splats read_splats(const std::string& path, std::size_t n, bool colors, bool index, bool piece,
+                   bool geometry = true);
 
 // A halo point's view of its orientation, for the chunk that owns the point: its input index,
 // the chunk and piece that hold it as halo, and its normal there.

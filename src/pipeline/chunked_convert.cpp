@@ -270,28 +270,47 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
     OrientationStitcher stitcher;
     for (std::size_t c = 0; c < chunks; ++c) stitcher.add_chunk(c, votes[c]);
     ProgressPhase phase(progress, "orientation", n);
-    for (std::size_t c = 0; c < chunks; ++c) {
-      std::optional<Splats> s;
-      for (int rank = 0; rank < jobs.size(); ++rank) {
-        const std::string rel_path = folder->file(ChunkFiles::name(relations_kind(rank).c_str(), c));
-        if (!std::filesystem::exists(rel_path)) continue;
-        if (!s) {
-          s = read_splats(folder->file(ChunkFiles::name("chunk", c) + ".prepared"), own_count[c],
-                          colors, true, true);
+    // Each chunk's relations are matched to its splats (their normals, indices and pieces only)
+    // on every thread, a chunk a thread at a time, then given to the stitcher in chunk order.
+    struct Related {
+      std::uint32_t piece, other_chunk, other_piece;
+      bool agree;
+    };
+    const std::size_t threads = pool.thread_count();
+    std::vector<std::vector<Related>> related(threads);
+    for (std::size_t first = 0; first < chunks; first += threads) {
+      const std::size_t count = std::min(threads, chunks - first);
+      pool.run(count, [&](std::size_t t) {
+        const std::size_t c = first + t;
+        std::vector<Related>& out = related[t];
+        out.clear();
+        std::optional<Splats> s;
+        for (int rank = 0; rank < jobs.size(); ++rank) {
+          const std::string rel_path =
+              folder->file(ChunkFiles::name(relations_kind(rank).c_str(), c));
+          if (!std::filesystem::exists(rel_path)) continue;
+          if (!s) {
+            s = read_splats(folder->file(ChunkFiles::name("chunk", c) + ".prepared"),
+                            own_count[c], colors, true, true, false);
+          }
+          const std::vector<char> bytes = read_whole(rel_path);
+          std::filesystem::remove(rel_path);
+          for (std::size_t at = 0; at + sizeof(Relation) <= bytes.size(); at += sizeof(Relation)) {
+            Relation r;
+            std::memcpy(&r, bytes.data() + at, sizeof r);
+            const auto it = std::lower_bound(s->index.begin(), s->index.end(), r.index);
+            if (it == s->index.end() || *it != r.index) continue;
+            const std::size_t i = std::size_t(it - s->index.begin());
+            out.push_back({s->piece[i], r.chunk, r.piece, dot(s->points.normals[i], r.normal) >= 0});
+          }
         }
-        const std::vector<char> bytes = read_whole(rel_path);
-        std::filesystem::remove(rel_path);
-        for (std::size_t at = 0; at + sizeof(Relation) <= bytes.size(); at += sizeof(Relation)) {
-          Relation r;
-          std::memcpy(&r, bytes.data() + at, sizeof r);
-          const auto it = std::lower_bound(s->index.begin(), s->index.end(), r.index);
-          if (it == s->index.end() || *it != r.index) continue;
-          const std::size_t i = std::size_t(it - s->index.begin());
-          stitcher.relate(c, s->piece[i], r.chunk, r.piece,
-                          dot(s->points.normals[i], r.normal) >= 0);
+      });
+      for (std::size_t t = 0; t < count; ++t) {
+        for (const Related& x : related[t]) {
+          stitcher.relate(first + t, x.piece, x.other_chunk, x.other_piece, x.agree);
         }
+        phase.advance(plan.counts[first + t]);
       }
-      phase.advance(plan.counts[c]);
     }
     stitcher.solve();
     for (std::size_t c = 0; c < chunks; ++c) {
