@@ -116,6 +116,10 @@ struct ChunkPlan {
   }
 };
 
+// From this many points on, a level with fewer ranges than threads (the first) splits each
+// range on two threads.
+constexpr std::size_t kSplitOnTwoThreads = std::size_t{1} << 17;
+
 // A point of the plan: its position and input index.
 struct PlanPoint {
   Vec3f position;

@@ -111,6 +111,22 @@ TEST(ChunkPlan, InMemoryPlanIsTheHierarchysMedianSplits) {
   expect_plan(plan_chunks(p, 4, pool), brute_force(p, 4), p);
 }
 
+// From kSplitOnTwoThreads points on, the first level is split on two threads (a count of the
+// coordinates' top bits, a selection in one bucket, two partitions and a swap): the same plan,
+// with many ties at the median (x in steps of 1/1000), and when the median's bucket is too
+// large to copy (nine distinct x: one std::nth_element instead).
+TEST(ChunkPlan, FirstLevelOnTwoThreadsIsTheHierarchysMedianSplits) {
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<int> step(-5000, 5000);
+  std::uniform_real_distribution<float> fine(-1.0f, 1.0f);
+  std::vector<Vec3f> stepped(kSplitOnTwoThreads + 4321);
+  for (Vec3f& x : stepped) x = {float(step(rng)) / 1000.0f, 0.5f * fine(rng), 0.01f * fine(rng)};
+  for (const auto& p : {stepped, tied_points(kSplitOnTwoThreads + 77, 13)}) {
+    ThreadPool pool(2);
+    expect_plan(plan_chunks(p, 3, pool), brute_force(p, 3), p);
+  }
+}
+
 TEST(ChunkPlan, OnDiskPlanIsTheSamePlanWhateverItsMemory) {
   const PositionsOnDisk file(6001, 5);
   const auto& [dir, p, path, box] = file;
