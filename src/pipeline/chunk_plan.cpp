@@ -26,29 +26,35 @@ bool before_on(int axis, const PlanPoint& i, const PlanPoint& j) {
   return ci < cj || (ci == cj && i.index < j.index);
 }
 
-// The box of pts[b, e) (coordinates with -0 as +0), on `tasks` threads of the pool.
-void range_box(std::span<const PlanPoint> pts, std::size_t b, std::size_t e, std::size_t tasks,
-               ThreadPool& pool, float lo[3], float hi[3]) {
-  std::vector<std::array<float, 6>> part(tasks);
-  pool.run(tasks, [&](std::size_t t) {
-    std::array<float, 6>& x = part[t];
-    for (int a = 0; a < 3; ++a) {
-      x[std::size_t(a)] = std::numeric_limits<float>::infinity();
-      x[std::size_t(a) + 3] = -std::numeric_limits<float>::infinity();
-    }
-    for (std::size_t k = b + (e - b) * t / tasks; k < b + (e - b) * (t + 1) / tasks; ++k) {
-      const Vec3f& p = pts[k].position;
-      for (int a = 0; a < 3; ++a) {
-        const float c = p[a] + 0.0f;
-        x[std::size_t(a)] = std::min(x[std::size_t(a)], c);
-        x[std::size_t(a) + 3] = std::max(x[std::size_t(a) + 3], c);
-      }
-    }
-  });
+// The box of pts[b, e) (coordinates with -0 as +0).
+void range_box(std::span<const PlanPoint> pts, std::size_t b, std::size_t e, float lo[3],
+               float hi[3]) {
   for (int a = 0; a < 3; ++a) {
     lo[a] = std::numeric_limits<float>::infinity();
     hi[a] = -lo[a];
-    for (const auto& x : part) {
+  }
+  for (std::size_t k = b; k < e; ++k) {
+    const Vec3f& p = pts[k].position;
+    for (int a = 0; a < 3; ++a) {
+      const float c = p[a] + 0.0f;
+      lo[a] = std::min(lo[a], c);
+      hi[a] = std::max(hi[a], c);
+    }
+  }
+}
+
+// The same on every thread of the pool, a part each.
+void range_box(std::span<const PlanPoint> pts, std::size_t b, std::size_t e, ThreadPool& pool,
+               float lo[3], float hi[3]) {
+  const std::size_t tasks = pool.thread_count();
+  std::vector<std::array<float, 6>> part(tasks);
+  pool.run(tasks, [&](std::size_t t) {
+    range_box(pts, b + (e - b) * t / tasks, b + (e - b) * (t + 1) / tasks, &part[t][0],
+              &part[t][3]);
+  });
+  range_box(pts, 0, 0, lo, hi);  // the empty box, then the parts' together
+  for (const auto& x : part) {
+    for (int a = 0; a < 3; ++a) {
       lo[a] = std::min(lo[a], x[std::size_t(a)]);
       hi[a] = std::max(hi[a], x[std::size_t(a) + 3]);
     }
@@ -63,12 +69,13 @@ void range_box(std::span<const PlanPoint> pts, std::size_t b, std::size_t e, std
 // that go right trade places with the right half's that go left (as many: the halves meet at
 // mid). Nothing when the bucket holds more than a sixteenth of the range (many equal
 // coordinates): its copy would take memory the plan is not allowed.
-std::optional<PlanPoint> split_on_two_threads(std::vector<PlanPoint>& pts, std::size_t b, std::size_t mid,
-                               std::size_t e, int axis, ThreadPool& pool) {
+std::optional<PlanPoint> split_on_two_threads(std::vector<PlanPoint>& pts, std::size_t b,
+                                              std::size_t mid, std::size_t e, int axis,
+                                              ThreadPool& pool) {
+  // (ordered_key keeps the coordinates' order, so its top bits bucket them in that order.)
   const auto key = [axis](const PlanPoint& p) { return ordered_key(p.position[axis] + 0.0f); };
-  const auto before = [&](const PlanPoint& i, const PlanPoint& j) {
-    const std::uint32_t ki = key(i), kj = key(j);
-    return ki < kj || (ki == kj && i.index < j.index);
+  const auto before = [axis](const PlanPoint& i, const PlanPoint& j) {
+    return before_on(axis, i, j);
   };
   const std::size_t bounds[3] = {b, mid, e};
   std::vector<std::vector<std::uint32_t>> counts(2, std::vector<std::uint32_t>(1 << 16, 0));
@@ -145,62 +152,42 @@ ChunkPlan plan_chunks(std::vector<PlanPoint> pts, std::uint32_t levels, ThreadPo
     const std::size_t nodes = bounds.size() - 1;
     const std::size_t first = (std::size_t{1} << level) - 1;
     std::vector<std::size_t> next(2 * nodes + 1);
-    if (nodes < pool.thread_count() && pool.thread_count() >= 2 && n >= kSplitOnTwoThreads) {
-      // Fewer ranges than threads (the first level): each range's box and split on two.
-      for (std::size_t r = 0; r < nodes; ++r) {
-        const std::size_t b = bounds[r], e = bounds[r + 1];
-        float lo[3], hi[3];
-        range_box(pts, b, e, pool.thread_count(), pool, lo, hi);
-        const float extent[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
-        const int axis = longest(extent);
-        const std::size_t mid = b + (e - b) / 2;
-        std::optional<PlanPoint> pivot = split_on_two_threads(pts, b, mid, e, axis, pool);
-        if (!pivot) {
-          std::nth_element(pts.begin() + std::ptrdiff_t(b), pts.begin() + std::ptrdiff_t(mid),
-                           pts.begin() + std::ptrdiff_t(e),
-                           [axis](const PlanPoint& i, const PlanPoint& j) {
-                             return before_on(axis, i, j);
-                           });
-          pivot = pts[mid];
-        }
-        plan.splits[first + r] = {static_cast<std::uint8_t>(axis),
-                                  pivot->position[axis] + 0.0f, pivot->index};
-        next[2 * r] = b;
-        next[2 * r + 1] = mid;
-        next[2 * r + 2] = e;
-      }
-      bounds = std::move(next);
-      continue;
-    }
-    pool.run(nodes, [&](std::size_t r) {
+    // Fewer ranges than threads (the first level) on many points: a range at a time, its box
+    // and split on two threads; else a range a thread.
+    const bool on_two =
+        nodes < pool.thread_count() && pool.thread_count() >= 2 && n >= kSplitOnTwoThreads;
+    const auto split_range = [&](std::size_t r) {
       const std::size_t b = bounds[r], e = bounds[r + 1];
       float lo[3], hi[3];
-      for (int a = 0; a < 3; ++a) {
-        lo[a] = std::numeric_limits<float>::infinity();
-        hi[a] = -lo[a];
-      }
-      for (std::size_t k = b; k < e; ++k) {
-        const Vec3f& p = pts[k].position;
-        for (int a = 0; a < 3; ++a) {
-          const float c = p[a] + 0.0f;
-          lo[a] = std::min(lo[a], c);
-          hi[a] = std::max(hi[a], c);
-        }
+      if (on_two) {
+        range_box(pts, b, e, pool, lo, hi);
+      } else {
+        range_box(pts, b, e, lo, hi);
       }
       const float extent[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
       const int axis = longest(extent);
       const std::size_t mid = b + (e - b) / 2;
-      const auto before = [axis](const PlanPoint& i, const PlanPoint& j) {
-        return before_on(axis, i, j);
-      };
-      std::nth_element(pts.begin() + std::ptrdiff_t(b), pts.begin() + std::ptrdiff_t(mid),
-                       pts.begin() + std::ptrdiff_t(e), before);
-      plan.splits[first + r] = {static_cast<std::uint8_t>(axis),
-                                pts[mid].position[axis] + 0.0f, pts[mid].index};
+      std::optional<PlanPoint> pivot;
+      if (on_two) pivot = split_on_two_threads(pts, b, mid, e, axis, pool);
+      if (!pivot) {
+        std::nth_element(pts.begin() + std::ptrdiff_t(b), pts.begin() + std::ptrdiff_t(mid),
+                         pts.begin() + std::ptrdiff_t(e),
+                         [axis](const PlanPoint& i, const PlanPoint& j) {
+                           return before_on(axis, i, j);
+                         });
+        pivot = pts[mid];
+      }
+      plan.splits[first + r] = {static_cast<std::uint8_t>(axis), pivot->position[axis] + 0.0f,
+                                pivot->index};
       next[2 * r] = b;
       next[2 * r + 1] = mid;
       next[2 * r + 2] = e;
-    });
+    };
+    if (on_two) {
+      for (std::size_t r = 0; r < nodes; ++r) split_range(r);
+    } else {
+      pool.run(nodes, split_range);
+    }
     bounds = std::move(next);
   }
   const std::size_t chunks = bounds.size() - 1;

@@ -32,6 +32,13 @@ struct ChunkPlan {
   std::vector<Aabb> boxes;          // box of each chunk's points
 
   std::size_t chunk_count() const { return counts.size(); }
+  // Whether the point (coordinate c on the split's axis, -0 taken as +0; input index) goes left.
+  static bool goes_left(const Split& s, float c, std::uint64_t index) {
+    return (c < s.value) | ((c == s.value) & (index < s.index));
+  }
+  // Whether points within `reach` of coordinate c may lie left of the split, and right of it.
+  static bool reaches_left(const Split& s, float c, float reach) { return c - reach <= s.value; }
+  static bool reaches_right(const Split& s, float c, float reach) { return c + reach >= s.value; }
   // The chunk of a point.
   std::uint32_t chunk_of(const Vec3f& p, std::uint64_t index) const {
     return static_cast<std::uint32_t>(node_below(p, index, levels) - splits.size());
@@ -47,8 +54,7 @@ struct ChunkPlan {
     for (std::uint32_t l = 0; l < depth; ++l) {
       const Split& s = splits[j];
       const float c = q[s.axis];
-      const bool left = (c < s.value) | ((c == s.value) & (index < s.index));
-      j = 2 * j + 2 - std::size_t{left};
+      j = 2 * j + 2 - std::size_t{goes_left(s, c, index)};
     }
     return j;
   }
@@ -73,10 +79,9 @@ struct ChunkPlan {
       for (std::size_t b = 0; b < kBatch; ++b) {
         const Split& s = splits[j[b]];
         const float c = q[b][s.axis];
-        const bool left = (c < s.value) | ((c == s.value) & (first + b < s.index));
         // for_near_chunks' two tests (its coordinates keep -0, equal to +0 in every comparison)
-        near[b] |= (c - max_reach <= s.value) & (c + max_reach >= s.value);
-        j[b] = 2 * j[b] + 2 - std::size_t{left};
+        near[b] |= reaches_left(s, c, max_reach) & reaches_right(s, c, max_reach);
+        j[b] = 2 * j[b] + 2 - std::size_t{goes_left(s, c, first + b)};
       }
     }
     for (std::size_t b = 0; b < count; ++b) {
@@ -111,8 +116,12 @@ struct ChunkPlan {
     }
     const Split& s = splits[j];
     const float c = p[s.axis];
-    if (c - max_reach <= s.value) visit_near(2 * j + 1, level + 1, p, own, reach, max_reach, fn);
-    if (c + max_reach >= s.value) visit_near(2 * j + 2, level + 1, p, own, reach, max_reach, fn);
+    if (reaches_left(s, c, max_reach)) {
+      visit_near(2 * j + 1, level + 1, p, own, reach, max_reach, fn);
+    }
+    if (reaches_right(s, c, max_reach)) {
+      visit_near(2 * j + 2, level + 1, p, own, reach, max_reach, fn);
+    }
   }
 };
 

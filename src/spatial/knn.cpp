@@ -51,6 +51,11 @@ struct Neighbour {
   std::uint32_t index;  // in the caller's order
 };
 
+// Nearer first, equal distances by index: the order of a row.
+bool closer(const Neighbour& x, const Neighbour& y) {
+  return x.d2 < y.d2 || (x.d2 == y.d2 && x.index < y.index);
+}
+
 // The squared distance as the kd-tree's metric sums it (x, then y, then z), so both paths give
 // the same bits (this file is compiled without floating-point contraction).
 inline float squared_distance(const Vec3f& q, float x, float y, float z) {
@@ -111,6 +116,37 @@ struct CellGrid {
   std::vector<std::uint32_t> table;     // open addressing: cell index + 1, or 0
   std::uint64_t mask = 0;
 
+  // True when every point outside the cells within r of cell a (on each axis) lies farther
+  // from q than sqrt(d2), so those cells hold all of q's neighbours up to there: measured in
+  // cells of the Morton grid, less 2 for the rounding of both cell assignments; sides at the
+  // grid's edge have no points beyond them.
+  bool vouches(Vec3f q, const std::array<std::uint32_t, 3>& a, std::uint32_t r,
+               float d2) const {
+    const std::uint32_t side = MortonFrame::kMaxCell >> level;
+    const double cell_units = double(1u << level), scale = frame.scale;
+    const float u[3] = {(q.x - frame.lo.x) * frame.scale, (q.y - frame.lo.y) * frame.scale,
+                        (q.z - frame.lo.z) * frame.scale};
+    double reach = std::numeric_limits<double>::infinity();
+    for (int axis = 0; axis < 3; ++axis) {
+      if (a[axis] >= r) {
+        reach = std::min(reach, double(u[axis]) - (double(a[axis]) - r) * cell_units);
+      }
+      if (a[axis] + r <= side) {
+        reach = std::min(reach, (double(a[axis]) + r + 1) * cell_units - double(u[axis]));
+      }
+    }
+    reach = reach - 2;
+    return reach > 0 && double(d2) * scale * scale < reach * reach * (1 - 1e-5);
+  }
+
+  // A point's Morton code at the grid's level, and a cell's coordinates from it.
+  std::uint64_t cell_key(std::uint64_t code) const {
+    return 3 * level >= 64 ? 0 : code >> (3 * level);
+  }
+  static std::array<std::uint32_t, 3> cell_coords(std::uint64_t key) {
+    return {compact_bits_21(key), compact_bits_21(key >> 1), compact_bits_21(key >> 2)};
+  }
+
   std::uint64_t slot(std::uint64_t k) const { return (k * 0x9E3779B97F4A7C15ULL) >> 20 & mask; }
   std::uint32_t find(std::uint64_t k) const {  // cell index + 1, or 0
     for (std::uint64_t h = slot(k);; h = (h + 1) & mask) {
@@ -142,11 +178,10 @@ bool build_grid(std::span<const Vec3f> points, CellGrid& g) {
     cells -= differ[std::size_t(m)];
     g.level = m + 1;
   }
-  const int shift = 3 * g.level;
   g.key.clear();
   g.begin.clear();
   for (std::size_t i = 0; i < n; ++i) {
-    const std::uint64_t k = shift >= 64 ? 0 : code[i] >> shift;
+    const std::uint64_t k = g.cell_key(code[i]);
     if (g.key.empty() || g.key.back() != k) {
       g.key.push_back(k);
       g.begin.push_back(std::uint32_t(i));
@@ -221,10 +256,8 @@ void grid_queries(const CellGrid& g, std::size_t cell_begin, std::size_t cell_en
   std::vector<std::uint32_t> ki;
   const auto original = [&](std::uint32_t j) { return order ? order[j] : j; };
   const std::uint32_t side = MortonFrame::kMaxCell >> g.level;  // the last cell on each axis
-  const float cell_units = float(1u << g.level);
   for (std::size_t c = cell_begin; c < cell_end; ++c) {
-    const std::uint32_t a[3] = {compact_bits_21(g.key[c]), compact_bits_21(g.key[c] >> 1),
-                                compact_bits_21(g.key[c] >> 2)};
+    const std::array<std::uint32_t, 3> a = CellGrid::cell_coords(g.key[c]);
     // Gather the block: the cell itself first (its points are the likeliest neighbours).
     std::array<std::uint32_t, 27> block;
     std::size_t block_cells = 0;
@@ -260,12 +293,8 @@ void grid_queries(const CellGrid& g, std::size_t cell_begin, std::size_t cell_en
     near.resize(m);
     cd.resize(m);
     kd.resize(m + kLanes), ki.resize(m + kLanes);
-    const double scale = g.frame.scale;
     for (std::uint32_t j = g.begin[c]; j < g.begin[c + 1]; ++j) {
       const Vec3f q = tree_points[j];
-      const float u[3] = {(q.x - g.frame.lo.x) * g.frame.scale,
-                          (q.y - g.frame.lo.y) * g.frame.scale,
-                          (q.z - g.frame.lo.z) * g.frame.scale};
       // The candidates within a limit (the last query's k-th distance, grown), but the point
       // itself: when they are k or more, they hold the k nearest and all tied with the k-th.
       // Else the limit grows until they do (all m - 1 of them at the end).
@@ -290,10 +319,7 @@ void grid_queries(const CellGrid& g, std::size_t cell_begin, std::size_t cell_en
       constexpr std::size_t kMostRanked = 128;
       if (count > kMostRanked) {
         for (std::size_t t = 0; t < count; ++t) near[t] = Neighbour{kd[t], ki[t]};
-        std::sort(near.begin(), near.begin() + std::ptrdiff_t(count),
-                  [](const Neighbour& x, const Neighbour& y) {
-                    return x.d2 < y.d2 || (x.d2 == y.d2 && x.index < y.index);
-                  });
+        std::sort(near.begin(), near.begin() + std::ptrdiff_t(count), closer);
       } else {
         // kd and ki have room for m + kLanes entries: count + 7 of them fit.
         const std::size_t padded = (count + kLanes - 1) & ~(kLanes - 1);
@@ -341,21 +367,7 @@ void grid_queries(const CellGrid& g, std::size_t cell_begin, std::size_t cell_en
       const float cut = near[k - 1].d2;
       guess = cut;
 
-      // Every point outside the block lies at least this far from q, in cells of the Morton
-      // grid (less 2 for the rounding of both cell assignments); sides at the grid's edge
-      // have no points beyond them.
-      double reach = std::numeric_limits<double>::infinity();
-      for (int axis = 0; axis < 3; ++axis) {
-        if (a[axis] > 0) {
-          reach = std::min(reach, double(u[axis]) - (double(a[axis]) - 1) * cell_units);
-        }
-        if (a[axis] < side) {
-          reach = std::min(reach, (double(a[axis]) + 2) * cell_units - double(u[axis]));
-        }
-      }
-      reach = reach - 2;
-      if (!(reach > 0) ||
-          !(double(cut) * scale * scale < reach * reach * (1 - 1e-5))) {
+      if (!g.vouches(q, a, 1, cut)) {
         missed.push_back(j);
         continue;
       }
@@ -377,21 +389,13 @@ bool wide_block_query(const CellGrid& g, std::uint32_t j, std::uint32_t r,
                       const std::uint32_t* order, std::size_t k, std::uint32_t* result,
                       float* result_d2, std::vector<Neighbour>& near) {
   const Vec3f q = tree_points[j];
-  const std::uint64_t key = g.level * 3 >= 64 ? 0 : g.frame.code(q) >> (3 * g.level);
-  const std::uint32_t found = g.find(key);
-  if (found == 0) return false;  // (every point's cell is in the grid)
-  const std::uint64_t cell_key = g.key[found - 1];
-  const std::uint32_t a[3] = {compact_bits_21(cell_key), compact_bits_21(cell_key >> 1),
-                              compact_bits_21(cell_key >> 2)};
+  const std::array<std::uint32_t, 3> a = CellGrid::cell_coords(g.cell_key(g.frame.code(q)));
   const std::uint32_t side = MortonFrame::kMaxCell >> g.level;
   std::uint32_t lo[3], hi[3];
   for (int axis = 0; axis < 3; ++axis) {
     lo[axis] = a[axis] > r ? a[axis] - r : 0;
     hi[axis] = std::min(side, a[axis] + r);
   }
-  const std::uint64_t cells = std::uint64_t(hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) *
-                              (hi[2] - lo[2] + 1);
-  if (cells > kMaxWideCandidates) return false;
   const auto original = [&](std::uint32_t i) { return order ? order[i] : i; };
   near.clear();
   for (std::uint32_t z = lo[2]; z <= hi[2]; ++z) {
@@ -409,24 +413,9 @@ bool wide_block_query(const CellGrid& g, std::uint32_t j, std::uint32_t r,
     }
   }
   if (near.size() < k) return false;
-  const auto closer = [](const Neighbour& x, const Neighbour& y) {
-    return x.d2 < y.d2 || (x.d2 == y.d2 && x.index < y.index);
-  };
   std::nth_element(near.begin(), near.begin() + std::ptrdiff_t(k - 1), near.end(), closer);
   const float cut = near[k - 1].d2;
-  // As in grid_queries: every point outside the cells lies at least this far from q.
-  const float u[3] = {(q.x - g.frame.lo.x) * g.frame.scale, (q.y - g.frame.lo.y) * g.frame.scale,
-                      (q.z - g.frame.lo.z) * g.frame.scale};
-  const double cell_units = double(1u << g.level), scale = g.frame.scale;
-  double reach = std::numeric_limits<double>::infinity();
-  for (int axis = 0; axis < 3; ++axis) {
-    if (lo[axis] > 0) reach = std::min(reach, double(u[axis]) - double(lo[axis]) * cell_units);
-    if (hi[axis] < side) {
-      reach = std::min(reach, (double(hi[axis]) + 1) * cell_units - double(u[axis]));
-    }
-  }
-  reach = reach - 2;
-  if (!(reach > 0) || !(double(cut) * scale * scale < reach * reach * (1 - 1e-5))) return false;
+  if (!g.vouches(q, a, r, cut)) return false;
   // The row: every candidate within the cut, by distance then index.
   const auto end = std::partition(near.begin(), near.end(),
                                   [&](const Neighbour& nb) { return nb.d2 <= cut; });
