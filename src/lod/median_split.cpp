@@ -179,15 +179,24 @@ class Splitter {
 
 std::vector<std::uint32_t> median_split_order(std::span<const Vec3f> positions, ThreadPool& pool,
                                               std::size_t grain, Progress& progress,
-                                              std::size_t morton_labels_from) {
+                                              std::size_t morton_labels_from,
+                                              const std::vector<std::uint32_t>* morton) {
   const std::size_t n = positions.size();
   std::vector<std::uint32_t> order(n);
   if (n == 0) return order;
   grain = std::max<std::size_t>(grain, 2);
   // Labels on many points: ranks along a Morton curve (input[rank] = input index,
   // label[input index] = rank).
-  std::vector<std::uint32_t> input;
-  if (n >= morton_labels_from) input = morton_order(positions, pool);
+  std::vector<std::uint32_t> own;
+  std::span<const std::uint32_t> input;
+  if (n >= morton_labels_from) {
+    if (morton && morton->size() == n) {
+      input = *morton;
+    } else {
+      own = morton_order(positions, pool);
+      input = own;
+    }
+  }
   Splitter splitter(n, order.data(), input.empty() ? nullptr : input.data());
   {
     std::vector<std::uint32_t> label(input.size());

@@ -210,7 +210,8 @@ SphereTree build_sphere_tree(const PointSet& points, ThreadPool& pool, Progress&
     for (std::uint32_t i = 0; i < n; ++i) order[i] = i;
   } else {
     order = lod_detail::median_split_order(points.positions, pool, options.parallel_grain_points,
-                                           progress, options.morton_labels_from);
+                                           progress, options.morton_labels_from,
+                                           options.morton_order);
   }
 
   tree.nodes.resize(shape.node_count);

@@ -208,8 +208,12 @@ ConvertResult convert_points(PointSet points, std::span<const std::string> input
   };
   // A mesh goes to write_qs as read: like qsplat_make, it computes normals and radii from the
   // faces itself (that is what makes the file byte-identical to the original tool's).
+  // The Morton order of a cloud's neighbour search, which the hierarchy reuses.
+  std::vector<std::uint32_t> morton;
   if (!(to_qs && points.is_mesh())) {
-    prepare_splats(points, pool, progress, o.prepare);
+    PrepareOptions prepare = o.prepare;
+    if (to_ptl) prepare.morton_order = &morton;
+    prepare_splats(points, pool, progress, prepare);
     phase_done("prepare");
   } else if (o.prepare.normals != NormalSource::Auto || o.prepare.radius_scale != 1.0f ||
              o.prepare.k != PrepareOptions{}.k || o.prepare.drop_outliers) {
@@ -235,8 +239,11 @@ ConvertResult convert_points(PointSet points, std::span<const std::string> input
     points.triangles = {};
     if (!keep_faces) faces = {};
     std::vector<std::uint32_t> split_order;
-    const SphereTree tree =
-        build_sphere_tree(points, pool, progress, {}, keep_faces ? &split_order : nullptr);
+    SphereTreeOptions tree_options;
+    tree_options.morton_order = &morton;
+    const SphereTree tree = build_sphere_tree(points, pool, progress, tree_options,
+                                              keep_faces ? &split_order : nullptr);
+    morton = {};
     if (keep_faces) faces = leaf_triangles(tree.view(), split_order, faces);
     split_order = {};
     phase_done("hierarchy");

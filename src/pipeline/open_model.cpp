@@ -153,10 +153,17 @@ Model Model::from_scans(std::span<const std::string> paths, const OpenModelOptio
                        .has_colors = points.has_colors(),
                        .has_radii = points.has_radii(),
                        .is_mesh = points.is_mesh()};
-  prepare_splats(points, pool, progress, options.prepare);
+  // The Morton order of a cloud's neighbour search, which the hierarchy reuses.
+  std::vector<std::uint32_t> morton;
+  PrepareOptions prepare = options.prepare;
+  prepare.morton_order = &morton;
+  prepare_splats(points, pool, progress, prepare);
   std::vector<std::uint32_t> split_order;
-  model.built_ = build_sphere_tree(points, pool, progress, {},
+  SphereTreeOptions tree_options;
+  tree_options.morton_order = &morton;
+  model.built_ = build_sphere_tree(points, pool, progress, tree_options,
                                    points.is_mesh() ? &split_order : nullptr);
+  morton = {};
   model.view_ = model.built_.view();
   if (points.is_mesh()) model.triangles_ = leaf_triangles(model.view_, split_order, points.triangles);
   model.paging_reason_ = "in memory: built from the scan";

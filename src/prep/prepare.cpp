@@ -164,8 +164,10 @@ void prepare_splats(PointSet& points, ThreadPool& pool, Progress& progress,
         cloud, kRadiusNeighbours, options.coverage * options.radius_scale, options.outlier_ratio,
         pool, progress);
     points.radii = prep_detail::to_caller_order<float>(cloud, radii, pool);
+    if (options.morton_order) *options.morton_order = std::move(cloud.order);
     return;
   }
+  if (options.morton_order && want_pca) *options.morton_order = std::move(cloud.order);
   ProgressPhase phase(progress, "radii", n);
   if (points.has_radii()) {
     const float scale = options.radius_scale;

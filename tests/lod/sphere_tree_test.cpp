@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "pointillist/core/morton.hpp"
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -423,6 +425,14 @@ TEST(SphereTree, TiesInEveryRangeGoToTheLowerIndexWithMortonLabels) {
     build_sphere_tree(pts, pool, Progress::none(),
                       {.parallel_grain_points = 16, .morton_labels_from = 0}, &split_order);
     EXPECT_EQ(split_order, expected) << threads << " threads";
+    // The same with the points' Morton order given (as prepare_splats hands it over).
+    const std::vector<std::uint32_t> morton = morton_order(pts.positions, pool);
+    std::vector<std::uint32_t> given_order;
+    build_sphere_tree(pts, pool, Progress::none(),
+                      {.parallel_grain_points = 16, .morton_labels_from = 0,
+                       .morton_order = &morton},
+                      &given_order);
+    EXPECT_EQ(given_order, expected) << threads << " threads, Morton order given";
   }
 }
 

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "pointillist/core/error.hpp"
+#include "pointillist/core/morton.hpp"
 #include "pointillist/scene/analytic.hpp"
 
 using namespace pointillist;
@@ -99,6 +100,25 @@ TEST(PrepareSplats, PointCloudKeepsEveryPointAndGetsPcaNormalsAndCloudRadii) {
     const float mean = (d[0] + d[1] + d[2] + d[3] + d[4]) / 5.0f;
     EXPECT_NEAR(p.radii[i], mean * 1.5f * 2.0f, 1e-5f) << "point " << i;
   }
+}
+
+TEST(PrepareSplats, HandsOverTheMortonOrderOfItsNeighbourSearch) {
+  // A cloud (PCA normals and radii), also after outliers are dropped: the Morton order of the
+  // points it returns. A mesh (no neighbour search): none.
+  const SurfaceSamples s = sample_scene(sphere_scene(2.0f), 3000, 32);
+  ThreadPool pool(2);
+  for (const bool drop : {false, true}) {
+    PointSet p = s.points;
+    p.positions.push_back({40, 40, 40});  // far from the sphere: an outlier
+    std::vector<std::uint32_t> morton{7};
+    prepare_splats(p, pool, Progress::none(), {.drop_outliers = drop, .morton_order = &morton});
+    ASSERT_EQ(p.size(), drop ? 3000u : 3001u);
+    EXPECT_EQ(morton, morton_order(p.positions, pool)) << (drop ? "outliers dropped" : "kept");
+  }
+  PointSet mesh = rectangle_with_strays();
+  std::vector<std::uint32_t> morton{7};
+  prepare_splats(mesh, pool, Progress::none(), {.morton_order = &morton});
+  EXPECT_EQ(morton, std::vector<std::uint32_t>{7});
 }
 
 TEST(PrepareSplats, PcaOnAMeshKeepsMeshRadii) {

@@ -73,6 +73,10 @@ struct SphereTreeOptions {
   // flags it reads by point stay in cache (20 M points: 0.6-0.7x its time; below about 8 M the
   // ordering costs more than it saves). Only changes speed, never the result.
   std::size_t morton_labels_from = std::size_t{1} << 23;
+  // The points' morton_order when the caller has it (prepare_splats makes it for a cloud:
+  // PrepareOptions::morton_order), used instead of computing it again; null: computed when
+  // needed. Must be morton_order of these very points.
+  const std::vector<std::uint32_t>* morton_order = nullptr;
   // The points are already in the order the median splits put them in (a build's `split_order`
   // applied to its points): the partition is skipped, and the tree is the one that build made.
   bool presorted = false;

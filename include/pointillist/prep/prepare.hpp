@@ -43,6 +43,10 @@ struct PrepareOptions {
   // When set and the normals are found by PCA: each point's connected component of the
   // orientation graph (components are oriented each on its own), in the points' order.
   std::vector<std::uint32_t>* orientation_components = nullptr;
+  // When set and a neighbour search ran (PCA normals or radii of a cloud): the points' Morton
+  // order it made (morton_order of the prepared points), for build_sphere_tree to reuse
+  // (SphereTreeOptions::morton_order); else left as it is.
+  std::vector<std::uint32_t>* morton_order = nullptr;
   // Names the input in error messages (e.g. the file path).
   std::string input_name = "the input";
 };
