@@ -25,6 +25,9 @@
 namespace pointillist::lod_detail {
 namespace {
 
+// From this many points a given Morton order names the points (median_split_order).
+constexpr std::size_t kGivenLabelsFrom = std::size_t{1} << 16;
+
 // A point's coordinate as an unsigned integer of the same order (-0 counts as +0).
 std::uint32_t ordered_bits(float v) { return ordered_key(v + 0.0f); }
 
@@ -187,15 +190,16 @@ std::vector<std::uint32_t> median_split_order(std::span<const Vec3f> positions, 
   grain = std::max<std::size_t>(grain, 2);
   // Labels on many points: ranks along a Morton curve (input[rank] = input index,
   // label[input index] = rank).
+  // A Morton order the caller already has costs nothing: it is used from far fewer points
+  // (clouds in input order, 1 M points: 0.5-0.7x the time; a mesh in its own, coherent order:
+  // the same time).
   std::vector<std::uint32_t> own;
   std::span<const std::uint32_t> input;
-  if (n >= morton_labels_from) {
-    if (morton && morton->size() == n) {
-      input = *morton;
-    } else {
-      own = morton_order(positions, pool);
-      input = own;
-    }
+  if (morton && morton->size() == n && n >= kGivenLabelsFrom) {
+    input = *morton;
+  } else if (n >= morton_labels_from) {
+    own = morton_order(positions, pool);
+    input = own;
   }
   Splitter splitter(n, order.data(), input.empty() ? nullptr : input.data());
   {

@@ -436,6 +436,29 @@ TEST(SphereTree, TiesInEveryRangeGoToTheLowerIndexWithMortonLabels) {
   }
 }
 
+TEST(SphereTree, AGivenOrderOfThePointsNamesThemWithoutChangingTheSplits) {
+  // 70,000 points (a given order is used from 65,536) on a coarse grid, so that coordinates tie
+  // at every level; the split order against the brute-force median splits, with the points'
+  // Morton order given and with a permutation that has nothing spatial about it.
+  PointSet pts = box_points(70000, 22, {1, 1, 1});
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const std::size_t j = (i * 7919) % pts.size();
+    pts.positions[i] = {float(j % 40), float(j / 40 % 50), float(j / 2000 % 35)};
+  }
+  std::vector<std::uint32_t> all(pts.size()), expected;
+  std::iota(all.begin(), all.end(), 0u);
+  expected_leaf_order(pts, all, expected);
+  ThreadPool pool(2);
+  std::vector<std::uint32_t> scrambled(pts.size());
+  for (std::size_t r = 0; r < pts.size(); ++r) scrambled[r] = std::uint32_t((r * 4001) % pts.size());
+  for (const auto& given : {morton_order(pts.positions, pool), scrambled}) {
+    std::vector<std::uint32_t> split_order;
+    build_sphere_tree(pts, pool, Progress::none(),
+                      {.parallel_grain_points = 1000, .morton_order = &given}, &split_order);
+    EXPECT_EQ(split_order, expected);
+  }
+}
+
 TEST(SphereTree, SameBitsForAnyThreadCount) {
   const PointSet pts = sphere_points(8000, 10, true);
   const SphereTreeOptions fine{.parallel_grain_points = 100};

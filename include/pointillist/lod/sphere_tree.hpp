@@ -74,8 +74,9 @@ struct SphereTreeOptions {
   // ordering costs more than it saves). Only changes speed, never the result.
   std::size_t morton_labels_from = std::size_t{1} << 23;
   // The points' morton_order when the caller has it (prepare_splats makes it for a cloud:
-  // PrepareOptions::morton_order), used instead of computing it again; null: computed when
-  // needed. Must be morton_order of these very points.
+  // PrepareOptions::morton_order): the partition then names points by it from 65,536 points
+  // (it costs nothing), whatever morton_labels_from says. Any permutation of the points gives
+  // the same tree; a spatial order makes it faster. Null: computed when needed.
   const std::vector<std::uint32_t>* morton_order = nullptr;
   // The points are already in the order the median splits put them in (a build's `split_order`
   // applied to its points): the partition is skipped, and the tree is the one that build made.
