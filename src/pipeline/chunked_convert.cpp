@@ -205,6 +205,8 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
       prepare.orientation_centre = sh.centroid;
       prepare.input_name = sh.input_name;
       prepare.orientation_components = &s.piece;
+      std::vector<std::uint32_t> morton;  // of the chunk and its halo
+      prepare.morton_order = &morton;
       prepare_splats(s.points, chunk_pool, Progress::none(), prepare);
       if (!s.piece.empty()) {
         pieces = true;
@@ -222,16 +224,27 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
         const std::lock_guard<std::mutex> lock(relations_mutex);
         for (const auto& [owner, r] : halo) relations.append(owner, &r, sizeof r);
       }
-      // Own splats only.
+      // Own splats only; the Morton order of the chunk and its halo, less the halo, still orders
+      // them along the curve (the hierarchy's partition reads it).
+      std::vector<std::uint32_t> kept(own.size());
       std::size_t k = 0;
       for (std::size_t i = 0; i < own.size(); ++i) {
         if (!own[i]) continue;
+        kept[i] = std::uint32_t(k);
         s.index[k] = s.index[i];
         if (!s.piece.empty()) s.piece[k] = s.piece[i];
         ++k;
       }
       s.index.resize(k);
       if (!s.piece.empty()) s.piece.resize(k);
+      if (morton.size() == own.size()) {
+        std::size_t r = 0;
+        for (const std::uint32_t i : morton) {
+          if (own[i]) morton[r++] = kept[i];
+        }
+        morton.resize(r);
+        s.morton = std::move(morton);
+      }
       keep_points(s.points, own);
       own_count[c] = k;
       write_splats(folder->file(ChunkFiles::name("chunk", c) + ".prepared"), s);
@@ -352,8 +365,10 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
         }
       }
       std::vector<std::uint32_t> order;
+      SphereTreeOptions tree_options;
+      tree_options.morton_order = &s.morton;
       const SphereTree tree =
-          build_sphere_tree(s.points, chunk_pool, Progress::none(), {}, &order);
+          build_sphere_tree(s.points, chunk_pool, Progress::none(), tree_options, &order);
       summaries[c] = summarize_ptl_v2_subtree(tree, v2);
       boxes[c] = tree.bounds;
       Splats sorted;
