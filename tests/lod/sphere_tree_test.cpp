@@ -2,8 +2,6 @@
 
 #include <gtest/gtest.h>
 
-#include "pointillist/core/morton.hpp"
-
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -17,6 +15,7 @@
 
 #include "lod/sphere_points.hpp"
 #include "pointillist/core/error.hpp"
+#include "pointillist/core/morton.hpp"
 
 namespace pointillist {
 namespace {
@@ -408,46 +407,46 @@ TEST(SphereTree, MedianTiesGoToTheLowerIndex) {
   }
 }
 
-TEST(SphereTree, TiesInEveryRangeGoToTheLowerIndexWithMortonLabels) {
-  // Coordinates on a coarse grid tie at every level, down to the three-point ranges, whose
-  // split compares input indices; the Morton ranks would order the tied points otherwise.
-  PointSet pts = box_points(1000, 21, {1, 1, 1});
+// `count` points (prime to 7919) on an a × b × c grid of unit steps, in a scrambled order (with
+// copies when count > a b c), so that coordinates tie at every level of the splits.
+PointSet tied_grid(std::size_t count, std::size_t a, std::size_t b, std::size_t c,
+                   std::uint64_t seed) {
+  PointSet pts = box_points(count, seed, {1, 1, 1});
   for (std::size_t i = 0; i < pts.size(); ++i) {
     const std::size_t j = (i * 7919) % pts.size();
-    pts.positions[i] = {float(j % 4), float(j / 4 % 5), float(j / 20 % 3)};
+    pts.positions[i] = {float(j % a), float(j / a % b), float(j / (a * b) % c)};
   }
+  return pts;
+}
+
+// The brute-force median splits' order of all the points.
+std::vector<std::uint32_t> expected_split_order(const PointSet& pts) {
   std::vector<std::uint32_t> all(pts.size()), expected;
   std::iota(all.begin(), all.end(), 0u);
   expected_leaf_order(pts, all, expected);
+  return expected;
+}
+
+TEST(SphereTree, TiesInEveryRangeGoToTheLowerIndexWithMortonLabels) {
+  // Coordinates on a coarse grid tie at every level, down to the three-point ranges, whose
+  // split compares input indices; the Morton ranks would order the tied points otherwise.
+  const PointSet pts = tied_grid(1000, 4, 5, 3, 21);
+  const std::vector<std::uint32_t> expected = expected_split_order(pts);
   for (unsigned threads : {1u, 2u}) {
     ThreadPool pool(threads);
     std::vector<std::uint32_t> split_order;
     build_sphere_tree(pts, pool, Progress::none(),
                       {.parallel_grain_points = 16, .morton_labels_from = 0}, &split_order);
     EXPECT_EQ(split_order, expected) << threads << " threads";
-    // The same with the points' Morton order given (as prepare_splats hands it over).
-    const std::vector<std::uint32_t> morton = morton_order(pts.positions, pool);
-    std::vector<std::uint32_t> given_order;
-    build_sphere_tree(pts, pool, Progress::none(),
-                      {.parallel_grain_points = 16, .morton_labels_from = 0,
-                       .morton_order = &morton},
-                      &given_order);
-    EXPECT_EQ(given_order, expected) << threads << " threads, Morton order given";
   }
 }
 
 TEST(SphereTree, AGivenOrderOfThePointsNamesThemWithoutChangingTheSplits) {
-  // 70,000 points (a given order is used from 65,536) on a coarse grid, so that coordinates tie
-  // at every level; the split order against the brute-force median splits, with the points'
-  // Morton order given and with a permutation that has nothing spatial about it.
-  PointSet pts = box_points(70000, 22, {1, 1, 1});
-  for (std::size_t i = 0; i < pts.size(); ++i) {
-    const std::size_t j = (i * 7919) % pts.size();
-    pts.positions[i] = {float(j % 40), float(j / 40 % 50), float(j / 2000 % 35)};
-  }
-  std::vector<std::uint32_t> all(pts.size()), expected;
-  std::iota(all.begin(), all.end(), 0u);
-  expected_leaf_order(pts, all, expected);
+  // 70,000 points (a given order is used from 65,536) tied on a grid; the split order against
+  // the brute-force median splits, with the points' Morton order given and with a permutation
+  // that has nothing spatial about it.
+  const PointSet pts = tied_grid(70000, 40, 50, 35, 22);
+  const std::vector<std::uint32_t> expected = expected_split_order(pts);
   ThreadPool pool(2);
   std::vector<std::uint32_t> scrambled(pts.size());
   for (std::size_t r = 0; r < pts.size(); ++r) scrambled[r] = std::uint32_t((r * 4001) % pts.size());
