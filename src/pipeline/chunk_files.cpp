@@ -139,7 +139,6 @@ void write_splats(const std::string& path, const Splats& s) {
   put(s.points.colors);
   put(s.index);
   put(s.piece);
-  put(s.morton);
   if (!out) write_failed(path);
 }
 
@@ -150,9 +149,9 @@ Splats read_splats(const std::string& path, std::size_t n, bool colors, bool ind
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) throw IoError(path + ": cannot read a chunk file back");
   const std::size_t need = n * (28 + (colors ? 3 : 0) + (index ? 8 : 0) + (piece ? 4 : 0));
-  const auto size = static_cast<std::size_t>(in.tellg());
-  const bool morton = size == need + 4 * n && n > 0;  // the order follows the other arrays
-  if (size != need && !morton) throw IoError(path + ": a chunk file changed on disk");
+  if (static_cast<std::size_t>(in.tellg()) != need) {
+    throw IoError(path + ": a chunk file changed on disk");
+  }
   in.seekg(0);
   Splats s;
   const auto get = [&](auto& v, bool wanted) {
@@ -170,7 +169,6 @@ Splats read_splats(const std::string& path, std::size_t n, bool colors, bool ind
   if (colors) get(s.points.colors, geometry);
   if (index) get(s.index, true);
   if (piece) get(s.piece, true);
-  if (morton) get(s.morton, geometry);
   if (!in) throw IoError(path + ": cannot read a chunk file back");
   return s;
 }

@@ -70,20 +70,17 @@ PointSet read_chunk(const std::string& path, const RecordLayout& l, bool colors,
                     std::vector<std::uint8_t>& own, std::vector<std::uint64_t>& index);
 
 // A chunk's splats (position, normal, radius, colour; and, between the passes, each one's input
-// index and orientation piece, and an order of them along a Morton curve for the hierarchy's
-// partition) as arrays, in order.
+// index and orientation piece) as arrays, in order.
 struct Splats {
   PointSet points;
   std::vector<std::uint64_t> index;
   std::vector<std::uint32_t> piece;
-  std::vector<std::uint32_t> morton;
 };
 
 // Throw IoError naming the file (a full disk: the error says so).
 void write_splats(const std::string& path, const Splats& s);
-// A file of write_splats with n splats, and colours, indices and pieces as said (and a Morton
-// order when the file's size says so); without `geometry`, only the normals (and the indices
-// and pieces asked for) are read.
+// A file of write_splats with n splats, and colours, indices and pieces as said; without
+// `geometry`, only the normals (and the indices and pieces asked for) are read.
 Splats read_splats(const std::string& path, std::size_t n, bool colors, bool index, bool piece,
                    bool geometry = true);
 

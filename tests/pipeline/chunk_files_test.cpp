@@ -1,6 +1,5 @@
 // The chunked conversion's splat files (private to the pipeline module): what is written comes
-// back, with the arrays asked for; the Morton order travels when the file holds one, which its
-// size tells; a file of any other size is named as changed.
+// back, with the arrays asked for; a file of another size is named as changed.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -14,7 +13,7 @@
 namespace pointillist::chunking {
 namespace {
 
-Splats some_splats(std::size_t n, bool morton) {
+Splats some_splats(std::size_t n) {
   Splats s;
   for (std::size_t i = 0; i < n; ++i) {
     const float f = float(i);
@@ -24,39 +23,35 @@ Splats some_splats(std::size_t n, bool morton) {
     s.points.colors.push_back({std::uint8_t(i), std::uint8_t(2 * i), 7});
     s.index.push_back(1000 + 3 * i);
     s.piece.push_back(std::uint32_t(i % 2));
-    if (morton) s.morton.push_back(std::uint32_t(n - 1 - i));
   }
   return s;
 }
 
-TEST(ChunkFiles, SplatsComeBackWithTheirMortonOrderWhenTheFileHoldsOne) {
+TEST(ChunkFiles, SplatsComeBackWithTheArraysAskedFor) {
   testing::TempDir dir;
   const std::string path = dir.file("s.prepared");
-  for (const bool morton : {false, true}) {
-    const Splats s = some_splats(5, morton);
-    write_splats(path, s);
-    const Splats all = read_splats(path, 5, true, true, true);
-    EXPECT_EQ(all.points.positions, s.points.positions);
-    EXPECT_EQ(all.points.normals, s.points.normals);
-    EXPECT_EQ(all.points.radii, s.points.radii);
-    EXPECT_EQ(all.points.colors, s.points.colors);
-    EXPECT_EQ(all.index, s.index);
-    EXPECT_EQ(all.piece, s.piece);
-    EXPECT_EQ(all.morton, (morton ? std::vector<std::uint32_t>{4, 3, 2, 1, 0}
-                                  : std::vector<std::uint32_t>{}));
-    // Normals, indices and pieces only: no geometry, no order.
-    const Splats some = read_splats(path, 5, true, true, true, false);
-    EXPECT_TRUE(some.points.positions.empty());
-    EXPECT_TRUE(some.morton.empty());
-    EXPECT_EQ(some.points.normals, s.points.normals);
-    EXPECT_EQ(some.piece, s.piece);
-  }
+  const Splats s = some_splats(5);
+  write_splats(path, s);
+  const Splats all = read_splats(path, 5, true, true, true);
+  EXPECT_EQ(all.points.positions, s.points.positions);
+  EXPECT_EQ(all.points.normals, s.points.normals);
+  EXPECT_EQ(all.points.radii, s.points.radii);
+  EXPECT_EQ(all.points.colors, s.points.colors);
+  EXPECT_EQ(all.index, s.index);
+  EXPECT_EQ(all.piece, s.piece);
+  // Normals, indices and pieces only: no geometry.
+  const Splats some = read_splats(path, 5, true, true, true, false);
+  EXPECT_TRUE(some.points.positions.empty());
+  EXPECT_TRUE(some.points.radii.empty());
+  EXPECT_EQ(some.points.normals, s.points.normals);
+  EXPECT_EQ(some.index, s.index);
+  EXPECT_EQ(some.piece, s.piece);
 }
 
 TEST(ChunkFiles, ASplatFileOfAnotherSizeIsNamedAsChanged) {
   testing::TempDir dir;
   const std::string path = dir.file("s.prepared");
-  write_splats(path, some_splats(5, true));
+  write_splats(path, some_splats(5));
   std::ofstream(path, std::ios::binary | std::ios::app).write("x", 1);
   try {
     read_splats(path, 5, true, true, true);
