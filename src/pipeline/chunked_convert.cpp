@@ -352,7 +352,7 @@ ConvertResult convert_chunked(std::span<const std::string> inputs, const std::st
           }
         }
       }
-      // A cloud whose neighbours were searched (no normals or radii in its records) comes in
+      // A cloud whose neighbours were searched (its records lack normals or radii) comes in
       // its input's order, which need not follow space: the partition names its points by
       // their Morton order (1 M points in input order: 0.02 s to compute, 0.08 s less to
       // split). A mesh's vertices come in the mesh's order, coherent already.

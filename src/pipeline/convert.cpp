@@ -206,10 +206,10 @@ ConvertResult convert_points(PointSet points, std::span<const std::string> input
     result.phase_seconds.emplace_back(name, seconds_since(phase_start));
     phase_start = std::chrono::steady_clock::now();
   };
-  // A mesh goes to write_qs as read: like qsplat_make, it computes normals and radii from the
-  // faces itself (that is what makes the file byte-identical to the original tool's).
   // The Morton order of a cloud's neighbour search, which the hierarchy reuses.
   std::vector<std::uint32_t> morton;
+  // A mesh goes to write_qs as read: like qsplat_make, it computes normals and radii from the
+  // faces itself (that is what makes the file byte-identical to the original tool's).
   if (!(to_qs && points.is_mesh())) {
     PrepareOptions prepare = o.prepare;
     if (to_ptl) prepare.morton_order = &morton;
