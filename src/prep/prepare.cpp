@@ -164,20 +164,20 @@ void prepare_splats(PointSet& points, ThreadPool& pool, Progress& progress,
         cloud, kRadiusNeighbours, options.coverage * options.radius_scale, options.outlier_ratio,
         pool, progress);
     points.radii = prep_detail::to_caller_order<float>(cloud, radii, pool);
-    if (options.morton_order) *options.morton_order = std::move(cloud.order);
-    return;
-  }
-  if (options.morton_order && want_pca) *options.morton_order = std::move(cloud.order);
-  ProgressPhase phase(progress, "radii", n);
-  if (points.has_radii()) {
-    const float scale = options.radius_scale;
-    parallel_for(pool, n, kGrain, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) points.radii[i] *= scale;
-    });
   } else {
-    points.radii = mesh_radii(points.positions, points.triangles, options.radius_scale, pool);
+    ProgressPhase phase(progress, "radii", n);
+    if (points.has_radii()) {
+      const float scale = options.radius_scale;
+      parallel_for(pool, n, kGrain, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) points.radii[i] *= scale;
+      });
+    } else {
+      points.radii = mesh_radii(points.positions, points.triangles, options.radius_scale, pool);
+    }
+    phase.advance(n);
   }
-  phase.advance(n);
+  // The neighbour search's order, when one ran.
+  if (options.morton_order && !cloud.order.empty()) *options.morton_order = std::move(cloud.order);
 }
 
 void prepare_mesh_vertices(PointSet& mesh, ThreadPool& pool, Progress& progress,
