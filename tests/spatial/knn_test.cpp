@@ -73,6 +73,26 @@ TEST(KNearestNeighbours, MatchesBruteForceOnRandomPoints) {
   expect_matches_brute_force(random_points(2000, 7), 16, 2);
 }
 
+TEST(KNearestNeighbours, MatchesBruteForceOnManyPointsInSampledRows) {
+  // 200,000 points, a grid of about 25,000 cells answered on two threads in many tasks; every
+  // 401st row against brute force.
+  const std::vector<Vec3f> p = random_points(200'000, 17);
+  const std::uint32_t k = 12;
+  ThreadPool pool(2);
+  std::vector<float> d2;
+  const auto nb = k_nearest_neighbours(p, pool, {.k = k}, &d2);
+  for (std::size_t i = 0; i < p.size(); i += 401) {
+    const std::vector<float> oracle = brute_force_d2(p, i, k);
+    for (std::uint32_t j = 0; j < k; ++j) {
+      const std::uint32_t m = nb[i * k + j];
+      ASSERT_LT(m, p.size());
+      EXPECT_NE(m, i) << "point " << i;
+      EXPECT_EQ(d2[i * k + j], length_squared(p[m] - p[i])) << "point " << i;
+      EXPECT_EQ(d2[i * k + j], oracle[j]) << "point " << i << " neighbour " << j;
+    }
+  }
+}
+
 TEST(KNearestNeighbours, MatchesBruteForceWithEqualDistancesOnAGrid) {
   expect_matches_brute_force(grid_points(12), 8, 2);
 }
