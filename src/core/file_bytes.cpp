@@ -81,7 +81,7 @@ void FileBytes::release() {
   size_ = 0;
 }
 
-FileBytes FileBytes::map(const std::string& path) {
+FileBytes FileBytes::map(const std::string& path, Use use) {
   const Fd fd(::open(path.c_str(), O_RDONLY | O_CLOEXEC));
   if (fd.get() < 0) throw IoError(errno_message("cannot open " + path));
   struct stat st {};
@@ -109,10 +109,12 @@ FileBytes FileBytes::map(const std::string& path) {
   const auto size = static_cast<std::size_t>(st.st_size);
   bytes.file_size_ = size;
   if (size == 0) return bytes;
-  // MAP_POPULATE maps the whole page-cache range at once instead of faulting page by page.
-  void* map = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd.get(), 0);
+  // For a whole read, MAP_POPULATE maps the whole page-cache range at once instead of faulting
+  // page by page (and reads the file in, when it is not in the page cache yet).
+  const int populate = use == Use::Whole ? MAP_POPULATE : 0;
+  void* map = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE | populate, fd.get(), 0);
   if (map != MAP_FAILED) {
-    ::madvise(map, size, MADV_SEQUENTIAL);
+    if (use == Use::Whole) ::madvise(map, size, MADV_SEQUENTIAL);
     bytes.map_ = map;
     bytes.map_size_ = size;
     bytes.data_ = static_cast<const char*>(map);

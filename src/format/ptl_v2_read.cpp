@@ -41,7 +41,8 @@ std::unique_ptr<PtlV2File> PtlV2File::open(const std::string& path) {
   std::unique_ptr<PtlV2File> file(new PtlV2File);
   file->path_ = path;
   file->map_ = std::make_unique<Mapping>();
-  file->map_->bytes = FileBytes::map(path);
+  // Pages are read as they are used: a render of a large model reads a small part of it.
+  file->map_->bytes = FileBytes::map(path, FileBytes::Use::Parts);
   const std::string_view view = file->map_->bytes.view();
   const auto* b = reinterpret_cast<const std::uint8_t*>(view.data());
   const std::uint64_t size = view.size();
@@ -468,7 +469,7 @@ void PtlV2File::pack_page(std::uint32_t page, PackedPage& out, const PagePrefix&
 PtlModel read_ptl(const std::string& path) {
   std::uint32_t version = 0;
   {
-    const FileBytes bytes = FileBytes::map(path);
+    const FileBytes bytes = FileBytes::map(path, FileBytes::Use::Parts);  // 12 bytes are read
     const std::string_view v = bytes.view();
     if (v.size() >= 12 && std::memcmp(v.data(), ptl::kMagic, sizeof ptl::kMagic) == 0) {
       version = load_u32(reinterpret_cast<const std::uint8_t*>(v.data()) + 8);

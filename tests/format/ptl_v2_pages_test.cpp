@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <random>
 #include <string>
 #include <vector>
@@ -210,4 +211,40 @@ TEST(PtlV2Pages, RandomCorruptionIsRejectedOrRenderedNeverMisread) {
     }
   }
   EXPECT_GT(rejected, 10u);  // most flips in records give other valid codes
+}
+
+namespace {
+
+// The file pages mapped into this process (RssFile of /proc/self/status), in bytes.
+std::uint64_t mapped_file_bytes() {
+  std::ifstream in("/proc/self/status");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("RssFile:", 0) == 0) return std::stoull(line.substr(8)) * 1024;
+  }
+  return 0;
+}
+
+}  // namespace
+
+TEST(PtlV2Pages, OpeningAModelReadsItsHeaderAndPageTableNotItsPages) {
+  // A render of a model larger than memory must not read it all first: opening maps the file
+  // and reads the header and page table; the pages come in when used. The file is in the page
+  // cache (just written), so a mapping that is filled at once shows as that many bytes mapped;
+  // touching the header and the metadata at its end maps up to about 512 KB around each here.
+  TempDir dir;
+  const std::string path = dir.file("m.ptl");
+  write_ptl_v2(path, scene_tree(800000, 67, false), "", {.page_bytes = 32768});
+  const std::uint64_t size = read_bytes(path).size();
+  ASSERT_GT(size, 4u << 20);
+  PtlV2File::open(path);  // the code that opens a file, mapped in before measuring
+  const std::uint64_t before = mapped_file_bytes();
+  const auto file = PtlV2File::open(path);
+  const std::uint64_t opened = mapped_file_bytes();
+  EXPECT_LT(opened, before + size / 3) << "opening a " << size << "-byte model mapped "
+                                       << opened - before << " bytes of it";
+  // Reading every page does map them (the measure sees the pages).
+  const SphereTree tree = file->decode_all();
+  EXPECT_GT(mapped_file_bytes(), before + size / 2);
+  EXPECT_EQ(tree.nodes.size(), file->node_count());
 }

@@ -31,8 +31,13 @@ class FileBytes {
   bool was_compressed() const { return was_compressed_; }
   std::uint64_t file_size() const { return file_size_; }
 
-  // Maps `path` read-only (reads it where mmap fails). Throws IoError.
-  static FileBytes map(const std::string& path);
+  // How a mapped file will be read: Whole, all of it from start to end (the mapping is filled at
+  // once and read ahead); Parts, only the parts asked for (a paged model: each page is read from
+  // disk when first touched, so opening a model larger than memory reads its header, not all of
+  // it).
+  enum class Use { Whole, Parts };
+  // Maps `path` read-only (reads it whole where mmap fails). Throws IoError.
+  static FileBytes map(const std::string& path, Use use = Use::Whole);
   // The inflated contents of `compressed` (a gzip file read from `path`). `on_compressed_bytes`
   // (may be empty) hears how many compressed bytes were consumed, in chunks. Throws FormatError
   // for corrupt or truncated data.
