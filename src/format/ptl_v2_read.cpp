@@ -467,14 +467,7 @@ void PtlV2File::pack_page(std::uint32_t page, PackedPage& out, const PagePrefix&
 }
 
 PtlModel read_ptl(const std::string& path) {
-  std::uint32_t version = 0;
-  {
-    const FileBytes bytes = FileBytes::map(path, FileBytes::Use::Parts);  // 12 bytes are read
-    const std::string_view v = bytes.view();
-    if (v.size() >= 12 && std::memcmp(v.data(), ptl::kMagic, sizeof ptl::kMagic) == 0) {
-      version = load_u32(reinterpret_cast<const std::uint8_t*>(v.data()) + 8);
-    }
-  }
+  const std::uint32_t version = ptl_file_version(path);
   PtlModel model;
   if (version == kPtlV2Version) {
     const auto file = PtlV2File::open(path);
