@@ -2,6 +2,8 @@
 // of its sharp-features section. Private to the format module.
 #pragma once
 
+#include <atomic>
+#include <cstdint>
 #include <mutex>
 
 #include "ptl_v2_features.hpp"
@@ -15,6 +17,11 @@ struct PtlV2File::Mapping {
   std::once_flag features_once;
   ptl2::FeatureSection features;
   TreeFeatures summary;  // surface count, options, statistics
+  // Bytes of pages copied out since the mapping was last let go of (PtlV2File::forget_page).
+  std::atomic<std::uint64_t> copied_since_forget{0};
 };
+
+// How many bytes of copied pages a PtlV2File lets stay mapped before it lets go of them all.
+inline constexpr std::uint64_t kForgetBytes = 64 << 20;
 
 }  // namespace pointillist

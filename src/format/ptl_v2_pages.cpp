@@ -56,6 +56,13 @@ class PtlV2Pages final : public PageSource {
   SphereTreeView summary() const override { return summary_; }
 
   void load(std::uint32_t page, HierarchyPage& out, const PagePrefix& prefix) const override {
+    load_packed(page, out, prefix);
+    // Packed now: the file's bytes need not stay mapped beside the copy.
+    file_.forget_page(page);
+  }
+
+ private:
+  void load_packed(std::uint32_t page, HierarchyPage& out, const PagePrefix& prefix) const {
     out.nodes.clear();
     out.child_page.clear();
     PackedPage& packed = out.packed;
@@ -114,7 +121,6 @@ class PtlV2Pages final : public PageSource {
     }
   }
 
- private:
   // A page's first levels were packed: the features are the whole page's cut to the loaded
   // records.
   void load_prefix_rest(std::uint32_t page, HierarchyPage& out) const {

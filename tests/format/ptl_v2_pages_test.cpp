@@ -248,3 +248,34 @@ TEST(PtlV2Pages, OpeningAModelReadsItsHeaderAndPageTableNotItsPages) {
   EXPECT_GT(mapped_file_bytes(), before + size / 2);
   EXPECT_EQ(tree.nodes.size(), file->node_count());
 }
+
+TEST(PtlV2Pages, LoadedPagesDoNotStayMappedBesideTheirPackedCopies) {
+  // A paged render copies each page it loads into a packed page, which the page cache counts
+  // against its cap. The file's bytes it read must not stay in the process too: loading every
+  // page of a model (in the page cache, just written) leaves under a third of the file mapped,
+  // where reading the pages through the mapping alone maps over half of it (the measure sees
+  // them, as the test above checks).
+  TempDir dir;
+  const std::string path = dir.file("m.ptl");
+  write_ptl_v2(path, scene_tree(800000, 71, true), "", {.page_bytes = 32768});
+  const std::uint64_t size = read_bytes(path).size();
+  ASSERT_GT(size, 4u << 20);
+  const auto file = PtlV2File::open(path);
+  const auto source = ptl_v2_page_source(*file);
+  ASSERT_GT(source->page_count(), 100u);
+  HierarchyPage first;
+  source->load(0, first, {});  // the code that loads, mapped in before measuring
+  const std::uint64_t before = mapped_file_bytes();
+  std::uint64_t nodes = 0;
+  for (std::uint32_t q = 0; q < source->page_count(); ++q) {
+    HierarchyPage page;  // (one that holds records is taken as an earlier prefix of q)
+    source->load(q, page, {});
+    nodes += page.packed.records.size();
+    EXPECT_EQ(page.packed.records.size(), file->page_info(q).node_count);
+  }
+  EXPECT_EQ(nodes, file->node_count());
+  const std::uint64_t after = mapped_file_bytes();
+  EXPECT_LT(after, before + size / 3) << "loading every page of a " << size
+                                      << "-byte model left " << after - before
+                                      << " bytes of it mapped";
+}

@@ -252,6 +252,11 @@ class PtlV2File {
   // and the link index of the last copied level points past them (see HierarchyPage). Records
   // already in `out` (an earlier prefix of this page) are kept, not read again.
   void pack_page(std::uint32_t page, PackedPage& out, const PagePrefix& prefix = {}) const;
+  // Says that page `page`'s bytes were copied out: a paged render keeps its pages packed, and
+  // the mapped file pages it read would otherwise stay resident beside them. Every 64 MB of
+  // such pages (or an eighth of the file), the whole mapping is let go of (FileBytes::forget).
+  // Thread-safe.
+  void forget_page(std::uint32_t page) const;
   // Record k (< node count) of page `page`, its bits 0..31 as stored (not validated).
   std::uint32_t page_record(std::uint32_t page, std::uint32_t k) const;
 
