@@ -143,25 +143,27 @@ void PackedPage::index_links(std::uint32_t first_level_count) {
   // Blocks below last_level_begin, then blocks from it; the +2 of memory_bytes covers the
   // partial block on either side.
   link_base.assign((count >> kBlockShift) + 2, 0);
-  link_step.assign(count, 0);
-  std::uint32_t value = first_level_count, base = 0;
-  const std::uint32_t mask = (1u << kBlockShift) - 1;
-  for (std::uint32_t i = 0; i < count; ++i) {
-    if (i == last_level_begin) value = 0;  // link indices count the last level's interior nodes
-    const std::uint32_t k = i - (i < last_level_begin ? 0 : last_level_begin);
-    if ((k & mask) == 0) {
-      base = value;
-      link_base[i < last_level_begin ? k >> kBlockShift
-                                     : first_last_level_block() + (k >> kBlockShift)] = base;
+  link_step.resize(count);  // every entry is written below
+  // Each part block by block: a block's base, then a running sum of its records' child counts
+  // (on the last level, link indices count its interior nodes: one each). A loop a part,
+  // without a test of which part a record is in (a full-detail frame of a 100 M-point model
+  // spent 9 % of its time here).
+  const auto part = [&]<bool kLastLevel>(std::uint32_t begin, std::uint32_t end,
+                                         std::uint32_t value, std::uint32_t block) {
+    for (std::uint32_t b = begin; b < end; b += 1u << kBlockShift, ++block) {
+      link_base[block] = value;
+      const std::uint32_t stop = std::min(end, b + (1u << kBlockShift));
+      std::uint32_t step = 0;  // at most 4 · 63
+      for (std::uint32_t i = b; i < stop; ++i) {
+        link_step[i] = static_cast<std::uint8_t>(step);
+        const std::uint32_t children = quant::record_child_count(records[i]);
+        step += kLastLevel ? std::uint32_t{children != 0} : children;
+      }
+      value += step;
     }
-    link_step[i] = static_cast<std::uint8_t>(value - base);  // at most 4 · 63
-    const std::uint32_t children = quant::record_child_count(records[i]);
-    if (i < last_level_begin) {
-      value += children;
-    } else {
-      value += children != 0;
-    }
-  }
+  };
+  part.template operator()<false>(0, last_level_begin, first_level_count, 0);
+  part.template operator()<true>(last_level_begin, count, 0, first_last_level_block());
 }
 
 std::unique_ptr<PageSource> paginate(const SphereTreeView& tree, std::uint64_t page_bytes,
