@@ -266,7 +266,7 @@ std::unique_ptr<PtlV2File> PtlV2File::open(const std::string& path) {
 
 PtlV2File::~PtlV2File() = default;
 
-template <class OnRecord>
+template <bool kParents, class OnRecord>
 std::uint32_t PtlV2File::scan_page(std::uint32_t page, std::vector<Sphere>& root_spheres,
                                    std::vector<std::uint8_t>& root_child_counts,
                                    OnRecord&& on_record, const PagePrefix& prefix,
@@ -304,7 +304,7 @@ std::uint32_t PtlV2File::scan_page(std::uint32_t page, std::vector<Sphere>& root
   // Level by level: the parents of level L + 1 are the roots (L = 0) or the interior records of
   // level L, in order; a level holds exactly their children. Child counts of the records seen
   // so far (the scan for the next parent never passes the current record).
-  std::vector<std::uint8_t> child_counts(count);
+  std::vector<std::uint8_t> child_counts(kParents ? count : 0);
   std::uint64_t need = 0;
   for (std::uint32_t r = 0; r < roots; ++r) need += root_child_counts[r];
   std::uint32_t next_root = 0;
@@ -328,6 +328,42 @@ std::uint32_t PtlV2File::scan_page(std::uint32_t page, std::vector<Sphere>& root
     ++levels;
     if (node_level == 0 && prefix.node < level_end) node_level = levels;
     need = 0;
+    // Record i checked (sphere code, reserved bit, normal code) and passed on.
+    const auto take = [&](PageParent parent, bool first_child) {
+      const std::uint64_t at = records_at + i * rs;
+      const std::uint8_t* r = base + at;
+      const bool is_known = i < known.size();
+      const std::uint32_t rec = is_known ? known[i] : load_u32(r);
+      const std::uint16_t color = rs == 6 && !is_known ? load_u16(r + 4) : 0;
+      const std::uint32_t code = bits(rec, kSphereShift, kSphereBits);
+      const std::uint32_t children = record_child_count(rec);
+      const std::uint32_t normal = bits(rec, kNormalShift, kNormalBits);
+      if (code >= kSphereCodeCount) {
+        fail_at(path_, at,
+                which() + "record " + str(i) + ": sphere code " + str(code) +
+                    " is outside the table (0.." + str(kSphereCodeCount - 1) + ")");
+      }
+      if (bits(rec, kLowTrimShift, 1) != 0 && (children != 0 || !trim_low_bit)) {
+        fail_at(path_, at + 1,
+                which() + "record " + str(i) + ": reserved bit 15 is set" +
+                    (trim_low_bit ? " on an interior node" : ""));
+      }
+      if (normal >= kNormalCodeCount) {
+        fail_at(path_, at + 2,
+                which() + "record " + str(i) + ": normal code " + str(normal) +
+                    " is outside the table (0.." + str(kNormalCodeCount - 1) + ")");
+      }
+      if constexpr (kParents) child_counts[i] = static_cast<std::uint8_t>(children);
+      need += children;
+      if (!is_known) on_record(static_cast<std::uint32_t>(i), rec, color, parent, first_child);
+    };
+    if constexpr (!kParents) {
+      // The level's size is the previous level's child counts' sum, and that is all there is
+      // to check of the structure: the records in one run (a loop a parent, of 2 to 4
+      // records, mispredicts its end).
+      for (; i < level_end; ++i) take(PageParent{}, false);
+      continue;
+    }
     while (i < level_end) {
       // The level's records are exactly the children of these parents, so the scan stays
       // within the previous level.
@@ -341,34 +377,7 @@ std::uint32_t PtlV2File::scan_page(std::uint32_t page, std::vector<Sphere>& root
         parent = {false, static_cast<std::uint32_t>(next_parent)};
         k = child_counts[next_parent++];
       }
-      for (std::uint32_t c = 0; c < k; ++c, ++i) {
-        const std::uint64_t at = records_at + i * rs;
-        const std::uint8_t* r = base + at;
-        const bool is_known = i < known.size();
-        const std::uint32_t rec = is_known ? known[i] : load_u32(r);
-        const std::uint16_t color = rs == 6 && !is_known ? load_u16(r + 4) : 0;
-        const std::uint32_t code = bits(rec, kSphereShift, kSphereBits);
-        const std::uint32_t children = record_child_count(rec);
-        const std::uint32_t normal = bits(rec, kNormalShift, kNormalBits);
-        if (code >= kSphereCodeCount) {
-          fail_at(path_, at,
-                  which() + "record " + str(i) + ": sphere code " + str(code) +
-                      " is outside the table (0.." + str(kSphereCodeCount - 1) + ")");
-        }
-        if (bits(rec, kLowTrimShift, 1) != 0 && (children != 0 || !trim_low_bit)) {
-          fail_at(path_, at + 1,
-                  which() + "record " + str(i) + ": reserved bit 15 is set" +
-                      (trim_low_bit ? " on an interior node" : ""));
-        }
-        if (normal >= kNormalCodeCount) {
-          fail_at(path_, at + 2,
-                  which() + "record " + str(i) + ": normal code " + str(normal) +
-                      " is outside the table (0.." + str(kNormalCodeCount - 1) + ")");
-        }
-        child_counts[i] = static_cast<std::uint8_t>(children);
-        need += child_counts[i];
-        if (!is_known) on_record(static_cast<std::uint32_t>(i), rec, color, parent, c == 0);
-      }
+      for (std::uint32_t c = 0; c < k; ++c, ++i) take(parent, c == 0);
     }
   }
   if (scanned != nullptr) *scanned = static_cast<std::uint32_t>(i);
@@ -437,7 +446,7 @@ void PtlV2File::pack_page(std::uint32_t page, PackedPage& out, const PagePrefix&
   std::vector<Sphere> root_spheres;
   std::vector<std::uint8_t> root_child_counts;
   std::uint32_t scanned = count;
-  out.last_level_begin = scan_page(
+  out.last_level_begin = scan_page</*kParents=*/false>(
       page, root_spheres, root_child_counts,
       [&](std::uint32_t i, std::uint32_t rec, std::uint16_t color, PageParent, bool) {
         out.records[i] = rec;

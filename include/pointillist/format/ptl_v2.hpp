@@ -328,7 +328,9 @@ class PtlV2File {
   // order. Returns the index of the first record of the last level. With a `prefix`, stops
   // after the first level where it is enough (`scanned`: the records seen). The `known` first
   // records (whole levels) are taken from there, not read, and not passed to on_record.
-  template <class OnRecord>
+  // Without kParents, on_record is told no parent (a default PageParent, is_first_child false),
+  // and the scan is faster: the same checks and errors.
+  template <bool kParents = true, class OnRecord>
   std::uint32_t scan_page(std::uint32_t page, std::vector<Sphere>& root_spheres,
                           std::vector<std::uint8_t>& root_child_counts, OnRecord&& on_record,
                           const PagePrefix& prefix = {}, std::uint32_t* scanned = nullptr,
