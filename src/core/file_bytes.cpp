@@ -127,20 +127,9 @@ FileBytes FileBytes::map(const std::string& path, Use use) {
   return bytes;
 }
 
-void FileBytes::forget(std::uint64_t offset, std::uint64_t size) const {
-  if (map_ == nullptr || offset >= map_size_ || size == 0) return;
-  // The memory pages around the bytes (mapped read-only, never written: dropping one loses
-  // nothing), in the aligned windows a fault may map at once: the kernel maps the cached pages
-  // around a faulting one too, a whole large folio of the page cache (up to 2 MB of aligned
-  // virtual addresses; here up to 512 KB seen), which a read of these bytes mapped, whoever
-  // else's they also are. Clipped to the mapping.
-  constexpr std::uintptr_t window = 2 << 20;
-  const auto base = reinterpret_cast<std::uintptr_t>(map_);
-  const std::uint64_t end = std::min<std::uint64_t>(map_size_, offset + size);
-  const std::uintptr_t first = std::max(base, (base + offset) / window * window);
-  const std::uintptr_t last =
-      std::min<std::uintptr_t>((base + end + window - 1) / window * window, base + map_size_);
-  ::madvise(reinterpret_cast<void*>(first), last - first, MADV_DONTNEED);
+void FileBytes::forget() const {
+  // Mapped read-only, never written: dropping a page loses nothing.
+  if (map_ != nullptr) ::madvise(map_, map_size_, MADV_DONTNEED);
 }
 
 bool has_gzip_magic(std::string_view bytes) {

@@ -49,12 +49,11 @@ class FileBytes {
   static FileBytes load(const std::string& path,
                         const std::function<void(std::uint64_t)>& on_compressed_bytes = {});
 
-  // Unmaps from this process the memory pages that hold bytes [offset, offset + size) of a
-  // mapped file once their contents were copied out: the file stays in the kernel's page cache
-  // and a later read of those bytes maps them again. Without it, every page of a model a render
-  // ever touched would count as the process's resident memory. No effect on bytes read into a
-  // buffer (inflated or unmappable files).
-  void forget(std::uint64_t offset, std::uint64_t size) const;
+  // Unmaps a mapped file's pages from this process once their contents were copied out: the
+  // file stays in the kernel's page cache and a later read maps its pages again. Without it,
+  // every page of a model a render ever touched would count as the process's resident memory.
+  // No effect on bytes read into a buffer (inflated or unmappable files).
+  void forget() const;
 
  private:
   friend class GzipInflater;
